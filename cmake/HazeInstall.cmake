@@ -1,0 +1,11 @@
+# install(): exported targets haze::core, haze::simd, ... and a hazeConfig.cmake with a version
+# file, so a consumer writes find_package(haze) and links haze::core (tests/install checks this).
+include(CMakePackageConfigHelpers)
+set(HAZE_CMAKE_DIR ${CMAKE_INSTALL_LIBDIR}/cmake/haze)
+install(EXPORT hazeTargets NAMESPACE haze:: DESTINATION ${HAZE_CMAKE_DIR})
+configure_package_config_file(cmake/hazeConfig.cmake.in ${CMAKE_CURRENT_BINARY_DIR}/hazeConfig.cmake
+  INSTALL_DESTINATION ${HAZE_CMAKE_DIR})
+write_basic_package_version_file(${CMAKE_CURRENT_BINARY_DIR}/hazeConfigVersion.cmake
+  COMPATIBILITY SameMinorVersion)
+install(FILES ${CMAKE_CURRENT_BINARY_DIR}/hazeConfig.cmake ${CMAKE_CURRENT_BINARY_DIR}/hazeConfigVersion.cmake
+  DESTINATION ${HAZE_CMAKE_DIR})

@@ -1,0 +1,29 @@
+# haze_warnings: an INTERFACE target that carries the project's warning and sanitizer flags
+# (after pbrt's pbrt_warnings). -Wdouble-promotion catches silent doubles in float kernels.
+add_library(haze_warnings INTERFACE)
+target_compile_options(haze_warnings INTERFACE -Wall -Wextra -Wdouble-promotion)
+if(HAZE_WERROR)
+  target_compile_options(haze_warnings INTERFACE -Werror)
+endif()
+if(HAZE_SANITIZE)
+  target_compile_options(haze_warnings INTERFACE -fsanitize=address,undefined -fno-omit-frame-pointer)
+  target_link_options(haze_warnings INTERFACE -fsanitize=address,undefined)
+endif()
+install(TARGETS haze_warnings EXPORT hazeTargets)
+
+# haze_module(NAME folder-target SOURCES ... DEPS ...): one static library per top-level folder,
+# public headers in <folder>/include, exported as haze::<name>.
+function(haze_module name)
+  cmake_parse_arguments(ARG "" "" "SOURCES;PUBLIC_DEPS;PRIVATE_DEPS" ${ARGN})
+  add_library(haze_${name} STATIC ${ARG_SOURCES})
+  add_library(haze::${name} ALIAS haze_${name})
+  set_target_properties(haze_${name} PROPERTIES EXPORT_NAME ${name} OUTPUT_NAME haze_${name})
+  target_include_directories(haze_${name} PUBLIC
+    $<BUILD_INTERFACE:${CMAKE_CURRENT_SOURCE_DIR}/include>
+    $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}>
+    PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/src)
+  target_link_libraries(haze_${name} PUBLIC ${ARG_PUBLIC_DEPS} PRIVATE ${ARG_PRIVATE_DEPS} $<BUILD_INTERFACE:haze_warnings>)
+  install(TARGETS haze_${name} EXPORT hazeTargets
+    ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR})
+  install(DIRECTORY include/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+endfunction()
