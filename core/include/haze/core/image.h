@@ -1,0 +1,51 @@
+// RGB float images (linear, rows top to bottom) and their files: OpenEXR holds linear float data,
+// PNG holds a tone-mapped 8-bit preview only.
+#pragma once
+
+#include <haze/core/math.h>
+
+#include <filesystem>
+#include <optional>
+#include <vector>
+
+namespace haze {
+
+class Image {
+ public:
+  Image() = default;
+  Image(int width, int height);  // zero-filled; throws haze::Error for sizes <= 0 or too large
+
+  int width() const { return width_; }
+  int height() const { return height_; }
+  Rgb at(int x, int y) const {
+    const float* p = &pixels_[index(x, y)];
+    return {p[0], p[1], p[2]};
+  }
+  void set(int x, int y, const Rgb& c) {
+    float* p = &pixels_[index(x, y)];
+    p[0] = static_cast<float>(c.r), p[1] = static_cast<float>(c.g), p[2] = static_cast<float>(c.b);
+  }
+  // Interleaved RGB, 3 floats per pixel.
+  const std::vector<float>& data() const { return pixels_; }
+  std::vector<float>& data() { return pixels_; }
+  Rgb mean() const;
+
+ private:
+  size_t index(int x, int y) const { return 3 * (static_cast<size_t>(y) * static_cast<size_t>(width_) + static_cast<size_t>(x)); }
+  int width_ = 0, height_ = 0;
+  std::vector<float> pixels_;
+};
+
+// Writes linear float RGB ("R", "G", "B"); with std_error, also its layer "stderr.R/G/B".
+void write_exr(const std::filesystem::path& path, const Image& image, const Image* std_error = nullptr);
+// Reads the "R", "G", "B" channels; with std_error, also the "stderr" layer when present.
+Image read_exr(const std::filesystem::path& path, std::optional<Image>* std_error = nullptr);
+// 8-bit sRGB preview, tone-mapped with exposure then Reinhard x / (1 + x): not data.
+void write_png(const std::filesystem::path& path, const Image& image, double exposure = 1.0);
+
+// Root mean square over pixels and channels of (a - b); sizes must match.
+double rmse(const Image& a, const Image& b);
+// rmse(a, b) / rms(b): the relative error `haze demo` reports against the reference.
+double relative_rmse(const Image& a, const Image& reference);
+
+}  // namespace haze

@@ -1,0 +1,46 @@
+// Lights (DESIGN.md "Units"): point (radiant intensity I, irradiance I / d^2), spot
+// (I0 cos^n(theta) inside the cone half-angle), directional (irradiance E), sky (radiance from
+// outside the medium, the same in every direction).
+#pragma once
+
+#include <haze/core/math.h>
+
+#include <variant>
+
+namespace haze {
+
+struct PointLight {
+  Vec3 position{0.0};
+  Rgb intensity{1.0};  // W/sr per channel
+};
+
+struct SpotLight {
+  Vec3 position{0.0};
+  Vec3 direction{0.0, 0.0, -1.0};  // unit axis the light shines along
+  Rgb intensity{1.0};              // I0, on the axis
+  double exponent = 1.0;           // n in cos^n(theta)
+  double cone_deg = 45.0;          // half-angle of the cone, degrees
+};
+
+struct DirectionalLight {
+  Vec3 direction{0.0, 0.0, -1.0};  // unit propagation direction of the light
+  Rgb irradiance{1.0};             // on a plane perpendicular to it
+};
+
+struct SkyLight {
+  Rgb radiance{1.0};
+};
+
+using Light = std::variant<PointLight, SpotLight, DirectionalLight, SkyLight>;
+
+// What a delta light (point, spot, directional) delivers at x, ignoring occlusion.
+struct LightArrival {
+  Vec3 to_light{0.0};      // unit vector from x toward the light (minus the propagation direction)
+  double distance = 0.0;   // to the light; infinite for a directional light
+  Rgb irradiance{0.0};     // on a plane perpendicular to to_light
+};
+
+// Delta lights only: a sky light has no single direction (returns false).
+bool arrival(const Light& light, const Vec3& x, LightArrival& out);
+
+}  // namespace haze

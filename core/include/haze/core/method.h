@@ -1,0 +1,71 @@
+// Rendering methods and their registry. Each method (reference, analytic, propagation, dom,
+// network, ...) registers itself under its scene-file name; `haze render --method` and the scene's
+// "method" block pick one.
+#pragma once
+
+#include <haze/core/image.h>
+#include <haze/core/progress.h>
+#include <haze/core/scene.h>
+
+#include <nlohmann/json.hpp>
+
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace haze {
+
+struct RenderOptions {
+  int threads = 0;  // 0: every core oneTBB offers; otherwise a cap
+  nlohmann::json settings = nlohmann::json::object();  // the method's settings ("name" ignored)
+  ProgressCallback progress;  // optional; return false to cancel (render throws haze::Cancelled)
+};
+
+struct RenderResult {
+  Image radiance;
+  std::optional<Image> std_error;  // per-pixel standard error, for Monte Carlo methods
+  nlohmann::json stats = nlohmann::json::object();  // method-specific figures for --json
+};
+
+class Method {
+ public:
+  virtual ~Method() = default;
+  virtual RenderResult render(const Scene& scene, const RenderOptions& options) const = 0;
+};
+
+struct MethodInfo {
+  std::string name;
+  std::string summary;  // one line for `haze render --help` and error messages
+  std::function<std::unique_ptr<Method>()> create;
+};
+
+// Reads a method's settings with validation: a bad value or a key the method never asked for
+// throws haze::Error naming "method.<key>".
+class Settings {
+ public:
+  Settings(const nlohmann::json& settings, std::string method);
+  long long integer(const std::string& key, long long fallback, long long min, long long max);
+  double number(const std::string& key, double fallback, double min, double max);
+  // Throws for any key not read by integer() or number().
+  void reject_unknown() const;
+
+ private:
+  const nlohmann::json& settings_;
+  std::string method_;
+  std::vector<std::string> known_;
+};
+
+// Adds a method; a second registration under the same name replaces the first.
+void register_method(MethodInfo info);
+// All registered methods, sorted by name (core's own are always there).
+std::vector<MethodInfo> registered_methods();
+// Throws haze::Error listing the available methods when the name is unknown.
+std::unique_ptr<Method> create_method(const std::string& name);
+
+// Renders with `method_name`, or the scene's method when empty. The scene's method settings
+// apply when its name matches; options.settings override them key by key.
+RenderResult render(const Scene& scene, const std::string& method_name, RenderOptions options = {});
+
+}  // namespace haze

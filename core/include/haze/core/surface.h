@@ -1,0 +1,34 @@
+// Opaque surfaces that block and reflect light: planes and spheres with energy-normalized BRDFs
+// (DESIGN.md): Lambert kd / pi plus Phong ks (n + 2) / (2 pi) cos^n(alpha). The thesis (seed 002)
+// writes kd and ks cos^n; its constants are folded in here.
+#pragma once
+
+#include <haze/core/math.h>
+
+#include <variant>
+
+namespace haze {
+
+struct Plane {
+  Vec3 point{0.0};
+  Vec3 normal{0.0, 1.0, 0.0};  // unit
+};
+
+struct Sphere {
+  Vec3 center{0.0};
+  double radius = 1.0;
+};
+
+struct Surface {
+  std::variant<Plane, Sphere> shape;
+  Rgb kd{0.5};
+  Rgb ks{0.0};
+  double shininess = 1.0;
+
+  // Nearest hit with t in (t_min, t_max); writes t and the unit normal facing the ray's origin.
+  bool intersect(const Ray& ray, double t_min, double t_max, double& t, Vec3& normal) const;
+  // f(wi, wo) per steradian: wi points toward the light, wo toward the viewer, n the unit normal.
+  Rgb brdf(const Vec3& wi, const Vec3& wo, const Vec3& n) const;
+};
+
+}  // namespace haze

@@ -1,0 +1,149 @@
+#include <haze/core/error.h>
+#include <haze/core/image.h>
+
+#include <ImfChannelList.h>
+#include <ImfFrameBuffer.h>
+#include <ImfHeader.h>
+#include <ImfInputFile.h>
+#include <ImfOutputFile.h>
+#include <png.h>
+
+#include <cstdio>
+#include <memory>
+
+namespace haze {
+
+Image::Image(int width, int height) {
+  if (width <= 0 || height <= 0 || static_cast<long long>(width) * height > (1LL << 28))
+    throw Error("image size", to_text(width) + " x " + to_text(height), "positive sizes with at most 2^28 pixels");
+  width_ = width, height_ = height;
+  pixels_.assign(3 * static_cast<size_t>(width) * static_cast<size_t>(height), 0.0f);
+}
+
+Rgb Image::mean() const {
+  Rgb sum(0.0);
+  for (size_t i = 0; i < pixels_.size(); i += 3) sum += Rgb(pixels_[i], pixels_[i + 1], pixels_[i + 2]);
+  return pixels_.empty() ? sum : sum / static_cast<double>(pixels_.size() / 3);
+}
+
+namespace {
+
+const char* kChannels[3] = {"R", "G", "B"};
+
+void insert_layer(Imf::FrameBuffer& fb, const std::string& prefix, const Image& image) {
+  auto* base = const_cast<char*>(reinterpret_cast<const char*>(image.data().data()));
+  for (int c = 0; c < 3; ++c)
+    fb.insert(prefix + kChannels[c], Imf::Slice(Imf::FLOAT, base + c * sizeof(float), 3 * sizeof(float),
+                                                3 * sizeof(float) * static_cast<size_t>(image.width())));
+}
+
+void check_same_size(const Image& a, const Image& b, const char* what) {
+  if (a.width() != b.width() || a.height() != b.height())
+    throw Error(what, to_text(b.width()) + " x " + to_text(b.height()),
+                "the size of the image, " + to_text(a.width()) + " x " + to_text(a.height()));
+}
+
+}  // namespace
+
+void write_exr(const std::filesystem::path& path, const Image& image, const Image* std_error) {
+  if (std_error) check_same_size(image, *std_error, "std_error image size");
+  try {
+    Imf::Header header(image.width(), image.height());
+    Imf::FrameBuffer fb;
+    for (const char* c : kChannels) header.channels().insert(c, Imf::Channel(Imf::FLOAT));
+    insert_layer(fb, "", image);
+    if (std_error) {
+      for (const char* c : kChannels) header.channels().insert(std::string("stderr.") + c, Imf::Channel(Imf::FLOAT));
+      insert_layer(fb, "stderr.", *std_error);
+    }
+    Imf::OutputFile file(path.string().c_str(), header);
+    file.setFrameBuffer(fb);
+    file.writePixels(image.height());
+  } catch (const std::exception& e) {
+    throw Error("exr output " + path.string(), e.what(), "a writable file");
+  }
+}
+
+Image read_exr(const std::filesystem::path& path, std::optional<Image>* std_error) {
+  try {
+    Imf::InputFile file(path.string().c_str());
+    auto window = file.header().dataWindow();
+    Image image(window.max.x - window.min.x + 1, window.max.y - window.min.y + 1);
+    bool has_error = file.header().channels().findChannel("stderr.R") != nullptr;
+    if (std_error) *std_error = has_error ? std::optional<Image>(Image(image.width(), image.height())) : std::nullopt;
+    Imf::FrameBuffer fb;
+    insert_layer(fb, "", image);
+    if (std_error && has_error) insert_layer(fb, "stderr.", **std_error);
+    // The slices are addressed from the data window's origin.
+    for (auto it = fb.begin(); it != fb.end(); ++it) {
+      auto& slice = it.slice();
+      slice.base -= (static_cast<ptrdiff_t>(window.min.y) * image.width() + window.min.x) * 3 * sizeof(float);
+    }
+    file.setFrameBuffer(fb);
+    file.readPixels(window.min.y, window.max.y);
+    return image;
+  } catch (const Error&) {
+    throw;
+  } catch (const std::exception& e) {
+    throw Error("exr input " + path.string(), e.what(), "a readable OpenEXR file");
+  }
+}
+
+void write_png(const std::filesystem::path& path, const Image& image, double exposure) {
+  std::unique_ptr<FILE, int (*)(FILE*)> file(std::fopen(path.string().c_str(), "wb"), &std::fclose);
+  if (!file) throw Error("png output", path.string(), "a writable file");
+  png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
+  png_infop info = png ? png_create_info_struct(png) : nullptr;
+  if (!png || !info) {
+    png_destroy_write_struct(&png, nullptr);
+    throw Error("png output", path.string(), "memory for libpng");
+  }
+  std::vector<unsigned char> row(3 * static_cast<size_t>(image.width()));
+  if (setjmp(png_jmpbuf(png))) {
+    png_destroy_write_struct(&png, &info);
+    throw Error("png output", path.string(), "a file libpng could write");
+  }
+  png_init_io(png, file.get());
+  png_set_IHDR(png, info, static_cast<png_uint_32>(image.width()), static_cast<png_uint_32>(image.height()), 8,
+               PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+  png_text text{};
+  text.compression = PNG_TEXT_COMPRESSION_NONE;
+  text.key = const_cast<char*>("Comment");
+  text.text = const_cast<char*>("Haze preview: tone-mapped (exposure, Reinhard, sRGB), not data; the EXR holds linear radiance");
+  png_set_text(png, info, &text, 1);
+  png_write_info(png, info);
+  for (int y = 0; y < image.height(); ++y) {
+    for (int x = 0; x < image.width(); ++x) {
+      Rgb c = image.at(x, y) * exposure;
+      for (int k = 0; k < 3; ++k) {
+        double v = std::max(0.0, c[k]);
+        if (!std::isfinite(v)) v = 0.0;
+        v = v / (1.0 + v);
+        v = v <= 0.0031308 ? 12.92 * v : 1.055 * std::pow(v, 1.0 / 2.4) - 0.055;
+        row[3 * static_cast<size_t>(x) + static_cast<size_t>(k)] = static_cast<unsigned char>(std::lround(std::clamp(v, 0.0, 1.0) * 255.0));
+      }
+    }
+    png_write_row(png, row.data());
+  }
+  png_write_end(png, nullptr);
+  png_destroy_write_struct(&png, &info);
+}
+
+double rmse(const Image& a, const Image& b) {
+  check_same_size(a, b, "image size");
+  double sum = 0.0;
+  for (size_t i = 0; i < a.data().size(); ++i) {
+    double d = static_cast<double>(a.data()[i]) - static_cast<double>(b.data()[i]);
+    sum += d * d;
+  }
+  return std::sqrt(sum / static_cast<double>(a.data().size()));
+}
+
+double relative_rmse(const Image& a, const Image& reference) {
+  double rms = 0.0;
+  for (float v : reference.data()) rms += static_cast<double>(v) * static_cast<double>(v);
+  rms = std::sqrt(rms / static_cast<double>(reference.data().size()));
+  return rms > 0.0 ? rmse(a, reference) / rms : rmse(a, reference);
+}
+
+}  // namespace haze

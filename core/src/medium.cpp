@@ -1,0 +1,142 @@
+#include <haze/core/error.h>
+#include <haze/core/medium.h>
+
+#include <algorithm>
+
+namespace haze {
+
+double Medium::density_integral(const Vec3& a, const Vec3& b) const {
+  double length = glm::length(b - a);
+  if (length == 0.0) return 0.0;
+  Ray ray{a, (b - a) / length};
+  double t0 = 0.0, t1 = length;
+  if (!bounds().clip(ray, t0, t1)) return 0.0;
+  // Composite Simpson over an even number of steps no longer than feature_size() / 4.
+  int n = 2 * std::max(1, static_cast<int>(std::ceil((t1 - t0) / (0.5 * feature_size()))));
+  n = std::min(n, 1 << 16);
+  double h = (t1 - t0) / n;
+  double sum = density(ray.at(t0)) + density(ray.at(t1));
+  for (int i = 1; i < n; ++i) sum += (i % 2 ? 4.0 : 2.0) * density(ray.at(t0 + i * h));
+  return sum * h / 3.0;
+}
+
+Rgb Medium::transmittance(const Vec3& a, const Vec3& b) const {
+  return glm::exp(-sigma_t_ * density_integral(a, b));
+}
+
+namespace {
+
+class ConstantMedium final : public Medium {
+ public:
+  ConstantMedium(const MediumDesc& desc, double value)
+      : Medium(desc.sigma_t, desc.albedo, desc.phase), bounds_(desc.bounds), value_(value) {}
+  Aabb bounds() const override { return bounds_; }
+  double density(const Vec3& x) const override { return bounds_.contains(x) ? value_ : 0.0; }
+  double max_density(const Aabb&) const override { return value_; }
+  double feature_size() const override { return kInfinity; }
+  bool homogeneous() const override { return true; }
+  double density_integral(const Vec3& a, const Vec3& b) const override {
+    double length = glm::length(b - a);
+    if (length == 0.0) return 0.0;
+    double t0 = 0.0, t1 = length;
+    if (!bounds_.clip({a, (b - a) / length}, t0, t1)) return 0.0;
+    return value_ * (t1 - t0);
+  }
+
+ private:
+  Aabb bounds_;
+  double value_;
+};
+
+// Evaluates the RBF sum directly (seed 003 eq. 2); grids/ injects it into a grid for speed.
+class RbfMedium final : public Medium {
+ public:
+  RbfMedium(const MediumDesc& desc, const RbfDensity& rbf) : Medium(desc.sigma_t, desc.albedo, desc.phase), blobs_(rbf.blobs) {
+    bounds_ = desc.bounds;
+    feature_ = kInfinity;
+    for (const auto& b : blobs_) {
+      max_ += b.weight;
+      feature_ = std::min(feature_, 1.0 / b.sharpness);
+    }
+    if (!bounds_.bounded() && !blobs_.empty()) {
+      // Beyond 6 / sharpness a blob's density is below weight * e^-36: treat it as zero.
+      bounds_ = {Vec3(kInfinity), Vec3(-kInfinity)};
+      for (const auto& b : blobs_) {
+        bounds_.lo = glm::min(bounds_.lo, b.center - Vec3(6.0 / b.sharpness));
+        bounds_.hi = glm::max(bounds_.hi, b.center + Vec3(6.0 / b.sharpness));
+      }
+    }
+  }
+  Aabb bounds() const override { return bounds_; }
+  double density(const Vec3& x) const override {
+    if (!bounds_.contains(x)) return 0.0;
+    double rho = 0.0;
+    for (const auto& b : blobs_) {
+      Vec3 d = x - b.center;
+      rho += b.weight * std::exp(-b.sharpness * b.sharpness * glm::dot(d, d));
+    }
+    return rho;
+  }
+  double max_density(const Aabb&) const override { return max_; }
+  double feature_size() const override { return feature_; }
+
+ private:
+  std::vector<RbfBlob> blobs_;
+  Aabb bounds_;
+  double max_ = 0.0, feature_ = kInfinity;
+};
+
+class GridMedium final : public Medium {
+ public:
+  GridMedium(const MediumDesc& desc, const GridDensity& grid)
+      : Medium(desc.sigma_t, desc.albedo, desc.phase), bounds_(desc.bounds), grid_(grid) {
+    if (!bounds_.bounded()) throw Error("medium.bounds", "unbounded", "bounds for a grid density");
+    size_t cells = static_cast<size_t>(grid.resolution[0]) * static_cast<size_t>(grid.resolution[1]) * static_cast<size_t>(grid.resolution[2]);
+    if (grid.values.size() != cells) throw Error("medium.density.values", to_text(grid.values.size()), to_text(cells) + " values");
+    max_ = grid.values.empty() ? 0.0 : static_cast<double>(*std::max_element(grid.values.begin(), grid.values.end()));
+    Vec3 cell = bounds_.extent() / Vec3(grid.resolution[0], grid.resolution[1], grid.resolution[2]);
+    feature_ = std::min({cell.x, cell.y, cell.z});
+  }
+  Aabb bounds() const override { return bounds_; }
+  // Trilinear between cell centres, clamped to the outermost centres inside the bounds.
+  double density(const Vec3& x) const override {
+    if (!bounds_.contains(x)) return 0.0;
+    const auto& r = grid_.resolution;
+    Vec3 u = (x - bounds_.lo) / bounds_.extent() * Vec3(r[0], r[1], r[2]) - 0.5;
+    int i0[3], i1[3];
+    double f[3];
+    for (int a = 0; a < 3; ++a) {
+      double c = std::clamp(u[a], 0.0, static_cast<double>(r[a] - 1));
+      i0[a] = std::min(static_cast<int>(c), r[a] - 1);
+      i1[a] = std::min(i0[a] + 1, r[a] - 1);
+      f[a] = c - i0[a];
+    }
+    auto at = [&](int x_, int y_, int z_) {
+      return static_cast<double>(grid_.values[(static_cast<size_t>(z_) * static_cast<size_t>(r[1]) + static_cast<size_t>(y_)) * static_cast<size_t>(r[0]) + static_cast<size_t>(x_)]);
+    };
+    double c00 = at(i0[0], i0[1], i0[2]) * (1 - f[0]) + at(i1[0], i0[1], i0[2]) * f[0];
+    double c10 = at(i0[0], i1[1], i0[2]) * (1 - f[0]) + at(i1[0], i1[1], i0[2]) * f[0];
+    double c01 = at(i0[0], i0[1], i1[2]) * (1 - f[0]) + at(i1[0], i0[1], i1[2]) * f[0];
+    double c11 = at(i0[0], i1[1], i1[2]) * (1 - f[0]) + at(i1[0], i1[1], i1[2]) * f[0];
+    double c0 = c00 * (1 - f[1]) + c10 * f[1];
+    double c1 = c01 * (1 - f[1]) + c11 * f[1];
+    return c0 * (1 - f[2]) + c1 * f[2];
+  }
+  double max_density(const Aabb&) const override { return max_; }
+  double feature_size() const override { return feature_; }
+
+ private:
+  Aabb bounds_;
+  GridDensity grid_;
+  double max_ = 0.0, feature_ = 1.0;
+};
+
+}  // namespace
+
+std::unique_ptr<Medium> make_medium(const MediumDesc& desc) {
+  if (auto* c = std::get_if<ConstantDensity>(&desc.density)) return std::make_unique<ConstantMedium>(desc, c->value);
+  if (auto* r = std::get_if<RbfDensity>(&desc.density)) return std::make_unique<RbfMedium>(desc, *r);
+  return std::make_unique<GridMedium>(desc, std::get<GridDensity>(desc.density));
+}
+
+}  // namespace haze

@@ -1,0 +1,105 @@
+#include "builtin_methods.h"
+
+#include <haze/core/error.h>
+#include <haze/core/method.h>
+
+#include <algorithm>
+#include <map>
+#include <mutex>
+
+namespace haze {
+
+namespace {
+
+struct Registry {
+  std::mutex mutex;
+  std::map<std::string, MethodInfo> methods;
+  Registry() {
+    methods["quadrature"] = {"quadrature",
+                             "single scattering by deterministic numerical quadrature (any medium; a yardstick, not fast)",
+                             internal::make_quadrature_method};
+  }
+};
+
+Registry& registry() {
+  static Registry instance;
+  return instance;
+}
+
+}  // namespace
+
+void register_method(MethodInfo info) {
+  if (info.name.empty() || !info.create) throw Error("method.name", "\"" + info.name + "\"", "a name and a factory");
+  auto& r = registry();
+  std::lock_guard lock(r.mutex);
+  r.methods[info.name] = std::move(info);
+}
+
+std::vector<MethodInfo> registered_methods() {
+  auto& r = registry();
+  std::lock_guard lock(r.mutex);
+  std::vector<MethodInfo> out;
+  for (const auto& [name, info] : r.methods) out.push_back(info);
+  return out;
+}
+
+std::unique_ptr<Method> create_method(const std::string& name) {
+  auto& r = registry();
+  std::lock_guard lock(r.mutex);
+  auto it = r.methods.find(name);
+  if (it == r.methods.end()) {
+    std::string names;
+    for (const auto& [n, info] : r.methods) names += (names.empty() ? "" : ", ") + n;
+    throw Error("method.name", "\"" + name + "\"", "one of the available methods: " + names);
+  }
+  return it->second.create();
+}
+
+RenderResult render(const Scene& scene, const std::string& method_name, RenderOptions options) {
+  std::string name = method_name.empty() ? scene.method_name() : method_name;
+  if (name.empty()) throw Error("method.name", "missing", "a method named by the scene or the caller");
+  auto method = create_method(name);
+  nlohmann::json settings = nlohmann::json::object();
+  if (scene.method_name() == name) settings = scene.method;
+  for (const auto& [key, value] : options.settings.items()) settings[key] = value;
+  settings.erase("name");
+  options.settings = std::move(settings);
+  return method->render(scene, options);
+}
+
+}  // namespace haze
+
+namespace haze {
+
+Settings::Settings(const nlohmann::json& settings, std::string method) : settings_(settings), method_(std::move(method)) {
+  if (!settings_.is_object()) throw Error("method", settings_.dump(), "an object of " + method_ + " settings");
+}
+
+long long Settings::integer(const std::string& key, long long fallback, long long min, long long max) {
+  known_.push_back(key);
+  auto it = settings_.find(key);
+  if (it == settings_.end()) return fallback;
+  if (!it->is_number_integer() || it->get<long long>() < min || it->get<long long>() > max)
+    throw Error("method." + key, it->dump(), "an integer in [" + std::to_string(min) + ", " + std::to_string(max) + "]");
+  return it->get<long long>();
+}
+
+double Settings::number(const std::string& key, double fallback, double min, double max) {
+  known_.push_back(key);
+  auto it = settings_.find(key);
+  if (it == settings_.end()) return fallback;
+  if (!it->is_number() || !(it->get<double>() >= min && it->get<double>() <= max))
+    throw Error("method." + key, it->dump(), "a number in [" + to_text(min) + ", " + to_text(max) + "]");
+  return it->get<double>();
+}
+
+void Settings::reject_unknown() const {
+  for (const auto& [key, value] : settings_.items()) {
+    if (key == "name" || std::find(known_.begin(), known_.end(), key) != known_.end()) continue;
+    std::string names;
+    for (const auto& k : known_) names += (names.empty() ? "" : ", ") + k;
+    throw Error("method." + key, value.dump(), "a setting of " + method_ + ": " + (names.empty() ? "none" : names));
+  }
+}
+
+}  // namespace haze

@@ -1,0 +1,187 @@
+// Method "quadrature": single scattering by deterministic numerical quadrature, for any Medium.
+// L = integral_{t0}^{t1} T(o, x) sigma_s(x) sum_lights p(wi . wo) E_light(x) T(x, light) dt
+//     + T(o, t1) L_surface_or_escape,
+// with Gauss-Legendre panels along the view ray (split at each point light's closest approach,
+// where the integrand peaks), sky in-scattering over a Fibonacci DirectionSet, and surface direct
+// lighting with shadows. Slow and simple on purpose: it checks the fast single-scattering methods.
+#include "builtin_methods.h"
+
+#include <haze/core/directions.h>
+#include <haze/core/error.h>
+
+#include <algorithm>
+#include <chrono>
+
+namespace haze::internal {
+
+namespace {
+
+constexpr int kNodesPerPanel = 8;
+constexpr double kEpsilon = 1e-7;
+
+struct Context {
+  const Scene& scene;
+  std::unique_ptr<Medium> medium;
+  Rgb sky{0.0};
+  DirectionSet sky_directions;
+  int steps;
+
+  // True when a surface blocks the segment from x along dir (unit) up to distance.
+  bool occluded(const Vec3& x, const Vec3& dir, double distance) const {
+    double t;
+    Vec3 n;
+    for (const auto& s : scene.surfaces)
+      if (s.intersect({x, dir}, kEpsilon, distance * (1.0 - 1e-9), t, n)) return true;
+    return false;
+  }
+
+  Rgb transmittance(const Vec3& x, const Vec3& dir, double distance) const {
+    if (!medium) return Rgb(1.0);
+    if (std::isfinite(distance)) return medium->transmittance(x, x + dir * distance);
+    double t0 = 0.0, t1 = kInfinity;
+    if (!medium->bounds().clip({x, dir}, t0, t1)) return Rgb(1.0);
+    if (std::isfinite(t1)) return medium->transmittance(x, x + dir * t1);
+    // An unbounded medium absorbs everything from infinitely far, in channels where it extinguishes.
+    Rgb out(1.0);
+    bool dense = medium->max_density(medium->bounds()) > 0.0;
+    for (int c = 0; c < 3; ++c)
+      if (dense && medium->sigma_t_scale()[c] > 0.0) out[c] = 0.0;
+    return out;
+  }
+
+  // Light arriving at x that scatters toward the camera: sum over lights of p(wi . wo) E T.
+  Rgb in_scattered(const Vec3& x, const Vec3& wo) const {
+    const PhaseFunction& phase = medium->phase();
+    Rgb sum(0.0);
+    LightArrival a;
+    for (const auto& light : scene.lights) {
+      if (!arrival(light, x, a) || a.irradiance == Rgb(0.0) || occluded(x, a.to_light, a.distance)) continue;
+      sum += phase.eval(-a.to_light, wo) * a.irradiance * transmittance(x, a.to_light, a.distance);
+    }
+    if (sky != Rgb(0.0)) {
+      for (int j = 0; j < sky_directions.size(); ++j) {
+        const Vec3& wi = sky_directions[j];
+        if (occluded(x, -wi, kInfinity)) continue;
+        sum += sky_directions.weight(j) * phase.eval(wi, wo) * sky * transmittance(x, -wi, kInfinity);
+      }
+    }
+    return sum;
+  }
+
+  Rgb surface_radiance(const Surface& s, const Vec3& p, const Vec3& n, const Vec3& to_viewer) const {
+    Vec3 origin = p + n * kEpsilon;
+    Rgb sum(0.0);
+    LightArrival a;
+    for (const auto& light : scene.lights) {
+      if (!arrival(light, origin, a)) continue;
+      double cos_i = glm::dot(n, a.to_light);
+      if (cos_i <= 0.0 || occluded(origin, a.to_light, a.distance)) continue;
+      sum += s.brdf(a.to_light, to_viewer, n) * a.irradiance * cos_i * transmittance(origin, a.to_light, a.distance);
+    }
+    if (sky != Rgb(0.0)) {
+      for (int j = 0; j < sky_directions.size(); ++j) {
+        Vec3 to_sky = -sky_directions[j];
+        double cos_i = glm::dot(n, to_sky);
+        if (cos_i <= 0.0 || occluded(origin, to_sky, kInfinity)) continue;
+        sum += sky_directions.weight(j) * s.brdf(to_sky, to_viewer, n) * sky * cos_i * transmittance(origin, to_sky, kInfinity);
+      }
+    }
+    return sum;
+  }
+
+  Rgb pixel(const Ray& ray, const std::vector<double>& gl_nodes, const std::vector<double>& gl_weights) const {
+    double t_hit = kInfinity;
+    const Surface* hit = nullptr;
+    Vec3 normal(0.0);
+    for (const auto& s : scene.surfaces) {
+      double t;
+      Vec3 n;
+      if (s.intersect(ray, kEpsilon, t_hit, t, n)) t_hit = t, hit = &s, normal = n;
+    }
+    Rgb radiance(0.0), view_t(1.0);
+    double t0 = 0.0, t1 = t_hit;
+    if (medium && medium->bounds().clip(ray, t0, t1) && t1 > t0) {
+      if (!std::isfinite(t1)) {
+        // Unbounded homogeneous medium: stop where the view transmittance falls below e^-30.
+        double sigma_min = kInfinity;
+        for (int c = 0; c < 3; ++c)
+          if (medium->sigma_t_scale()[c] > 0.0) sigma_min = std::min(sigma_min, medium->sigma_t_scale()[c]);
+        double rho = medium->max_density(medium->bounds());
+        t1 = (rho > 0.0 && std::isfinite(sigma_min)) ? t0 + 30.0 / (sigma_min * rho) : t0;
+      }
+      // Breakpoints: the ends and each point-like light's closest approach.
+      std::vector<double> breaks{t0, t1};
+      for (const auto& light : scene.lights) {
+        const Vec3* p = std::get_if<PointLight>(&light) ? &std::get<PointLight>(light).position
+                        : std::get_if<SpotLight>(&light) ? &std::get<SpotLight>(light).position : nullptr;
+        if (!p) continue;
+        double tc = glm::dot(*p - ray.origin, ray.direction);
+        if (tc > t0 && tc < t1) breaks.push_back(tc);
+      }
+      std::sort(breaks.begin(), breaks.end());
+      const Vec3 wo = -ray.direction;
+      Vec3 previous = ray.at(t0);
+      for (size_t b = 0; b + 1 < breaks.size(); ++b) {
+        double a = breaks[b], len = breaks[b + 1] - a;
+        int panels = std::max(1, static_cast<int>(std::ceil(steps / double(kNodesPerPanel) * len / (t1 - t0))));
+        double h = len / panels;
+        for (int p = 0; p < panels; ++p) {
+          for (size_t q = 0; q < gl_nodes.size(); ++q) {
+            Vec3 x = ray.at(a + h * (p + 0.5 + 0.5 * gl_nodes[q]));
+            view_t *= glm::exp(-medium->sigma_t_scale() * medium->density_integral(previous, x));
+            previous = x;
+            Rgb sigma_s = medium->sigma_s(x);
+            if (sigma_s == Rgb(0.0)) continue;
+            radiance += 0.5 * h * gl_weights[q] * view_t * sigma_s * in_scattered(x, wo);
+          }
+        }
+      }
+      view_t *= glm::exp(-medium->sigma_t_scale() * medium->density_integral(previous, ray.at(t1)));
+    }
+    if (hit) {
+      Vec3 p = ray.at(t_hit);
+      radiance += view_t * surface_radiance(*hit, p, normal, -ray.direction);
+    } else if (std::isinf(t_hit)) {
+      radiance += view_t * (scene.background + sky);
+    }
+    return radiance;
+  }
+};
+
+class QuadratureMethod final : public Method {
+ public:
+  RenderResult render(const Scene& scene, const RenderOptions& options) const override {
+    Settings settings(options.settings, "quadrature");
+    int steps = static_cast<int>(settings.integer("steps", 512, kNodesPerPanel, 1 << 20));
+    int sky_count = static_cast<int>(settings.integer("sky_directions", 256, 1, 1 << 16));
+    settings.reject_unknown();
+
+    auto start = std::chrono::steady_clock::now();
+    Context ctx{scene, scene.medium ? make_medium(*scene.medium) : nullptr, Rgb(0.0), DirectionSet::fibonacci(sky_count), steps};
+    for (const auto& light : scene.lights)
+      if (auto* sky = std::get_if<SkyLight>(&light)) ctx.sky += sky->radiance;
+    std::vector<double> nodes, weights;
+    gauss_legendre(kNodesPerPanel, nodes, weights);
+
+    const Camera& camera = scene.camera;
+    RenderResult result{Image(camera.width_px, camera.height_px), std::nullopt, {}};
+    ProgressTracker progress(options.progress, camera.height_px);
+    parallel_for(camera.height_px, options.threads, 1, [&](long long y0, long long y1) {
+      for (auto y = static_cast<int>(y0); y < y1 && !progress.cancelled(); ++y) {
+        for (int x = 0; x < camera.width_px; ++x) result.radiance.set(x, y, ctx.pixel(camera.pixel_ray(x, y), nodes, weights));
+        progress.advance();
+      }
+    });
+    progress.throw_if_cancelled();
+    result.stats = {{"steps", steps},
+                    {"sky_directions", sky_count},
+                    {"seconds", std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()}};
+    return result;
+  }
+};
+
+}  // namespace
+
+std::unique_ptr<Method> make_quadrature_method() { return std::make_unique<QuadratureMethod>(); }
+
+}  // namespace haze::internal

@@ -1,0 +1,495 @@
+// Scene files (docs/SCENES.md). Every field is checked here, once, so that renderers can trust a
+// Scene: a bad value throws haze::Error naming its JSON path, the value and what was expected.
+#include <haze/core/error.h>
+#include <haze/core/scene.h>
+
+#include <algorithm>
+#include <bit>
+#include <climits>
+#include <cstdint>
+#include <fstream>
+#include <initializer_list>
+#include <iterator>
+#include <new>
+#include <string_view>
+#include <utility>
+
+namespace haze {
+
+namespace {
+
+using json = nlohmann::json;
+namespace fs = std::filesystem;
+
+constexpr int kMaxImagePx = 16384;
+constexpr int kMaxGridAxis = 16384;
+// Downstream code may index a grid with int: keep nx * ny * nz within int range.
+constexpr std::uint64_t kMaxGridCells = INT_MAX;
+
+const char* const kVec3Text = "an [x, y, z] array of 3 finite numbers";
+const char* const kDirectionText = "a non-zero [x, y, z] array of 3 finite numbers";
+
+std::string key_path(const std::string& path, std::string_view key) {
+  return path.empty() ? std::string(key) : path + "." + std::string(key);
+}
+std::string index_path(const std::string& path, std::size_t i) { return path + "[" + std::to_string(i) + "]"; }
+
+std::string join(std::initializer_list<std::string_view> names, std::string_view quote = "") {
+  std::string out;
+  for (auto name : names) {
+    if (!out.empty()) out += ", ";
+    out.append(quote).append(name).append(quote);
+  }
+  return out;
+}
+
+// The offending value as text. nlohmann dumps NaN and inf as null, so those are written by hand;
+// long values are cut so that a bad 1000-entry array does not flood the message.
+std::string text(const json& v) {
+  if (v.is_number_float() && !std::isfinite(v.get<double>())) return to_text(v.get<double>());
+  std::string s = v.dump(-1, ' ', false, json::error_handler_t::replace);
+  if (s.size() > 80) s = s.substr(0, 77) + "...";
+  return s;
+}
+
+// A number check: the predicate and the words for the error message.
+struct Check {
+  bool (*ok)(double);
+  const char* expected;
+};
+constexpr Check kFinite{[](double) { return true; }, "a finite number"};
+constexpr Check kNonNegative{[](double x) { return x >= 0.0; }, "a finite number >= 0"};
+constexpr Check kPositive{[](double x) { return x > 0.0; }, "a finite number > 0"};
+constexpr Check kUnit{[](double x) { return x >= 0.0 && x <= 1.0; }, "a finite number in [0, 1]"};
+// The phase constructors check |g| < 1 themselves; this only words the type error.
+constexpr Check kG{[](double) { return true; }, "a number with |g| < 1"};
+
+double read_number(const json& v, const std::string& path, Check check) {
+  if (!v.is_number()) throw Error(path, text(v), check.expected);
+  double x = v.get<double>();
+  if (!std::isfinite(x) || !check.ok(x)) throw Error(path, text(v), check.expected);
+  return x;
+}
+
+int read_int(const json& v, const std::string& path, int lo, int hi) {
+  const std::string expected = "an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]";
+  if (!v.is_number_integer()) throw Error(path, text(v), expected);
+  // Unsigned JSON integers may not fit int64_t; compare before converting.
+  if (v.is_number_unsigned()) {
+    auto u = v.get<std::uint64_t>();
+    if (u > static_cast<std::uint64_t>(hi) || static_cast<std::int64_t>(u) < lo) throw Error(path, text(v), expected);
+    return static_cast<int>(u);
+  }
+  auto i = v.get<std::int64_t>();
+  if (i < lo || i > hi) throw Error(path, text(v), expected);
+  return static_cast<int>(i);
+}
+
+Vec3 read_vec3(const json& v, const std::string& path) {
+  if (!v.is_array() || v.size() != 3) throw Error(path, text(v), kVec3Text);
+  Vec3 out;
+  for (int i = 0; i < 3; ++i) out[i] = read_number(v[i], index_path(path, i), kFinite);
+  return out;
+}
+
+// Unit vector along d, or false for a zero (or overflowing) vector. Scaling by the largest
+// component first keeps huge and tiny inputs from overflowing or underflowing the length.
+bool normalize(Vec3& d) {
+  double m = std::max({std::abs(d.x), std::abs(d.y), std::abs(d.z)});
+  if (!(m > 0.0) || !std::isfinite(m)) return false;
+  d = glm::normalize(d / m);
+  return true;
+}
+
+Vec3 read_direction(const json& v, const std::string& path) {
+  Vec3 d = read_vec3(v, path);
+  if (!normalize(d)) throw Error(path, text(v), kDirectionText);
+  return d;
+}
+
+// A colour-like quantity: one number for all channels or an [r, g, b] array, each checked.
+Rgb read_color(const json& v, const std::string& path, Check check) {
+  if (v.is_number()) return Rgb(read_number(v, path, check));
+  if (!v.is_array() || v.size() != 3)
+    throw Error(path, text(v), std::string(check.expected) + ", or an [r, g, b] array of such numbers");
+  Rgb out;
+  for (int i = 0; i < 3; ++i) out[i] = read_number(v[i], index_path(path, i), check);
+  return out;
+}
+
+std::string read_string(const json& v, const std::string& path, const std::string& expected) {
+  if (!v.is_string() || v.get_ref<const std::string&>().empty()) throw Error(path, text(v), expected);
+  return v.get<std::string>();
+}
+
+// A JSON object being read, with its path for error messages.
+class Object {
+ public:
+  Object(const json& j, std::string path) : j_(j), path_(std::move(path)) {
+    if (!j_.is_object()) throw Error(path_.empty() ? "(scene)" : path_, text(j_), "a JSON object {...}");
+  }
+
+  const std::string& path() const { return path_; }
+  std::string at(std::string_view key) const { return key_path(path_, key); }
+  const json* find(const char* key) const {
+    auto it = j_.find(key);
+    return it == j_.end() ? nullptr : &*it;
+  }
+  const json& need(const char* key, const std::string& expected) const {
+    if (const json* v = find(key)) return *v;
+    throw Error(at(key), "missing", expected);
+  }
+
+  // Unknown fields are almost always typos ("albdeo"): reject them and name the allowed ones.
+  void allow(std::initializer_list<std::string_view> fields) const {
+    for (const auto& [key, value] : j_.items()) {
+      if (std::find(fields.begin(), fields.end(), key) != fields.end()) continue;
+      std::string where = path_.empty() ? "the scene" : path_;
+      throw Error(at(key), "unknown field \"" + key + "\"", "a field of " + where + ": " + join(fields));
+    }
+  }
+
+  // The "type" field, one of `types`; `fallback` when absent, or required when fallback is null.
+  std::string type(std::initializer_list<std::string_view> types, const char* fallback = nullptr) const {
+    const std::string expected = "one of " + join(types, "\"");
+    const json* v = find("type");
+    if (!v) {
+      if (fallback) return fallback;
+      throw Error(at("type"), "missing", expected);
+    }
+    if (!v->is_string() || std::find(types.begin(), types.end(), v->get_ref<const std::string&>()) == types.end())
+      throw Error(at("type"), text(*v), expected);
+    return v->get<std::string>();
+  }
+
+  double number(const char* key, Check check) const { return read_number(need(key, check.expected), at(key), check); }
+  double number(const char* key, double fallback, Check check) const {
+    const json* v = find(key);
+    return v ? read_number(*v, at(key), check) : fallback;
+  }
+  int integer(const char* key, int fallback, int lo, int hi) const {
+    const json* v = find(key);
+    return v ? read_int(*v, at(key), lo, hi) : fallback;
+  }
+  Vec3 vec3(const char* key) const { return read_vec3(need(key, kVec3Text), at(key)); }
+  Vec3 vec3(const char* key, const Vec3& fallback) const {
+    const json* v = find(key);
+    return v ? read_vec3(*v, at(key)) : fallback;
+  }
+  Vec3 direction(const char* key) const { return read_direction(need(key, kDirectionText), at(key)); }
+  Rgb color(const char* key, Check check) const {
+    return read_color(need(key, std::string(check.expected) + ", or an [r, g, b] array of such numbers"), at(key),
+                      check);
+  }
+  Rgb color(const char* key, const Rgb& fallback, Check check) const {
+    const json* v = find(key);
+    return v ? read_color(*v, at(key), check) : fallback;
+  }
+
+ private:
+  const json& j_;
+  std::string path_;
+};
+
+Camera read_camera(const Object& o) {
+  Camera c;
+  std::string type = o.type({"pinhole", "orthographic"}, "pinhole");
+  // Each projection's own size field only: "height" on a pinhole camera is a likely mix-up with
+  // height_px, and silently ignoring it would hide that.
+  if (type == "pinhole") {
+    o.allow({"type", "position", "look_at", "up", "fov_y_deg", "width_px", "height_px"});
+    c.type = Camera::Type::pinhole;
+    c.fov_y_deg = o.number("fov_y_deg", 40.0, {[](double x) { return x > 0.0 && x < 180.0; },
+                                                "an angle in degrees in (0, 180)"});
+  } else {
+    o.allow({"type", "position", "look_at", "up", "height", "width_px", "height_px"});
+    c.type = Camera::Type::orthographic;
+    c.height = o.number("height", 2.0, kPositive);
+  }
+  c.position = o.vec3("position");
+  c.look_at = o.vec3("look_at");
+  c.up = o.vec3("up", Vec3(0.0, 1.0, 0.0));
+  c.width_px = o.integer("width_px", 64, 1, kMaxImagePx);
+  c.height_px = o.integer("height_px", 64, 1, kMaxImagePx);
+
+  Vec3 view = c.look_at - c.position;
+  if (!normalize(view)) throw Error(o.at("look_at"), text(*o.find("look_at")), "a point different from camera.position");
+  const std::string up_text = o.find("up") ? text(*o.find("up")) : "[0, 1, 0] (the default)";
+  if (!normalize(c.up)) throw Error(o.at("up"), up_text, kDirectionText);
+  if (glm::length(glm::cross(view, c.up)) < 1e-6)
+    throw Error(o.at("up"), up_text, "a vector not parallel to the view direction (look_at - position)");
+  return c;
+}
+
+Aabb read_bounds(const json& v, const std::string& path) {
+  const char* expected = "[[x0, y0, z0], [x1, y1, z1]] with x0 < x1, y0 < y1 and z0 < z1";
+  if (!v.is_array() || v.size() != 2) throw Error(path, text(v), expected);
+  Aabb box;
+  box.lo = read_vec3(v[0], index_path(path, 0));
+  box.hi = read_vec3(v[1], index_path(path, 1));
+  for (int a = 0; a < 3; ++a)
+    if (!(box.lo[a] < box.hi[a])) throw Error(path, text(v), expected);
+  return box;
+}
+
+void check_grid_values(const std::vector<float>& values, const GridDensity& grid, const std::string& path,
+                       const fs::path& file) {
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    if (std::isfinite(values[i]) && values[i] >= 0.0f) continue;
+    const auto nx = static_cast<std::size_t>(grid.resolution[0]), ny = static_cast<std::size_t>(grid.resolution[1]);
+    std::string cell = "(" + std::to_string(i % nx) + ", " + std::to_string(i / nx % ny) + ", " +
+                       std::to_string(i / (nx * ny)) + ")";
+    throw Error(path, to_text(values[i]) + " at cell " + cell + " (index " + std::to_string(i) + ") of " + file.string(),
+                "finite density values >= 0");
+  }
+}
+
+GridDensity read_grid(const Object& o, const fs::path& base_dir) {
+  GridDensity grid;
+  const std::string res_path = o.at("resolution");
+  const std::string res_expected = "[nx, ny, nz], integers in [1, " + std::to_string(kMaxGridAxis) + "]";
+  const json& res = o.need("resolution", res_expected);
+  if (!res.is_array() || res.size() != 3) throw Error(res_path, text(res), res_expected);
+  std::uint64_t cells = 1;
+  for (std::size_t i = 0; i < 3; ++i) {
+    grid.resolution[i] = read_int(res[i], index_path(res_path, i), 1, kMaxGridAxis);
+    cells *= static_cast<std::uint64_t>(grid.resolution[i]);
+  }
+  if (cells > kMaxGridCells)
+    throw Error(res_path, text(res), "at most " + std::to_string(kMaxGridCells) + " cells in all (nx * ny * nz)");
+
+  const std::string file_path = o.at("file");
+  const char* file_expected = "a float32 little-endian file name (relative to the scene file's folder)";
+  fs::path file = read_string(o.need("file", file_expected), file_path, file_expected);
+  if (file.is_relative()) file = base_dir / file;
+  file = file.lexically_normal();
+
+  std::error_code ec;
+  if (!fs::is_regular_file(file, ec))
+    throw Error(file_path, text(o.need("file", file_expected)) + " (resolved to " + file.string() + ")",
+                "an existing file; none found at " + file.string());
+  const std::uint64_t expected_bytes = cells * 4;
+  const std::uint64_t actual_bytes = fs::file_size(file, ec);
+  if (ec) throw Error(file_path, file.string(), "a readable file (" + ec.message() + ")");
+  if (actual_bytes != expected_bytes)
+    throw Error(file_path, file.string() + " of " + std::to_string(actual_bytes) + " bytes",
+                std::to_string(expected_bytes) + " bytes (nx * ny * nz * 4 = " + std::to_string(grid.resolution[0]) +
+                    " * " + std::to_string(grid.resolution[1]) + " * " + std::to_string(grid.resolution[2]) +
+                    " * 4)");
+
+  try {
+    grid.values.resize(static_cast<std::size_t>(cells));
+  } catch (const std::bad_alloc&) {
+    throw Error(file_path, file.string(), "a grid that fits in memory (" + std::to_string(expected_bytes) + " bytes)");
+  }
+  std::ifstream in(file, std::ios::binary);
+  in.read(reinterpret_cast<char*>(grid.values.data()), static_cast<std::streamsize>(expected_bytes));
+  if (!in) throw Error(file_path, file.string(), "a readable file of " + std::to_string(expected_bytes) + " bytes");
+  if constexpr (std::endian::native == std::endian::big) {
+    for (auto& v : grid.values) {
+      auto bits = std::bit_cast<std::uint32_t>(v);
+      bits = (bits >> 24) | ((bits >> 8) & 0xff00u) | ((bits << 8) & 0xff0000u) | (bits << 24);
+      v = std::bit_cast<float>(bits);
+    }
+  }
+  check_grid_values(grid.values, grid, file_path, file);
+  return grid;
+}
+
+Density read_density(const Object& o, bool bounded, const fs::path& base_dir) {
+  std::string type = o.type({"constant", "rbf", "grid"});
+  if (type == "constant") {
+    o.allow({"type", "value"});
+    return ConstantDensity{o.number("value", 1.0, kNonNegative)};
+  }
+  if (type == "grid") {
+    o.allow({"type", "resolution", "file"});
+    // The grid's cells span the medium's bounds, so without them it has no place in the world.
+    if (!bounded) throw Error("medium.bounds", "missing", "[[x0, y0, z0], [x1, y1, z1]]: a grid density needs them");
+    return read_grid(o, base_dir);
+  }
+  o.allow({"type", "blobs"});
+  const char* blobs_expected = "a non-empty array of {\"center\", \"weight\", \"sharpness\"} objects";
+  const json& blobs = o.need("blobs", blobs_expected);
+  if (!blobs.is_array() || blobs.empty()) throw Error(o.at("blobs"), text(blobs), blobs_expected);
+  RbfDensity rbf;
+  for (std::size_t i = 0; i < blobs.size(); ++i) {
+    Object b(blobs[i], index_path(o.at("blobs"), i));
+    b.allow({"center", "weight", "sharpness"});
+    RbfBlob blob;
+    blob.center = b.vec3("center");
+    blob.weight = b.number("weight", 1.0, kNonNegative);
+    blob.sharpness = b.number("sharpness", 1.0, kPositive);
+    rbf.blobs.push_back(blob);
+  }
+  return rbf;
+}
+
+// Builds with a PhaseFunction constructor; its errors name the bare parameter ("g"), so they are
+// rethrown under the full path ("medium.phase.g").
+template <class Make>
+PhaseFunction make_phase(const Object& o, Make make) {
+  try {
+    return make();
+  } catch (const Error& e) {
+    throw Error(o.at(e.field()), e.value(), e.expected());
+  }
+}
+
+PhaseFunction read_phase(const Object& o) {
+  std::string type = o.type({"isotropic", "hg", "rayleigh", "cornette_shanks", "double_hg", "tabulated"});
+  if (type == "isotropic" || type == "rayleigh") {
+    o.allow({"type"});
+    return type == "isotropic" ? PhaseFunction::isotropic() : PhaseFunction::rayleigh();
+  }
+  if (type == "hg" || type == "cornette_shanks") {
+    o.allow({"type", "g"});
+    double g = o.number("g", kG);
+    return make_phase(o, [&] {
+      return type == "hg" ? PhaseFunction::henyey_greenstein(g) : PhaseFunction::cornette_shanks(g);
+    });
+  }
+  if (type == "double_hg") {
+    o.allow({"type", "g1", "g2", "w"});
+    double g1 = o.number("g1", kG), g2 = o.number("g2", kG);
+    double w = o.number("w", {[](double) { return true; }, "a lobe weight in [0, 1]"});
+    return make_phase(o, [&] { return PhaseFunction::double_hg(g1, g2, w); });
+  }
+  o.allow({"type", "values"});
+  const char* expected = "an array of at least 2 numbers >= 0 over mu in [-1, 1], evenly spaced";
+  const json& values = o.need("values", expected);
+  if (!values.is_array()) throw Error(o.at("values"), text(values), expected);
+  std::vector<double> table;
+  for (std::size_t i = 0; i < values.size(); ++i)
+    table.push_back(read_number(values[i], index_path(o.at("values"), i), kNonNegative));
+  return make_phase(o, [&] { return PhaseFunction::tabulated(std::move(table)); });
+}
+
+MediumDesc read_medium(const Object& o, const fs::path& base_dir) {
+  o.allow({"bounds", "density", "sigma_t", "albedo", "phase"});
+  MediumDesc m;
+  if (const json* b = o.find("bounds")) m.bounds = read_bounds(*b, o.at("bounds"));
+  m.density = read_density(Object(o.need("density", "a density object with a \"type\""), o.at("density")),
+                           m.bounds.bounded(), base_dir);
+  m.sigma_t = o.color("sigma_t", kNonNegative);
+  m.albedo = o.color("albedo", Rgb(0.8), kUnit);
+  if (const json* p = o.find("phase")) m.phase = read_phase(Object(*p, o.at("phase")));
+  return m;
+}
+
+Light read_light(const Object& o) {
+  std::string type = o.type({"point", "spot", "directional", "sky"});
+  if (type == "point") {
+    o.allow({"type", "position", "intensity"});
+    return PointLight{o.vec3("position"), o.color("intensity", kNonNegative)};
+  }
+  if (type == "spot") {
+    o.allow({"type", "position", "direction", "intensity", "exponent", "cone_deg"});
+    SpotLight s;
+    s.position = o.vec3("position");
+    s.direction = o.direction("direction");
+    s.intensity = o.color("intensity", kNonNegative);
+    s.exponent = o.number("exponent", 1.0, kNonNegative);
+    s.cone_deg = o.number("cone_deg", 45.0, {[](double x) { return x > 0.0 && x <= 90.0; },
+                                            "a half-angle in degrees in (0, 90]"});
+    return s;
+  }
+  if (type == "directional") {
+    o.allow({"type", "direction", "irradiance"});
+    return DirectionalLight{o.direction("direction"), o.color("irradiance", kNonNegative)};
+  }
+  o.allow({"type", "radiance"});
+  return SkyLight{o.color("radiance", kNonNegative)};
+}
+
+Surface read_surface(const Object& o) {
+  std::string type = o.type({"plane", "sphere"});
+  Surface s;
+  if (type == "plane") {
+    o.allow({"type", "point", "normal", "kd", "ks", "shininess"});
+    s.shape = Plane{o.vec3("point"), o.direction("normal")};
+  } else {
+    o.allow({"type", "center", "radius", "kd", "ks", "shininess"});
+    s.shape = Sphere{o.vec3("center"), o.number("radius", kPositive)};
+  }
+  // kd and ks are reflectances (albedos): above 1 a surface would create energy.
+  s.kd = o.color("kd", Rgb(0.5), kUnit);
+  s.ks = o.color("ks", Rgb(0.0), kUnit);
+  s.shininess = o.number("shininess", 1.0, kNonNegative);
+  return s;
+}
+
+template <class T, class Read>
+std::vector<T> read_array(const Object& top, const char* key, Read read) {
+  std::vector<T> out;
+  const json* v = top.find(key);
+  if (!v) return out;
+  if (!v->is_array()) throw Error(top.at(key), text(*v), "an array [...] of objects");
+  for (std::size_t i = 0; i < v->size(); ++i) out.push_back(read(Object((*v)[i], index_path(top.at(key), i))));
+  return out;
+}
+
+Scene parse(const json& j, const fs::path& base_dir) {
+  Object top(j, "");
+  top.allow({"camera", "medium", "particles", "lights", "surfaces", "background", "method"});
+  Scene scene;
+  scene.camera = read_camera(Object(top.need("camera", "a camera object"), "camera"));
+  if (const json* m = top.find("medium")) scene.medium = read_medium(Object(*m, "medium"), base_dir);
+  if (const json* p = top.find("particles")) {
+    // Only its shape is checked here; the particle module validates the rest.
+    if (!p->is_object()) throw Error("particles", text(*p), "a JSON object {...}");
+    scene.particles = *p;
+  }
+  scene.lights = read_array<Light>(top, "lights", read_light);
+  scene.surfaces = read_array<Surface>(top, "surfaces", read_surface);
+  scene.background = top.color("background", Rgb(0.0), kNonNegative);
+  if (const json* m = top.find("method")) {
+    Object method(*m, "method");
+    read_string(method.need("name", "a non-empty method name"), "method.name", "a non-empty method name");
+    scene.method = *m;
+  }
+  return scene;
+}
+
+}  // namespace
+
+Scene Scene::from_json(const nlohmann::json& json, const std::filesystem::path& base_dir) {
+  try {
+    return parse(json, base_dir);
+  } catch (const nlohmann::json::exception& e) {
+    // The readers check types before every access, so this is a bug; still never let it escape raw.
+    throw Error(std::string("scene: unexpected JSON error: ") + e.what());
+  }
+}
+
+Scene Scene::load(const std::filesystem::path& path) {
+  std::error_code ec;
+  if (!fs::is_regular_file(path, ec)) throw Error(path.string(), "missing", "an existing scene file");
+  std::ifstream in(path, std::ios::binary);
+  std::string content((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (!in.good() && !in.eof()) throw Error(path.string(), "unreadable", "a readable scene file");
+
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(content);
+  } catch (const nlohmann::json::parse_error& e) {
+    // nlohmann's byte is 1-based: the character where parsing failed.
+    std::size_t pos = std::min<std::size_t>(e.byte > 0 ? e.byte - 1 : 0, content.size());
+    std::string_view head = std::string_view(content).substr(0, pos);
+    auto line = 1 + std::count(head.begin(), head.end(), '\n');
+    std::size_t last_newline = head.rfind('\n');
+    std::size_t column = pos - (last_newline == std::string_view::npos ? 0 : last_newline + 1) + 1;
+    // Drop nlohmann's "[json.exception.parse_error.101] " tag: the rest is the useful part.
+    std::string detail = e.what();
+    if (auto tag_end = detail.find("] "); detail.starts_with("[json.exception") && tag_end != std::string::npos)
+      detail.erase(0, tag_end + 2);
+    throw Error(path.string(),
+                "invalid JSON at line " + std::to_string(line) + ", column " + std::to_string(column) + " (byte " +
+                    std::to_string(e.byte) + ")",
+                "valid JSON (" + detail + ")");
+  }
+  fs::path base = path.parent_path();
+  return from_json(j, base.empty() ? fs::path(".") : base);
+}
+
+}  // namespace haze

@@ -1,0 +1,154 @@
+// Cameras, boxes, surfaces and BRDF normalization, lights, media, the random number generator.
+#include <haze/core/camera.h>
+#include <haze/core/error.h>
+#include <haze/core/light.h>
+#include <haze/core/medium.h>
+#include <haze/core/phase.h>
+#include <haze/core/surface.h>
+
+#include <gtest/gtest.h>
+
+namespace haze {
+namespace {
+
+TEST(Camera, RowsRunTopToBottomAndCentreLooksAtTarget) {
+  Camera cam;
+  cam.position = Vec3(0, 0, 5);
+  cam.look_at = Vec3(0, 0, 0);
+  cam.width_px = 4, cam.height_px = 2;
+  Ray centre = cam.generate_ray(2.0, 1.0);
+  EXPECT_NEAR(glm::length(centre.direction - Vec3(0, 0, -1)), 0.0, 1e-12);
+  EXPECT_GT(cam.pixel_ray(0, 0).direction.y, 0.0);   // top row looks up
+  EXPECT_LT(cam.pixel_ray(0, 1).direction.y, 0.0);
+  EXPECT_LT(cam.pixel_ray(0, 0).direction.x, 0.0);   // left column looks left
+  // Top edge of a pinhole image is fov_y / 2 above the axis.
+  Ray top = cam.generate_ray(2.0, 0.0);
+  EXPECT_NEAR(std::acos(-top.direction.z), 0.5 * cam.fov_y_deg * kPi / 180.0, 1e-12);
+
+  cam.type = Camera::Type::orthographic;
+  cam.height = 2.0;
+  Ray ortho_top = cam.generate_ray(2.0, 0.0);
+  EXPECT_NEAR(ortho_top.origin.y, 1.0, 1e-12);
+  EXPECT_NEAR(glm::length(ortho_top.direction - Vec3(0, 0, -1)), 0.0, 1e-12);
+}
+
+TEST(Aabb, ClipsRays) {
+  Aabb box{Vec3(-1), Vec3(1)};
+  double t0 = 0.0, t1 = kInfinity;
+  ASSERT_TRUE(box.clip({Vec3(0, 0, -5), Vec3(0, 0, 1)}, t0, t1));
+  EXPECT_DOUBLE_EQ(t0, 4.0);
+  EXPECT_DOUBLE_EQ(t1, 6.0);
+  t0 = 0.0, t1 = kInfinity;
+  EXPECT_FALSE(box.clip({Vec3(0, 3, -5), Vec3(0, 0, 1)}, t0, t1));
+  EXPECT_FALSE(Aabb{}.bounded());
+  EXPECT_TRUE(box.bounded());
+}
+
+TEST(Surface, IntersectsPlanesAndSpheres) {
+  Surface plane{Plane{Vec3(0, -1, 0), Vec3(0, 1, 0)}};
+  Surface sphere{Sphere{Vec3(0, 0, 0), 0.5}};
+  double t;
+  Vec3 n;
+  ASSERT_TRUE(plane.intersect({Vec3(0, 1, 0), Vec3(0, -1, 0)}, 0.0, kInfinity, t, n));
+  EXPECT_DOUBLE_EQ(t, 2.0);
+  EXPECT_DOUBLE_EQ(n.y, 1.0);
+  ASSERT_TRUE(sphere.intersect({Vec3(0, 0, -3), Vec3(0, 0, 1)}, 0.0, kInfinity, t, n));
+  EXPECT_DOUBLE_EQ(t, 2.5);
+  EXPECT_DOUBLE_EQ(n.z, -1.0);
+  // From inside, the far side faces the origin.
+  ASSERT_TRUE(sphere.intersect({Vec3(0), Vec3(1, 0, 0)}, 0.0, kInfinity, t, n));
+  EXPECT_DOUBLE_EQ(t, 0.5);
+  EXPECT_DOUBLE_EQ(n.x, -1.0);
+}
+
+// Energy-normalized BRDFs: at normal incidence, Lambert reflects kd and Phong reflects ks.
+TEST(Surface, BrdfsAreEnergyNormalized) {
+  Vec3 n(0, 0, 1);
+  for (double shininess : {1.0, 10.0, 100.0}) {
+    Surface lambert{Plane{}, Rgb(0.6), Rgb(0.0), 1.0};
+    Surface phong{Plane{}, Rgb(0.0), Rgb(0.3), shininess};
+    std::vector<double> x, w;
+    gauss_legendre(2000, x, w);
+    Rgb reflected_l(0.0), reflected_p(0.0);
+    const int phis = 64;
+    for (size_t i = 0; i < x.size(); ++i) {
+      double cos_o = 0.5 * (x[i] + 1.0);  // [0, 1]
+      for (int k = 0; k < phis; ++k) {
+        Vec3 wo = direction_around(n, cos_o, 2.0 * kPi * (k + 0.5) / phis);
+        double dw = 0.5 * w[i] * 2.0 * kPi / phis;
+        reflected_l += lambert.brdf(n, wo, n) * cos_o * dw;
+        reflected_p += phong.brdf(n, wo, n) * cos_o * dw;
+      }
+    }
+    EXPECT_NEAR(reflected_l.r, 0.6, 1e-6);
+    EXPECT_NEAR(reflected_p.g, 0.3, 1e-4) << shininess;
+  }
+}
+
+TEST(Light, ArrivalFollowsInverseSquareAndSpotCone) {
+  LightArrival a;
+  ASSERT_TRUE(arrival(PointLight{Vec3(0, 0, 2), Rgb(8.0)}, Vec3(0), a));
+  EXPECT_DOUBLE_EQ(a.distance, 2.0);
+  EXPECT_DOUBLE_EQ(a.irradiance.r, 2.0);
+  EXPECT_DOUBLE_EQ(a.to_light.z, 1.0);
+  SpotLight spot{Vec3(0, 0, 2), Vec3(0, 0, -1), Rgb(4.0), 2.0, 30.0};
+  ASSERT_TRUE(arrival(spot, Vec3(0), a));
+  EXPECT_DOUBLE_EQ(a.irradiance.g, 1.0);
+  ASSERT_TRUE(arrival(spot, Vec3(std::tan(0.4), 0, 1), a));  // 0.4 rad = 22.9 deg, inside
+  EXPECT_NEAR(a.irradiance.g, 4.0 * std::pow(std::cos(0.4), 2) / (1.0 + std::pow(std::tan(0.4), 2)), 1e-12);
+  ASSERT_TRUE(arrival(spot, Vec3(1, 0, 1), a));  // 45 deg, outside
+  EXPECT_EQ(a.irradiance, Rgb(0.0));
+  ASSERT_TRUE(arrival(DirectionalLight{Vec3(0, -1, 0), Rgb(3.0)}, Vec3(5), a));
+  EXPECT_EQ(a.to_light, Vec3(0, 1, 0));
+  EXPECT_TRUE(std::isinf(a.distance));
+  EXPECT_FALSE(arrival(SkyLight{}, Vec3(0), a));
+}
+
+TEST(Medium, DensityIntegralsAreExactOrConverged) {
+  MediumDesc constant;
+  constant.bounds = {Vec3(-1), Vec3(1)};
+  constant.density = ConstantDensity{2.0};
+  auto m = make_medium(constant);
+  EXPECT_DOUBLE_EQ(m->density_integral(Vec3(0, 0, -5), Vec3(0, 0, 5)), 4.0);
+  EXPECT_NEAR(m->transmittance(Vec3(0, 0, -5), Vec3(0, 0, 5)).r, std::exp(-4.0), 1e-15);
+
+  // A Gaussian's line integral through its centre: w sqrt(pi) / a.
+  MediumDesc rbf;
+  rbf.density = RbfDensity{{RbfBlob{Vec3(0.2, 0.1, 0), 1.5, 2.0}}};
+  auto r = make_medium(rbf);
+  EXPECT_NEAR(r->density_integral(Vec3(0.2, 0.1, -9), Vec3(0.2, 0.1, 9)), 1.5 * std::sqrt(kPi) / 2.0, 1e-9);
+  EXPECT_NEAR(r->density(Vec3(0.2, 0.1, 0.5)), 1.5 * std::exp(-1.0), 1e-15);
+
+  // Trilinear grid: a linear ramp in x is reproduced between cell centres.
+  MediumDesc grid;
+  grid.bounds = {Vec3(0), Vec3(4, 1, 1)};
+  grid.density = GridDensity{{4, 1, 1}, {0.0f, 1.0f, 2.0f, 3.0f}};
+  auto g = make_medium(grid);
+  EXPECT_NEAR(g->density(Vec3(1.5, 0.5, 0.5)), 1.0, 1e-12);
+  EXPECT_NEAR(g->density(Vec3(2.0, 0.5, 0.5)), 1.5, 1e-12);
+  EXPECT_NEAR(g->density_integral(Vec3(0.5, 0.5, 0.5), Vec3(3.5, 0.5, 0.5)), 4.5, 1e-9);
+  MediumDesc unbounded_grid = grid;
+  unbounded_grid.bounds = Aabb{};
+  EXPECT_THROW(make_medium(unbounded_grid), Error);
+}
+
+TEST(Rng, UniformIsUniformAndDeterministic) {
+  Rng a(3, 9), b(3, 9), c(3, 10);
+  double mean = 0.0, m2 = 0.0;
+  const int n = 100000;
+  bool differs = false;
+  for (int i = 0; i < n; ++i) {
+    double u = a.uniform();
+    ASSERT_EQ(u, b.uniform());
+    differs |= (u != c.uniform());
+    ASSERT_GE(u, 0.0);
+    ASSERT_LT(u, 1.0);
+    mean += u / n, m2 += u * u / n;
+  }
+  EXPECT_TRUE(differs);
+  EXPECT_NEAR(mean, 0.5, 0.005);
+  EXPECT_NEAR(m2 - mean * mean, 1.0 / 12.0, 0.002);
+}
+
+}  // namespace
+}  // namespace haze

@@ -1,0 +1,114 @@
+// The method registry and core's "quadrature" method, checked against closed forms.
+#include <haze/core/error.h>
+#include <haze/core/method.h>
+
+#include <gtest/gtest.h>
+
+namespace haze {
+namespace {
+
+// One orthographic pixel looking down +z from the origin, through an unbounded medium, stopped by a
+// black plane at z = d_vp.
+Scene single_ray_scene(double sigma_t, double albedo, double d_vp) {
+  Scene scene;
+  scene.camera.type = Camera::Type::orthographic;
+  scene.camera.position = Vec3(0);
+  scene.camera.look_at = Vec3(0, 0, 1);
+  scene.camera.height = 1e-9;
+  scene.camera.width_px = scene.camera.height_px = 1;
+  MediumDesc medium;
+  medium.sigma_t = Rgb(sigma_t);
+  medium.albedo = Rgb(albedo);
+  scene.medium = medium;
+  scene.surfaces.push_back({Plane{Vec3(0, 0, d_vp), Vec3(0, 0, -1)}, Rgb(0.0), Rgb(0.0), 1.0});
+  return scene;
+}
+
+// BEYOND.md: Sun et al. 2005 closed form, 0.0132328536 for sigma_t = 0.5, albedo 1, I = 1,
+// d_sv = 2, gamma = 0.7, d_vp = 5.
+TEST(Quadrature, MatchesSunEtAlAirlight) {
+  Scene scene = single_ray_scene(0.5, 1.0, 5.0);
+  scene.lights.push_back(PointLight{Vec3(2.0 * std::sin(0.7), 0.0, 2.0 * std::cos(0.7)), Rgb(1.0)});
+  auto result = render(scene, "quadrature");
+  EXPECT_NEAR(result.radiance.at(0, 0).r, 0.0132328536, 1e-9);
+}
+
+// Seed 004 / BEYOND.md: without extinction, L = sigma_s I / (4 pi h) [atan((t1 - tc)/h) - atan((t0 - tc)/h)].
+TEST(Quadrature, MatchesNoExtinctionClosedForm) {
+  const double sigma = 1e-7, h = 0.3, tc = 1.2, t1 = 4.0;
+  Scene scene = single_ray_scene(sigma, 1.0, t1);
+  scene.lights.push_back(PointLight{Vec3(h, 0.0, tc), Rgb(2.0)});
+  double expected = sigma * 2.0 / (4.0 * kPi * h) * (std::atan((t1 - tc) / h) - std::atan((0.0 - tc) / h));
+  auto result = render(scene, "quadrature");
+  EXPECT_NEAR(result.radiance.at(0, 0).g / expected, 1.0, 1e-5);
+}
+
+Scene small_scene() {
+  Scene scene;
+  scene.camera.position = Vec3(0, 0, 4);
+  scene.camera.width_px = 12, scene.camera.height_px = 9;
+  MediumDesc medium;
+  medium.bounds = {Vec3(-1), Vec3(1)};
+  medium.density = RbfDensity{{RbfBlob{Vec3(0.2, 0, 0), 2.0, 1.5}, RbfBlob{Vec3(-0.3, 0.2, 0.1), 1.0, 3.0}}};
+  medium.sigma_t = Rgb(1.0, 1.5, 2.0);
+  medium.albedo = Rgb(0.9);
+  medium.phase = PhaseFunction::henyey_greenstein(0.4);
+  scene.medium = medium;
+  scene.lights.push_back(PointLight{Vec3(1.5, 1.5, 1.0), Rgb(5.0)});
+  scene.lights.push_back(SkyLight{Rgb(0.1, 0.2, 0.3)});
+  scene.surfaces.push_back({Plane{Vec3(0, -1, 0), Vec3(0, 1, 0)}, Rgb(0.5), Rgb(0.2), 20.0});
+  scene.method = {{"name", "quadrature"}, {"steps", 64}, {"sky_directions", 32}};
+  return scene;
+}
+
+TEST(Quadrature, ResultsDoNotDependOnThreadCount) {
+  Scene scene = small_scene();
+  RenderOptions one, two;
+  one.threads = 1;
+  two.threads = 2;
+  auto a = render(scene, "", one), b = render(scene, "", two);
+  EXPECT_EQ(a.radiance.data(), b.radiance.data());
+  EXPECT_GT(a.radiance.mean().r, 0.0);
+  EXPECT_EQ(a.stats["steps"], 64);  // the scene's settings applied
+}
+
+TEST(Methods, UnknownNamesAndSettingsAreClearErrors) {
+  Scene scene = small_scene();
+  try {
+    render(scene, "no_such_method");
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_EQ(e.field(), "method.name");
+    EXPECT_NE(std::string(e.what()).find("quadrature"), std::string::npos) << e.what();
+  }
+  RenderOptions bad;
+  bad.settings = {{"stepz", 3}};
+  try {
+    render(scene, "quadrature", bad);
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_EQ(e.field(), "method.stepz");
+  }
+  bad.settings = {{"steps", -3}};
+  EXPECT_THROW(render(scene, "quadrature", bad), Error);
+  scene.method = nlohmann::json::object();
+  EXPECT_THROW(render(scene, ""), Error);
+}
+
+TEST(Methods, ProgressReachesOneAndCancellationStops) {
+  Scene scene = small_scene();
+  RenderOptions options;
+  double last = 0.0;
+  options.progress = [&](double f) {
+    EXPECT_GE(f, last);
+    last = f;
+    return true;
+  };
+  render(scene, "", options);
+  EXPECT_DOUBLE_EQ(last, 1.0);
+  options.progress = [](double) { return false; };
+  EXPECT_THROW(render(scene, "", options), Cancelled);
+}
+
+}  // namespace
+}  // namespace haze
