@@ -1,0 +1,47 @@
+// Per-target phase evaluation (Highway: included once per target by foreach_target.h).
+#include "phase_params.h"
+
+#if defined(HAZE_SIMD_PHASE_BATCH_INL_H_) == defined(HWY_TARGET_TOGGLE)
+#ifdef HAZE_SIMD_PHASE_BATCH_INL_H_
+#undef HAZE_SIMD_PHASE_BATCH_INL_H_
+#else
+#define HAZE_SIMD_PHASE_BATCH_INL_H_
+#endif
+
+#include <hwy/highway.h>
+
+HWY_BEFORE_NAMESPACE();
+namespace haze::simd::HWY_NAMESPACE {
+namespace hn = hwy::HWY_NAMESPACE;
+
+template <class D, class V>
+HWY_INLINE V EvalPhase(D d, const internal::PhaseParams& p, V mu) {
+  V poly = hn::MulAdd(hn::Set(d, p.c2), hn::Mul(mu, mu), hn::Set(d, p.c0));
+  if (p.lobes == 0) return poly;
+  V sum = hn::Zero(d);
+  for (int l = 0; l < p.lobes; ++l) {
+    V one_minus_s_mu = hn::NegMulAdd(hn::Set(d, p.s[l]), mu, hn::Set(d, 1.0f));
+    V denom = hn::MulAdd(hn::Set(d, p.b[l]), one_minus_s_mu, hn::Set(d, p.a[l]));
+    sum = hn::Add(sum, hn::Div(hn::Set(d, p.k[l]), hn::Mul(denom, hn::Sqrt(denom))));
+  }
+  return hn::Mul(poly, sum);
+}
+
+HWY_NOINLINE void EvalPhaseBatch(const internal::PhaseParams& p, const float* HWY_RESTRICT mu, float* HWY_RESTRICT out,
+                                 size_t count) {
+  const hn::ScalableTag<float> d;
+  const size_t lanes = hn::Lanes(d);
+  size_t i = 0;
+  for (; i + lanes <= count; i += lanes) hn::StoreU(EvalPhase(d, p, hn::LoadU(d, mu + i)), d, out + i);
+  if (i < count) {
+    // Tail: pad with mu = 0 so no lane divides by zero, store only the valid lanes.
+    auto mask = hn::FirstN(d, count - i);
+    auto v = hn::IfThenElseZero(mask, hn::MaskedLoad(mask, d, mu + i));
+    hn::BlendedStore(EvalPhase(d, p, v), mask, d, out + i);
+  }
+}
+
+}  // namespace haze::simd::HWY_NAMESPACE
+HWY_AFTER_NAMESPACE();
+
+#endif  // HAZE_SIMD_PHASE_BATCH_INL_H_
