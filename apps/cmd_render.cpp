@@ -1,0 +1,98 @@
+// haze render: one scene with one method, to EXR (+ PNG preview), with a JSON summary.
+#include "commands.h"
+#include "progress_bar.h"
+
+#include <haze/core/error.h>
+
+#include <chrono>
+#include <iostream>
+
+namespace haze::app {
+
+nlohmann::json save_result(const RenderResult& result, const std::string& method, double seconds,
+                           const std::filesystem::path& exr, bool png) {
+  if (exr.has_parent_path()) std::filesystem::create_directories(exr.parent_path());
+  write_exr(exr, result.radiance, result.std_error ? &*result.std_error : nullptr);
+  Rgb mean = result.radiance.mean();
+  nlohmann::json out = {{"method", method},
+                        {"seconds", seconds},
+                        {"width", result.radiance.width()},
+                        {"height", result.radiance.height()},
+                        {"mean", {mean.r, mean.g, mean.b}},
+                        {"output", exr.string()},
+                        {"stats", result.stats}};
+  if (result.std_error) {
+    Rgb e = result.std_error->mean();
+    out["mean_std_error"] = {e.r, e.g, e.b};
+  }
+  if (png) {
+    auto preview = std::filesystem::path(exr).replace_extension(".png");
+    write_png(preview, result.radiance);
+    out["preview"] = preview.string();
+  }
+  return out;
+}
+
+namespace {
+
+struct RenderArgs {
+  std::string scene, method, out;
+  int threads = 0;
+  bool json = false, no_png = false;
+  std::vector<std::string> set;
+};
+
+// "--set key=value": the value is JSON when it parses as JSON, else a string.
+nlohmann::json parse_settings(const std::vector<std::string>& pairs) {
+  nlohmann::json settings = nlohmann::json::object();
+  for (const auto& pair : pairs) {
+    auto eq = pair.find('=');
+    if (eq == std::string::npos || eq == 0) throw Error("--set", pair, "key=value");
+    std::string value = pair.substr(eq + 1);
+    auto parsed = nlohmann::json::parse(value, nullptr, false);
+    settings[pair.substr(0, eq)] = parsed.is_discarded() ? nlohmann::json(value) : parsed;
+  }
+  return settings;
+}
+
+int run(const RenderArgs& a) {
+  Scene scene = Scene::load(a.scene);
+  std::string method = a.method.empty() ? scene.method_name() : a.method;
+  if (method.empty()) create_method("");  // the error lists the available methods
+  RenderOptions options;
+  options.threads = a.threads;
+  options.settings = parse_settings(a.set);
+  ProgressBar bar(method);
+  options.progress = bar.callback();
+  auto start = std::chrono::steady_clock::now();
+  RenderResult result = render(scene, method, options);
+  double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  std::filesystem::path out = a.out.empty() ? std::filesystem::path(a.scene).stem().string() + "_" + method + ".exr" : a.out;
+  auto summary = save_result(result, method, seconds, out, !a.no_png);
+  summary["scene"] = a.scene;
+  if (a.json) {
+    std::cout << summary.dump(2) << "\n";
+  } else {
+    Rgb m = result.radiance.mean();
+    std::cout << method << ": " << result.radiance.width() << "x" << result.radiance.height() << " in " << seconds
+              << " s, mean RGB (" << m.r << ", " << m.g << ", " << m.b << ") -> " << out.string() << "\n";
+  }
+  return 0;
+}
+
+}  // namespace
+
+Command add_render(CLI::App& app) {
+  auto* sub = app.add_subcommand("render", "Render a scene file with a method; writes EXR and a PNG preview");
+  auto a = std::make_shared<RenderArgs>();
+  sub->add_option("scene", a->scene, "Scene JSON file")->required()->check(CLI::ExistingFile);
+  sub->add_option("--method", a->method, "Method (overrides the scene's; the scene's settings apply when names match)");
+  sub->add_option("--out", a->out, "Output EXR (default: <scene>_<method>.exr)");
+  sub->add_option("--threads", a->threads, "Thread cap (0: all cores)")->check(CLI::NonNegativeNumber);
+  sub->add_option("--set", a->set, "Method setting key=value (repeatable), e.g. --set steps=256");
+  sub->add_flag("--json", a->json, "Print a JSON summary");
+  sub->add_flag("--no-png", a->no_png, "Do not write the PNG preview");
+  return {sub, [a] { return run(*a); }};
+}
+
+}  // namespace haze::app

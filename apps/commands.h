@@ -1,0 +1,33 @@
+// The `haze` subcommands: each adds itself to the CLI11 app and runs when chosen.
+#pragma once
+
+#include <haze/core/method.h>
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include <filesystem>
+
+#include <functional>
+
+namespace haze::app {
+
+// A subcommand and what runs when it was chosen (after parsing); run returns the exit status.
+struct Command {
+  CLI::App* sub;
+  std::function<int()> run;
+};
+Command add_info(CLI::App& app);
+Command add_phase(CLI::App& app);
+Command add_render(CLI::App& app);
+Command add_demo(CLI::App& app);
+
+// Writes the result's EXR (with its standard-error layer, if any) and a PNG preview beside it;
+// returns the JSON summary `haze render --json` prints.
+nlohmann::json save_result(const RenderResult& result, const std::string& method, double seconds,
+                           const std::filesystem::path& exr, bool png);
+
+// Registers every module's methods with core's registry (core's own are always there).
+void register_all_methods();
+
+}  // namespace haze::app

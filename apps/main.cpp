@@ -1,0 +1,27 @@
+// haze: render participating media, inspect phase-function factorizations, run the demo.
+#include "commands.h"
+
+#include <haze/core/error.h>
+
+#include <iostream>
+
+int main(int argc, char** argv) {
+  CLI::App app{"Haze: light transport in participating media (fog, haze, smoke, clouds)"};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", std::string("haze ") + HAZE_VERSION);
+  const haze::app::Command commands[] = {haze::app::add_info(app), haze::app::add_phase(app),
+                                          haze::app::add_render(app), haze::app::add_demo(app)};
+  CLI11_PARSE(app, argc, argv);
+  try {
+    haze::app::register_all_methods();
+    for (const auto& command : commands)
+      if (command.sub->parsed()) return command.run();
+  } catch (const haze::Error& e) {
+    std::cerr << "haze: error: " << e.what() << "\n";
+    return 2;
+  } catch (const std::exception& e) {
+    std::cerr << "haze: unexpected error: " << e.what() << "\n";
+    return 3;
+  }
+  return 0;
+}

@@ -1,0 +1,35 @@
+// Headless OpenGL contexts: EGL surfaceless first (GPU or Mesa llvmpipe), OSMesa as the fallback.
+#pragma once
+
+#include <memory>
+#include <string>
+
+namespace haze::gl {
+
+struct GlInfo {
+  bool available = false;
+  std::string backend;   // "egl-surfaceless" or "osmesa"
+  std::string vendor, renderer, version;
+  std::string error;     // why neither backend worked, when unavailable
+};
+
+// An OpenGL context current on the calling thread for its lifetime; no window, no display server.
+class HeadlessContext {
+ public:
+  // Throws haze::Error naming both backends' failures when neither can make a context.
+  HeadlessContext();
+  ~HeadlessContext();
+  HeadlessContext(const HeadlessContext&) = delete;
+  HeadlessContext& operator=(const HeadlessContext&) = delete;
+  const GlInfo& info() const { return info_; }
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  GlInfo info_;
+};
+
+// Tries to make a context and reports what it got (never throws).
+GlInfo probe();
+
+}  // namespace haze::gl

@@ -1,0 +1,105 @@
+#include <haze/core/error.h>
+#include <haze/gl/context.h>
+
+#include <EGL/egl.h>
+#include <EGL/eglext.h>
+#include <GL/gl.h>
+#include <GL/osmesa.h>
+
+#include <vector>
+
+namespace haze::gl {
+
+struct HeadlessContext::Impl {
+  EGLDisplay display = EGL_NO_DISPLAY;
+  EGLContext egl_context = EGL_NO_CONTEXT;
+  OSMesaContext osmesa = nullptr;
+  std::vector<unsigned char> osmesa_buffer;
+
+  // EGL_MESA_platform_surfaceless + EGL_KHR_surfaceless_context: no window system at all.
+  std::string try_egl() {
+    auto get_platform_display =
+        reinterpret_cast<PFNEGLGETPLATFORMDISPLAYEXTPROC>(eglGetProcAddress("eglGetPlatformDisplayEXT"));
+    if (!get_platform_display) return "EGL: eglGetPlatformDisplayEXT missing";
+    display = get_platform_display(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr);
+    EGLint major = 0, minor = 0;
+    if (display == EGL_NO_DISPLAY || !eglInitialize(display, &major, &minor)) {
+      display = EGL_NO_DISPLAY;
+      return "EGL: no surfaceless display";
+    }
+    if (!eglBindAPI(EGL_OPENGL_API)) return "EGL: OpenGL API not bindable";
+    const EGLint attributes[] = {EGL_CONTEXT_MAJOR_VERSION, 3, EGL_CONTEXT_MINOR_VERSION, 3,
+                                 EGL_CONTEXT_OPENGL_PROFILE_MASK, EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT, EGL_NONE};
+    egl_context = eglCreateContext(display, EGL_NO_CONFIG_KHR, EGL_NO_CONTEXT, attributes);
+    if (egl_context == EGL_NO_CONTEXT) return "EGL: no OpenGL 3.3 core context";
+    if (!eglMakeCurrent(display, EGL_NO_SURFACE, EGL_NO_SURFACE, egl_context)) return "EGL: eglMakeCurrent failed";
+    return {};
+  }
+
+  std::string try_osmesa() {
+    const int attributes[] = {OSMESA_FORMAT, OSMESA_RGBA, OSMESA_DEPTH_BITS, 24, OSMESA_PROFILE, OSMESA_CORE_PROFILE,
+                              OSMESA_CONTEXT_MAJOR_VERSION, 3, OSMESA_CONTEXT_MINOR_VERSION, 3, 0};
+    osmesa = OSMesaCreateContextAttribs(attributes, nullptr);
+    if (!osmesa) return "OSMesa: no OpenGL 3.3 core context";
+    osmesa_buffer.assign(4 * 16 * 16, 0);
+    if (!OSMesaMakeCurrent(osmesa, osmesa_buffer.data(), GL_UNSIGNED_BYTE, 16, 16)) return "OSMesa: make current failed";
+    return {};
+  }
+
+  void release() {
+    if (egl_context != EGL_NO_CONTEXT) {
+      eglMakeCurrent(display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+      eglDestroyContext(display, egl_context);
+      egl_context = EGL_NO_CONTEXT;
+    }
+    if (display != EGL_NO_DISPLAY) {
+      eglTerminate(display);
+      display = EGL_NO_DISPLAY;
+    }
+    if (osmesa) {
+      OSMesaDestroyContext(osmesa);
+      osmesa = nullptr;
+    }
+  }
+};
+
+namespace {
+std::string gl_string(GLenum name) {
+  const auto* s = reinterpret_cast<const char*>(glGetString(name));
+  return s ? s : "";
+}
+}  // namespace
+
+HeadlessContext::HeadlessContext() : impl_(std::make_unique<Impl>()) {
+  std::string egl_error = impl_->try_egl();
+  if (egl_error.empty()) {
+    info_.backend = "egl-surfaceless";
+  } else {
+    impl_->release();
+    std::string osmesa_error = impl_->try_osmesa();
+    if (!osmesa_error.empty()) {
+      impl_->release();
+      throw Error("gl context", egl_error + "; " + osmesa_error, "an EGL surfaceless or OSMesa OpenGL 3.3 context");
+    }
+    info_.backend = "osmesa";
+  }
+  info_.available = true;
+  info_.vendor = gl_string(GL_VENDOR);
+  info_.renderer = gl_string(GL_RENDERER);
+  info_.version = gl_string(GL_VERSION);
+}
+
+HeadlessContext::~HeadlessContext() { impl_->release(); }
+
+GlInfo probe() {
+  try {
+    HeadlessContext context;
+    return context.info();
+  } catch (const std::exception& e) {
+    GlInfo info;
+    info.error = e.what();
+    return info;
+  }
+}
+
+}  // namespace haze::gl

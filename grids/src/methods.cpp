@@ -1,0 +1,7 @@
+#include <haze/grids/methods.h>
+
+namespace haze::grids {
+
+void register_methods() {}
+
+}  // namespace haze::grids
