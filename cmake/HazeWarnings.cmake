@@ -9,7 +9,6 @@ if(HAZE_SANITIZE)
   target_compile_options(haze_warnings INTERFACE -fsanitize=address,undefined -fno-omit-frame-pointer)
   target_link_options(haze_warnings INTERFACE -fsanitize=address,undefined)
 endif()
-install(TARGETS haze_warnings EXPORT hazeTargets)
 
 # haze_module(NAME folder-target SOURCES ... DEPS ...): one static library per top-level folder,
 # public headers in <folder>/include, exported as haze::<name>.
