@@ -6,7 +6,8 @@ if(HAZE_WERROR)
   target_compile_options(haze_warnings INTERFACE -Werror)
 endif()
 if(HAZE_SANITIZE)
-  target_compile_options(haze_warnings INTERFACE -fsanitize=address,undefined -fno-omit-frame-pointer)
+  # GCC 12 reports false -Wmaybe-uninitialized through std::variant under the sanitizers.
+  target_compile_options(haze_warnings INTERFACE -fsanitize=address,undefined -fno-omit-frame-pointer -Wno-maybe-uninitialized)
   target_link_options(haze_warnings INTERFACE -fsanitize=address,undefined)
 endif()
 

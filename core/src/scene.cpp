@@ -129,7 +129,6 @@ class Object {
     if (!j_.is_object()) throw Error(path_.empty() ? "(scene)" : path_, text(j_), "a JSON object {...}");
   }
 
-  const std::string& path() const { return path_; }
   std::string at(std::string_view key) const { return key_path(path_, key); }
   const json* find(const char* key) const {
     auto it = j_.find(key);
@@ -145,6 +144,7 @@ class Object {
     for (const auto& [key, value] : j_.items()) {
       if (std::find(fields.begin(), fields.end(), key) != fields.end()) continue;
       std::string where = path_.empty() ? "the scene" : path_;
+      if (!type_.empty()) where += " (type \"" + type_ + "\")";
       throw Error(at(key), "unknown field \"" + key + "\"", "a field of " + where + ": " + join(fields));
     }
   }
@@ -153,13 +153,13 @@ class Object {
   std::string type(std::initializer_list<std::string_view> types, const char* fallback = nullptr) const {
     const std::string expected = "one of " + join(types, "\"");
     const json* v = find("type");
-    if (!v) {
-      if (fallback) return fallback;
-      throw Error(at("type"), "missing", expected);
-    }
-    if (!v->is_string() || std::find(types.begin(), types.end(), v->get_ref<const std::string&>()) == types.end())
-      throw Error(at("type"), text(*v), expected);
-    return v->get<std::string>();
+    if (!v && !fallback) throw Error(at("type"), "missing", expected);
+    auto known = [&](const json& t) {
+      return t.is_string() && std::find(types.begin(), types.end(), t.get_ref<const std::string&>()) != types.end();
+    };
+    if (v && !known(*v)) throw Error(at("type"), text(*v), expected);
+    type_ = v ? v->get<std::string>() : fallback;
+    return type_;
   }
 
   double number(const char* key, Check check) const { return read_number(need(key, check.expected), at(key), check); }
@@ -189,6 +189,7 @@ class Object {
  private:
   const json& j_;
   std::string path_;
+  mutable std::string type_;  // once type() has read it: allow() names it, as the fields depend on it
 };
 
 Camera read_camera(const Object& o) {
@@ -213,7 +214,8 @@ Camera read_camera(const Object& o) {
   c.height_px = o.integer("height_px", 64, 1, kMaxImagePx);
 
   Vec3 view = c.look_at - c.position;
-  if (!normalize(view)) throw Error(o.at("look_at"), text(*o.find("look_at")), "a point different from camera.position");
+  if (!normalize(view))
+    throw Error(o.at("look_at"), text(*o.find("look_at")), "a point different from camera.position");
   const std::string up_text = o.find("up") ? text(*o.find("up")) : "[0, 1, 0] (the default)";
   if (!normalize(c.up)) throw Error(o.at("up"), up_text, kDirectionText);
   if (glm::length(glm::cross(view, c.up)) < 1e-6)
@@ -227,19 +229,25 @@ Aabb read_bounds(const json& v, const std::string& path) {
   Aabb box;
   box.lo = read_vec3(v[0], index_path(path, 0));
   box.hi = read_vec3(v[1], index_path(path, 1));
-  for (int a = 0; a < 3; ++a)
-    if (!(box.lo[a] < box.hi[a])) throw Error(path, text(v), expected);
+  for (int a = 0; a < 3; ++a) {
+    if (box.lo[a] < box.hi[a]) continue;
+    const std::string axis(1, "xyz"[a]);
+    throw Error(path, text(v),
+                std::string(expected) + "; " + axis + "0 = " + to_text(box.lo[a]) + " is not below " + axis + "1 = " +
+                    to_text(box.hi[a]));
+  }
   return box;
 }
 
-void check_grid_values(const std::vector<float>& values, const GridDensity& grid, const std::string& path,
-                       const fs::path& file) {
+void check_grid_values(const GridDensity& grid, const std::string& path, const fs::path& file) {
+  const std::vector<float>& values = grid.values;
   for (std::size_t i = 0; i < values.size(); ++i) {
     if (std::isfinite(values[i]) && values[i] >= 0.0f) continue;
     const auto nx = static_cast<std::size_t>(grid.resolution[0]), ny = static_cast<std::size_t>(grid.resolution[1]);
     std::string cell = "(" + std::to_string(i % nx) + ", " + std::to_string(i / nx % ny) + ", " +
                        std::to_string(i / (nx * ny)) + ")";
-    throw Error(path, to_text(values[i]) + " at cell " + cell + " (index " + std::to_string(i) + ") of " + file.string(),
+    throw Error(path, to_text(values[i]) + " at cell " + cell + " (index " + std::to_string(i) + ") of " +
+                          file.string(),
                 "finite density values >= 0");
   }
 }
@@ -262,12 +270,14 @@ GridDensity read_grid(const Object& o, const fs::path& base_dir) {
   const char* file_expected = "a float32 little-endian file name (relative to the scene file's folder)";
   fs::path file = read_string(o.need("file", file_expected), file_path, file_expected);
   if (file.is_relative()) file = base_dir / file;
+  std::error_code ec;
+  // Absolute, so that the messages below say exactly where Haze looked.
+  if (fs::path absolute = fs::absolute(file, ec); !ec) file = absolute;
   file = file.lexically_normal();
 
-  std::error_code ec;
   if (!fs::is_regular_file(file, ec))
     throw Error(file_path, text(o.need("file", file_expected)) + " (resolved to " + file.string() + ")",
-                "an existing file; none found at " + file.string());
+                "an existing file, but there is none at that path");
   const std::uint64_t expected_bytes = cells * 4;
   const std::uint64_t actual_bytes = fs::file_size(file, ec);
   if (ec) throw Error(file_path, file.string(), "a readable file (" + ec.message() + ")");
@@ -292,7 +302,7 @@ GridDensity read_grid(const Object& o, const fs::path& base_dir) {
       v = std::bit_cast<float>(bits);
     }
   }
-  check_grid_values(grid.values, grid, file_path, file);
+  check_grid_values(grid, file_path, file);
   return grid;
 }
 
