@@ -10,6 +10,8 @@
 
 #include <hwy/highway.h>
 
+#include <algorithm>
+
 HWY_BEFORE_NAMESPACE();
 namespace haze::simd::HWY_NAMESPACE {
 namespace hn = hwy::HWY_NAMESPACE;
@@ -34,10 +36,12 @@ HWY_NOINLINE void EvalPhaseBatch(const internal::PhaseParams& p, const float* HW
   size_t i = 0;
   for (; i + lanes <= count; i += lanes) hn::StoreU(EvalPhase(d, p, hn::LoadU(d, mu + i)), d, out + i);
   if (i < count) {
-    // Tail: pad with mu = 0 so no lane divides by zero, store only the valid lanes.
-    auto mask = hn::FirstN(d, count - i);
-    auto v = hn::IfThenElseZero(mask, hn::MaskedLoad(mask, d, mu + i));
-    hn::BlendedStore(EvalPhase(d, p, v), mask, d, out + i);
+    // Tail through a padded copy: Highway 1.0's MaskedLoad on SSE targets reads the whole vector,
+    // past the end of the caller's array. Padding with mu = 0 keeps every lane finite.
+    HWY_ALIGN float in[hn::MaxLanes(d)] = {}, result[hn::MaxLanes(d)];
+    std::copy(mu + i, mu + count, in);
+    hn::Store(EvalPhase(d, p, hn::Load(d, in)), d, result);
+    std::copy(result, result + (count - i), out + i);
   }
 }
 
