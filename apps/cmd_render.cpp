@@ -5,6 +5,7 @@
 #include <haze/core/error.h>
 
 #include <chrono>
+#include <optional>
 #include <iostream>
 
 namespace haze::app {
@@ -40,6 +41,8 @@ struct RenderArgs {
   int threads = 0;
   bool json = false, no_png = false;
   std::vector<std::string> set;
+  // Shortcuts for the reference path tracer's settings; unset unless given.
+  std::optional<long long> spp, max_scattering, seed;
 };
 
 // "--set key=value": the value is JSON when it parses as JSON, else a string.
@@ -62,6 +65,9 @@ int run(const RenderArgs& a) {
   RenderOptions options;
   options.threads = a.threads;
   options.settings = parse_settings(a.set);
+  if (a.spp) options.settings["spp"] = *a.spp;
+  if (a.max_scattering) options.settings["max_scattering"] = *a.max_scattering;
+  if (a.seed) options.settings["seed"] = *a.seed;
   ProgressBar bar(method);
   options.progress = bar.callback();
   auto start = std::chrono::steady_clock::now();
@@ -90,6 +96,9 @@ Command add_render(CLI::App& app) {
   sub->add_option("--out", a->out, "Output EXR (default: <scene>_<method>.exr)");
   sub->add_option("--threads", a->threads, "Thread cap (0: all cores)")->check(CLI::NonNegativeNumber);
   sub->add_option("--set", a->set, "Method setting key=value (repeatable), e.g. --set steps=256");
+  sub->add_option("--spp", a->spp, "Samples per pixel (reference)");
+  sub->add_option("--max-scattering", a->max_scattering, "Scattering events per path: -1 unlimited, 1 single, 0 none (reference)");
+  sub->add_option("--seed", a->seed, "Random seed (reference); the same seed gives the same image on any thread count");
   sub->add_flag("--json", a->json, "Print a JSON summary");
   sub->add_flag("--no-png", a->no_png, "Do not write the PNG preview");
   return {sub, [a] { return run(*a); }};

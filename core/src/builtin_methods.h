@@ -7,5 +7,7 @@ namespace haze::internal {
 
 // Deterministic single scattering by numerical quadrature (quadrature.cpp).
 std::unique_ptr<Method> make_quadrature_method();
+// The unbiased volumetric path tracer every fast method is measured against (reference.cpp).
+std::unique_ptr<Method> make_reference_method();
 
 }  // namespace haze::internal

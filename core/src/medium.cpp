@@ -77,7 +77,16 @@ class RbfMedium final : public Medium {
     }
     return rho;
   }
-  double max_density(const Aabb&) const override { return max_; }
+  // Each blob is at most weight * exp(-a^2 d^2) in the region, d its centre's distance to the box.
+  double max_density(const Aabb& region) const override {
+    double bound = 0.0;
+    for (const auto& b : blobs_) {
+      Vec3 nearest = glm::clamp(b.center, region.lo, region.hi);
+      Vec3 d = b.center - nearest;
+      bound += b.weight * std::exp(-b.sharpness * b.sharpness * glm::dot(d, d));
+    }
+    return std::min(bound, max_);
+  }
   double feature_size() const override { return feature_; }
 
  private:
@@ -122,7 +131,24 @@ class GridMedium final : public Medium {
     double c1 = c01 * (1 - f[1]) + c11 * f[1];
     return c0 * (1 - f[2]) + c1 * f[2];
   }
-  double max_density(const Aabb&) const override { return max_; }
+  // The largest sample among the cells whose centres the region's trilinear lookups can touch.
+  double max_density(const Aabb& region) const override {
+    const auto& r = grid_.resolution;
+    int lo[3], hi[3];
+    for (int a = 0; a < 3; ++a) {
+      double scale = r[a] / bounds_.extent()[a];
+      double u0 = (region.lo[a] - bounds_.lo[a]) * scale - 0.5, u1 = (region.hi[a] - bounds_.lo[a]) * scale - 0.5;
+      lo[a] = static_cast<int>(std::clamp(std::floor(u0), 0.0, r[a] - 1.0));
+      hi[a] = static_cast<int>(std::clamp(std::ceil(u1), 0.0, r[a] - 1.0));
+      if (!(u1 >= u0)) return max_;  // NaN or an empty region: the global bound
+    }
+    float bound = 0.0f;
+    for (int z = lo[2]; z <= hi[2]; ++z)
+      for (int y = lo[1]; y <= hi[1]; ++y)
+        for (int x = lo[0]; x <= hi[0]; ++x)
+          bound = std::max(bound, grid_.values[(static_cast<size_t>(z) * static_cast<size_t>(r[1]) + static_cast<size_t>(y)) * static_cast<size_t>(r[0]) + static_cast<size_t>(x)]);
+    return static_cast<double>(bound);
+  }
   double feature_size() const override { return feature_; }
 
  private:

@@ -18,6 +18,9 @@ struct Registry {
     methods["quadrature"] = {"quadrature",
                              "single scattering by deterministic numerical quadrature (any medium; a yardstick, not fast)",
                              internal::make_quadrature_method};
+    methods["reference"] = {"reference",
+                            "unbiased volumetric path tracer with a standard-error image (the yardstick for every method)",
+                            internal::make_reference_method};
   }
 };
 

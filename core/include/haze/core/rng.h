@@ -22,11 +22,8 @@ class Rng {
     auto rot = static_cast<std::uint32_t>(old >> 59u);
     return (xorshifted >> rot) | (xorshifted << ((32u - rot) & 31u));
   }
-  // Uniform in [0, 1) with 53 random bits.
-  double uniform() {
-    std::uint64_t hi = next_u32(), lo = next_u32();
-    return static_cast<double>(((hi << 32u) | lo) >> 11u) * 0x1.0p-53;
-  }
+  // Uniform in [0, 1) on a grid of 2^-32: one generator step per number, plenty for Monte Carlo.
+  double uniform() { return static_cast<double>(next_u32()) * 0x1.0p-32; }
 
  private:
   std::uint64_t state_ = 0, inc_ = 1;
