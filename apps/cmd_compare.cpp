@@ -26,12 +26,8 @@ int run(const CompareArgs& a) {
   Rgb mi = image.mean(), mr = reference.mean();
   out["mean"] = {mi.r, mi.g, mi.b};
   out["reference_mean"] = {mr.r, mr.g, mr.b};
-  if (ref_error) {
-    // The reference's own noise, as an RMS of its per-pixel standard errors.
-    double sum = 0.0;
-    for (float e : ref_error->data()) sum += static_cast<double>(e) * static_cast<double>(e);
-    out["reference_noise_rms"] = std::sqrt(sum / static_cast<double>(ref_error->data().size()));
-  }
+  // The reference's own noise: the RMS of its per-pixel standard errors.
+  if (ref_error) out["reference_noise_rms"] = rms(*ref_error);
   if (a.json) {
     std::cout << out.dump(2) << "\n";
   } else {

@@ -53,6 +53,10 @@ int run(const DemoArgs& a) {
         std::string error = has_reference ? "-" : "n/a (no ref.)";
         if (method.name == "reference") {
           reference = result.radiance;
+          // Its own noise on the same scale: RMS standard error over RMS radiance.
+          char buf[32];
+          std::snprintf(buf, sizeof buf, "noise %.4f", result.std_error ? rms(*result.std_error) / rms(result.radiance) : 0.0);
+          error = buf;
         } else if (reference) {
           char buf[32];
           std::snprintf(buf, sizeof buf, "%.4f", relative_rmse(result.radiance, *reference));
@@ -68,7 +72,8 @@ int run(const DemoArgs& a) {
       std::fflush(stdout);
     }
   }
-  std::printf("rel. error: RMSE over pixels and channels divided by the reference's RMS.\n");
+  std::printf("rel. error: RMSE over pixels and channels divided by the reference's RMS; the reference's row\n"
+              "gives its own noise (RMS standard error over RMS radiance) on the same scale.\n");
   return rendered > 0 ? 0 : 1;
 }
 

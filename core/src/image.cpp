@@ -139,11 +139,15 @@ double rmse(const Image& a, const Image& b) {
   return std::sqrt(sum / static_cast<double>(a.data().size()));
 }
 
+double rms(const Image& image) {
+  double sum = 0.0;
+  for (float v : image.data()) sum += static_cast<double>(v) * static_cast<double>(v);
+  return std::sqrt(sum / static_cast<double>(std::max<size_t>(1, image.data().size())));
+}
+
 double relative_rmse(const Image& a, const Image& reference) {
-  double rms = 0.0;
-  for (float v : reference.data()) rms += static_cast<double>(v) * static_cast<double>(v);
-  rms = std::sqrt(rms / static_cast<double>(reference.data().size()));
-  return rms > 0.0 ? rmse(a, reference) / rms : rmse(a, reference);
+  double scale = rms(reference);
+  return scale > 0.0 ? rmse(a, reference) / scale : rmse(a, reference);
 }
 
 }  // namespace haze

@@ -43,6 +43,8 @@ Image read_exr(const std::filesystem::path& path, std::optional<Image>* std_erro
 // 8-bit sRGB preview, tone-mapped with exposure then Reinhard x / (1 + x): not data.
 void write_png(const std::filesystem::path& path, const Image& image, double exposure = 1.0);
 
+// Root mean square over pixels and channels.
+double rms(const Image& image);
 // Root mean square over pixels and channels of (a - b); sizes must match.
 double rmse(const Image& a, const Image& b);
 // rmse(a, b) / rms(b): the relative error `haze demo` reports against the reference.
