@@ -24,6 +24,17 @@ Rgb Medium::transmittance(const Vec3& a, const Vec3& b) const {
   return glm::exp(-sigma_t_ * density_integral(a, b));
 }
 
+Rgb Medium::transmittance_along(const Vec3& x, const Vec3& direction, double distance) const {
+  double t0 = 0.0, t1 = distance;
+  if (!bounds().clip({x, direction}, t0, t1) || !(t1 > t0)) return Rgb(1.0);
+  if (std::isfinite(t1)) return transmittance(x + direction * t0, x + direction * t1);
+  Rgb out(1.0);
+  if (max_density(bounds()) > 0.0)
+    for (int c = 0; c < 3; ++c)
+      if (sigma_t_[c] > 0.0) out[c] = 0.0;
+  return out;
+}
+
 namespace {
 
 class ConstantMedium final : public Medium {

@@ -36,17 +36,7 @@ struct Context {
   }
 
   Rgb transmittance(const Vec3& x, const Vec3& dir, double distance) const {
-    if (!medium) return Rgb(1.0);
-    if (std::isfinite(distance)) return medium->transmittance(x, x + dir * distance);
-    double t0 = 0.0, t1 = kInfinity;
-    if (!medium->bounds().clip({x, dir}, t0, t1)) return Rgb(1.0);
-    if (std::isfinite(t1)) return medium->transmittance(x, x + dir * t1);
-    // An unbounded medium absorbs everything from infinitely far, in channels where it extinguishes.
-    Rgb out(1.0);
-    bool dense = medium->max_density(medium->bounds()) > 0.0;
-    for (int c = 0; c < 3; ++c)
-      if (dense && medium->sigma_t_scale()[c] > 0.0) out[c] = 0.0;
-    return out;
+    return medium ? medium->transmittance_along(x, dir, distance) : Rgb(1.0);
   }
 
   // Light arriving at x that scatters toward the camera: sum over lights of p(wi . wo) E T.

@@ -67,12 +67,7 @@ struct Tracer {
     if (homogeneous) {
       double t0 = 0.0, t1 = distance;
       if (!bounds.clip({x, dir}, t0, t1) || !(t1 > t0)) return Rgb(1.0);
-      if (std::isfinite(t1)) return beer(sigma_t_homogeneous, t1 - t0);
-      // An unbounded medium absorbs everything from infinitely far, in channels where it extinguishes.
-      Rgb out(1.0);
-      for (int c = 0; c < 3; ++c)
-        if (sigma_t_homogeneous[c] > 0.0) out[c] = 0.0;
-      return out;
+      return std::isfinite(t1) ? beer(sigma_t_homogeneous, t1 - t0) : medium->transmittance_along(x, dir, distance);
     }
     // Ratio tracking: T = prod (1 - sigma_t / sigma_maj) over tentative collisions.
     Ray ray{x, dir};
@@ -266,14 +261,12 @@ class ReferenceMethod final : public Method {
       result.std_error->set(px, py, glm::sqrt(variance / n));
     }
     double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    Rgb mean_error = result.std_error->mean();
     result.stats = {{"spp", spp},
                     {"seed", seed},
                     {"max_scattering", max_scattering},
                     {"samples", spp * pixels},
                     {"scattering_events", total_events},
                     {"events_per_second", static_cast<double>(total_events) / seconds},
-                    {"mean_std_error", {mean_error.r, mean_error.g, mean_error.b}},
                     {"seconds", seconds}};
     return result;
   }

@@ -65,6 +65,9 @@ class Medium {
   Rgb sigma_s(const Vec3& x) const { return albedo_ * sigma_t(x); }
   // exp(-optical depth) between a and b, per channel.
   Rgb transmittance(const Vec3& a, const Vec3& b) const;
+  // From x along the unit direction over distance, which may be infinite (directional lights, the
+  // sky): an unbounded medium then absorbs every channel it extinguishes.
+  Rgb transmittance_along(const Vec3& x, const Vec3& direction, double distance) const;
 
  protected:
   Medium(const Rgb& sigma_t, const Rgb& albedo, const PhaseFunction& phase)
