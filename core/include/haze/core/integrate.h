@@ -1,0 +1,19 @@
+// Adaptive Gauss-Kronrod quadrature (G7-K15, bisection on the worst interval) in float64: the
+// yardstick the analytic methods and their tables are measured against.
+#pragma once
+
+#include <functional>
+
+namespace haze {
+
+struct IntegrationResult {
+  double value = 0.0;
+  double error = 0.0;  // estimated absolute error (|K15 - G7| summed over intervals)
+  int evaluations = 0;
+};
+
+// integral_a^b f(x) dx to max(rel_tol * |value|, abs_tol), at most max_intervals subintervals.
+IntegrationResult integrate_adaptive(const std::function<double(double)>& f, double a, double b, double rel_tol = 1e-10,
+                                     double abs_tol = 0.0, int max_intervals = 4096);
+
+}  // namespace haze
