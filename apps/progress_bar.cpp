@@ -22,7 +22,12 @@ ProgressCallback ProgressBar::callback() {
 
 void ProgressBar::draw(double fraction) {
   double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
-  if (elapsed < 0.5 && fraction < 1.0) return;  // short work draws nothing
+  if (elapsed < 0.5 && !drawn_) return;  // short work draws nothing
+  if (fraction >= 1.0) {                    // done: leave the line to the caller's summary
+    std::fprintf(stderr, "\r\033[K");
+    drawn_ = false;
+    return;
+  }
   const int width = 30;
   int filled = static_cast<int>(fraction * width);
   std::string bar(static_cast<size_t>(filled), '#');
