@@ -50,6 +50,27 @@ struct Integrand {
   }
 };
 
+// The tail integrand over eta for the table.
+double tail_integral(const PhaseFunction& phase, double u, double eta0) {
+  const double w0 = std::exp(eta0);
+  auto f = [&](double eta) {
+    return std::exp(-u * (std::exp(eta) - w0)) * phase.eval(-std::tanh(eta)) / std::cosh(eta);
+  };
+  // Past eta0 + 45 (and 45 past 0) the integrand is below e^-45 of its start.
+  double end = std::max(eta0, 0.0) + 45.0;
+  return integrate_adaptive(f, eta0, end, 1e-10, 0.0, 1 << 14).value;
+}
+
+void catmull_rom_weights(double x, double w[4]) {
+  w[0] = 0.5 * x * ((2.0 - x) * x - 1.0);
+  w[1] = 0.5 * (x * x * (3.0 * x - 5.0) + 2.0);
+  w[2] = 0.5 * x * ((4.0 - 3.0 * x) * x + 1.0);
+  w[3] = 0.5 * x * x * (x - 1.0);
+}
+
+// w = (xi + r) / h without cancellation, xi the signed distance from the foot of the perpendicular.
+double w_of(double xi, double r, double h) { return xi >= 0.0 ? (xi + r) / h : h / (r - xi); }
+
 }  // namespace
 
 AirlightSegment AirlightSegment::from_points(const Vec3& viewer, const Vec3& direction, const Vec3& light, double length) {
@@ -74,6 +95,73 @@ double airlight_no_extinction(const AirlightMedium& medium, const AirlightSegmen
   Reduced r = reduce(segment);
   // atan((d_vp - t)/h) - atan(-t/h) = theta_d - theta0.
   return medium.sigma_s * medium.intensity * kInv4Pi / r.h * (r.theta_d - r.theta0);
+}
+
+AirlightTable::AirlightTable(const PhaseFunction& phase, int a_samples, int eta_samples, int threads,
+                             ProgressCallback progress)
+    : phase_(phase), na_(a_samples), neta_(eta_samples) {
+  if (a_samples < 2 || a_samples > 8192) throw Error("a_samples", to_text(a_samples), "an integer in [2, 8192]");
+  if (eta_samples < 2 || eta_samples > 8192) throw Error("eta_samples", to_text(eta_samples), "an integer in [2, 8192]");
+  t_.assign(static_cast<size_t>(na_) * static_cast<size_t>(neta_), 0.0f);
+  ProgressTracker tracker(std::move(progress), neta_);
+  parallel_for(neta_, threads, 1, [&](long long j0, long long j1) {
+    for (auto j = static_cast<int>(j0); j < j1 && !tracker.cancelled(); ++j) {
+      double eta0 = -kEtaMax + 2.0 * kEtaMax * j / (neta_ - 1);
+      double w0 = std::exp(eta0);
+      for (int i = 0; i < na_; ++i) {
+        double m = static_cast<double>(i) / (na_ - 1);
+        double value;
+        if (i == na_ - 1) {
+          // a -> infinity: K -> p(-tanh eta0) / (cosh eta0 u w0), so T -> p (1 + w0)^2 / (1 + w0^2).
+          value = phase_.eval(-std::tanh(eta0)) * (1.0 + w0) * (1.0 + w0) / (1.0 + w0 * w0);
+        } else {
+          double a = m * m / (1.0 - m * m);
+          value = tail_integral(phase_, a / (1.0 + w0), eta0) * 0.5 * (1.0 + w0) * (1.0 + a);
+        }
+        t_[static_cast<size_t>(j) * static_cast<size_t>(na_) + static_cast<size_t>(i)] = static_cast<float>(value);
+      }
+      tracker.advance();
+    }
+  });
+  tracker.throw_if_cancelled();
+}
+
+double AirlightTable::tail(double u, double eta0) const {
+  double w0 = std::exp(std::min(eta0, 700.0));
+  double a = u * (1.0 + w0);
+  double m = std::sqrt(a / (1.0 + a));
+  double fa = (std::isfinite(a) ? m : 1.0) * (na_ - 1);
+  double fe = (std::clamp(eta0, -kEtaMax, kEtaMax) + kEtaMax) / (2.0 * kEtaMax) * (neta_ - 1);
+  int i = std::min(static_cast<int>(fa), na_ - 2), j = std::min(static_cast<int>(fe), neta_ - 2);
+  // Bicubic Catmull-Rom: T's curvature limits bilinear lookups to ~3e-3 at these sizes.
+  double wx[4], wy[4];
+  catmull_rom_weights(fa - i, wx);
+  catmull_rom_weights(fe - j, wy);
+  double t = 0.0;
+  for (int k = 0; k < 4; ++k) {
+    size_t row = static_cast<size_t>(std::clamp(j - 1 + k, 0, neta_ - 1)) * static_cast<size_t>(na_);
+    double sum = 0.0;
+    for (int l = 0; l < 4; ++l) sum += wx[l] * static_cast<double>(t_[row + static_cast<size_t>(std::clamp(i - 1 + l, 0, na_ - 1))]);
+    t += wy[k] * sum;
+  }
+  return 2.0 * t / ((1.0 + w0) * (1.0 + a));
+}
+
+double AirlightTable::eval(const AirlightMedium& medium, const AirlightSegment& segment) const {
+  check(medium, segment);
+  Reduced r = reduce(segment);
+  const double u = medium.sigma_t * r.h;
+  // Near end: xi = -t, r = d_sv; far end: xi = d_vp - t, r = d_sp.
+  double near = std::exp(-medium.sigma_t * r.d_sv) * tail(u, std::log(w_of(-r.t, r.d_sv, r.h)));
+  double far = r.infinite ? 0.0
+                          : std::exp(-medium.sigma_t * (segment.d_vp + r.d_sp)) *
+                                tail(u, std::log(w_of(segment.d_vp - r.t, r.d_sp, r.h)));
+  double integral = near - far;
+  if (far > 0.5 * near) {
+    integral = std::exp(-medium.sigma_t * r.d_sv) *
+               integrate_adaptive(Integrand{phase_, medium.sigma_t, r}, r.theta0, r.theta_d, 1e-7, 0.0, 1024).value;
+  }
+  return medium.sigma_s * medium.intensity / r.h * std::max(0.0, integral);
 }
 
 }  // namespace haze

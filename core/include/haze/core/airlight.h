@@ -10,6 +10,9 @@
 #pragma once
 
 #include <haze/core/phase.h>
+#include <haze/core/progress.h>
+
+#include <vector>
 
 namespace haze {
 
@@ -39,5 +42,42 @@ double airlight_quadrature(const PhaseFunction& phase, const AirlightMedium& med
 // L = sigma_s I / (4 pi h) [atan((d_vp - t) / h) - atan(-t / h)]. A segment through the light is
 // evaluated at h = 1e-9 d_sv (and d_sv >= 1e-12): large, finite, never NaN.
 double airlight_no_extinction(const AirlightMedium& medium, const AirlightSegment& segment);
+
+// The tabulated airlight for one phase function (the thesis' H(u, v) in a better-conditioned form).
+// With eta = asinh(tan theta) (so w = (1 + sin theta) / cos theta = e^eta, x + r = t + h e^eta and
+// dtheta = deta / cosh eta), the airlight is a difference of two tails,
+//   L_a = sigma_s I / h [e^(-sigma_t d_sv) K(u, eta0) - e^(-sigma_t (d_vp + d_sp)) K(u, eta_d)],
+//   K(u, eta0) = integral_{eta0}^inf e^(-u (e^eta - e^eta0)) p(-tanh eta) / cosh eta deta,  u = sigma_t h,
+// each term in range for every optical depth and for lights behind the viewer (where the thesis'
+// H(u, v) differences cancel). The table holds T = K (1 + w0) (1 + a) / 2 with a = u (1 + w0),
+// which stays bounded and smooth: eta0 uniform in [-30, 30] (beyond, T no longer depends on eta0
+// to 1e-13), and m = sqrt(a / (1 + a)) uniform in [0, 1] (the square root absorbs K's u log u
+// behaviour at small u; m = 1 is the exact limit). Lookups are bicubic (Catmull-Rom). At the
+// default 256 x 512 the worst relative error against quadrature over 10^4 random segments with
+// the extremes (tests/core/airlight_test.cpp) is 5.8e-4 for HG g in [-0.95, 0.95]; a table takes
+// about 0.7 s on 2 threads.
+class AirlightTable {
+ public:
+  AirlightTable(const PhaseFunction& phase, int a_samples = 256, int eta_samples = 512, int threads = 0,
+                ProgressCallback progress = {});
+
+  // Airlight for one segment by two table lookups; when the far tail is at least half the near one
+  // (a short segment) the difference would cancel, so that stretch is integrated directly. A
+  // segment through the light is evaluated at h = 1e-9 d_sv: large, finite, never NaN.
+  double eval(const AirlightMedium& medium, const AirlightSegment& segment) const;
+  // K(u, eta0) by bilinear lookup.
+  double tail(double u, double eta0) const;
+
+  int a_samples() const { return na_; }
+  int eta_samples() const { return neta_; }
+  const std::vector<float>& values() const { return t_; }  // a fastest
+
+  static constexpr double kEtaMax = 30.0;
+
+ private:
+  PhaseFunction phase_;
+  int na_, neta_;
+  std::vector<float> t_;
+};
 
 }  // namespace haze
