@@ -9,5 +9,7 @@ namespace haze::internal {
 std::unique_ptr<Method> make_quadrature_method();
 // The unbiased volumetric path tracer every fast method is measured against (reference.cpp).
 std::unique_ptr<Method> make_reference_method();
+// Closed-form single scattering in homogeneous media from point lights (analytic.cpp).
+std::unique_ptr<Method> make_analytic_method();
 
 }  // namespace haze::internal

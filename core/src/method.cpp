@@ -21,6 +21,9 @@ struct Registry {
     methods["reference"] = {"reference",
                             "unbiased volumetric path tracer with a standard-error image (the yardstick for every method)",
                             internal::make_reference_method};
+    methods["analytic"] = {"analytic",
+                           "closed-form single scattering, homogeneous medium, point lights (seed 002; no shadows)",
+                           internal::make_analytic_method};
   }
 };
 

@@ -112,3 +112,55 @@ TEST(Methods, ProgressReachesOneAndCancellationStops) {
 
 }  // namespace
 }  // namespace haze
+
+namespace haze {
+namespace {
+
+Scene analytic_scene() {
+  Scene scene;
+  scene.camera.position = Vec3(0, 1.5, 6);
+  scene.camera.look_at = Vec3(0, 1, 0);
+  scene.camera.width_px = 24, scene.camera.height_px = 16;
+  MediumDesc m;
+  m.sigma_t = Rgb(0.25, 0.3, 0.35);
+  m.albedo = Rgb(0.9);
+  m.phase = PhaseFunction::henyey_greenstein(0.5);
+  scene.medium = m;
+  scene.lights.push_back(PointLight{Vec3(-0.6, 1.6, 0.4), Rgb(12, 10, 7)});
+  scene.lights.push_back(PointLight{Vec3(1.5, 0.8, -1.0), Rgb(3, 5, 9)});
+  scene.surfaces.push_back({Plane{Vec3(0), Vec3(0, 1, 0)}, Rgb(0.6), Rgb(0.2), 10.0});
+  return scene;
+}
+
+// The analytic method against quadrature where both model the same light: airlight from point
+// lights and unshadowed direct surface light (no surface blocks a light here).
+TEST(Analytic, MatchesQuadratureOnUnboundedAndBoundedFog) {
+  for (bool bounded : {false, true}) {
+    Scene scene = analytic_scene();
+    if (bounded) scene.medium->bounds = {Vec3(-3, 0, -3), Vec3(3, 3, 3)};
+    RenderOptions quad;
+    quad.settings = {{"steps", 4096}};
+    auto exact = render(scene, "quadrature", quad);
+    auto fast = render(scene, "analytic");
+    EXPECT_LT(relative_rmse(fast.radiance, exact.radiance), 5e-4) << "bounded " << bounded;
+  }
+}
+
+TEST(Analytic, RejectsWhatItDoesNotModel) {
+  Scene scene = analytic_scene();
+  scene.lights.push_back(DirectionalLight{});
+  try {
+    render(scene, "analytic");
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_EQ(e.field(), "lights[2].type");
+  }
+  scene = analytic_scene();
+  scene.medium->density = RbfDensity{{RbfBlob{}}};
+  EXPECT_THROW(render(scene, "analytic"), Error);
+  scene.medium.reset();
+  EXPECT_THROW(render(scene, "analytic"), Error);
+}
+
+}  // namespace
+}  // namespace haze

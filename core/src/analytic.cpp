@@ -1,0 +1,108 @@
+// Method "analytic": closed-form single scattering in a homogeneous medium from point lights
+// (seed 002 ch. 4, seed 004). Per pixel and light: the airlight of the view segment inside the
+// medium from the tabulated tail form (airlight.h), plus the surface's direct radiance attenuated
+// along both legs (eq. 4.2, 4.10 in Haze's energy-normalized BRDFs). Like the thesis' model it has
+// no shadows and no multiple scattering; airlight scattered onto surfaces (eq. 4.11-4.15) is not
+// included yet.
+#include "builtin_methods.h"
+
+#include <haze/core/airlight.h>
+#include <haze/core/error.h>
+
+#include <chrono>
+
+namespace haze::internal {
+
+namespace {
+
+class AnalyticMethod final : public Method {
+ public:
+  RenderResult render(const Scene& scene, const RenderOptions& options) const override {
+    Settings settings(options.settings, "analytic");
+    const int a_samples = static_cast<int>(settings.integer("table_a", 256, 16, 4096));
+    const int eta_samples = static_cast<int>(settings.integer("table_eta", 512, 16, 4096));
+    settings.reject_unknown();
+
+    if (!scene.medium) throw Error("medium", "missing", "a homogeneous medium for the analytic method");
+    const MediumDesc& desc = *scene.medium;
+    const auto* constant = std::get_if<ConstantDensity>(&desc.density);
+    if (!constant) throw Error("medium.density.type", "heterogeneous", "\"constant\" for the analytic method (use propagation or reference)");
+    std::vector<PointLight> lights;
+    for (size_t i = 0; i < scene.lights.size(); ++i) {
+      if (auto* p = std::get_if<PointLight>(&scene.lights[i])) {
+        lights.push_back(*p);
+      } else {
+        throw Error("lights[" + std::to_string(i) + "].type", "not a point light",
+                    "point lights only for the analytic method (spot lights are planned)");
+      }
+    }
+
+    auto start = std::chrono::steady_clock::now();
+    auto medium = make_medium(desc);
+    const Rgb sigma_t = desc.sigma_t * constant->value;
+    const Rgb sigma_s = desc.albedo * sigma_t;
+    AirlightTable table(desc.phase, a_samples, eta_samples, options.threads);
+    double table_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+
+    const Camera& camera = scene.camera;
+    const Aabb bounds = medium->bounds();
+    RenderResult result{Image(camera.width_px, camera.height_px), std::nullopt, {}};
+    ProgressTracker progress(options.progress, camera.height_px);
+    parallel_for(camera.height_px, options.threads, 1, [&](long long y0, long long y1) {
+      for (auto y = static_cast<int>(y0); y < y1 && !progress.cancelled(); ++y) {
+        for (int x = 0; x < camera.width_px; ++x) {
+          Ray ray = camera.pixel_ray(x, y);
+          double t_hit = kInfinity;
+          const Surface* hit = nullptr;
+          Vec3 normal(0.0);
+          for (const auto& s : scene.surfaces) {
+            double t;
+            Vec3 n;
+            if (s.intersect(ray, 1e-7, t_hit, t, n)) t_hit = t, hit = &s, normal = n;
+          }
+          Rgb radiance(0.0);
+          double t0 = 0.0, t1 = t_hit;
+          bool in_medium = bounds.clip(ray, t0, t1) && t1 > t0;
+          if (in_medium) {
+            Vec3 entry = ray.at(t0);
+            for (const auto& light : lights)
+              for (int c = 0; c < 3; ++c) {
+                if (sigma_s[c] == 0.0 || light.intensity[c] == 0.0) continue;
+                AirlightSegment segment = AirlightSegment::from_points(entry, ray.direction, light.position, t1 - t0);
+                radiance[c] += table.eval({sigma_t[c], sigma_s[c], light.intensity[c]}, segment);
+              }
+          }
+          Rgb view_t = medium->transmittance_along(ray.origin, ray.direction, t_hit);
+          if (hit) {
+            Vec3 p = ray.at(t_hit);
+            Rgb surface(0.0);
+            for (const auto& light : lights) {
+              Vec3 to_light = light.position - p;
+              double d2 = glm::dot(to_light, to_light), d = std::sqrt(d2);
+              Vec3 wi = to_light / d;
+              double cos_i = glm::dot(normal, wi);
+              if (cos_i <= 0.0) continue;
+              surface += hit->brdf(wi, -ray.direction, normal) * light.intensity / d2 * cos_i * medium->transmittance(p, light.position);
+            }
+            radiance += view_t * surface;
+          } else {
+            radiance += view_t * scene.background;
+          }
+          result.radiance.set(x, y, radiance);
+        }
+        progress.advance();
+      }
+    });
+    progress.throw_if_cancelled();
+    result.stats = {{"table_seconds", table_seconds},
+                    {"table", {a_samples, eta_samples}},
+                    {"seconds", std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()}};
+    return result;
+  }
+};
+
+}  // namespace
+
+std::unique_ptr<Method> make_analytic_method() { return std::make_unique<AnalyticMethod>(); }
+
+}  // namespace haze::internal
