@@ -1,8 +1,8 @@
 // Method "quadrature": single scattering by deterministic numerical quadrature, for any Medium.
 // L = integral_{t0}^{t1} T(o, x) sigma_s(x) sum_lights p(wi . wo) E_light(x) T(x, light) dt
 //     + T(o, t1) L_surface_or_escape,
-// with Gauss-Legendre panels along the view ray (split at each point light's closest approach,
-// where the integrand peaks), sky in-scattering over a Fibonacci DirectionSet, and surface direct
+// with Gauss-Legendre panels along the view ray (graded geometrically toward each point light's
+// closest approach, where the integrand peaks), sky in-scattering over a Fibonacci DirectionSet, and surface direct
 // lighting with shadows. Slow and simple on purpose: it checks the fast single-scattering methods.
 #include "builtin_methods.h"
 
@@ -99,31 +99,36 @@ struct Context {
         double rho = medium->max_density(medium->bounds());
         t1 = (rho > 0.0 && std::isfinite(sigma_min)) ? t0 + 30.0 / (sigma_min * rho) : t0;
       }
-      // Breakpoints: the ends and each point-like light's closest approach.
-      std::vector<double> breaks{t0, t1};
+      // Panel edges: uniform, plus edges graded geometrically (h 2^k) away from each point or spot
+      // light's closest approach, where the integrand peaks with width h.
+      std::vector<double> edges;
+      const int uniform_panels = std::max(1, steps / kNodesPerPanel);
+      for (int i = 0; i <= uniform_panels; ++i) edges.push_back(t0 + (t1 - t0) * i / uniform_panels);
       for (const auto& light : scene.lights) {
         const Vec3* p = std::get_if<PointLight>(&light) ? &std::get<PointLight>(light).position
                         : std::get_if<SpotLight>(&light) ? &std::get<SpotLight>(light).position : nullptr;
         if (!p) continue;
         double tc = glm::dot(*p - ray.origin, ray.direction);
-        if (tc > t0 && tc < t1) breaks.push_back(tc);
+        double h = std::max(glm::length(*p - ray.at(tc)), 1e-9 * (t1 - t0));
+        if (tc > t0 && tc < t1) edges.push_back(tc);
+        for (double d = h / 8.0; d < t1 - t0; d *= 2.0) {
+          if (tc - d > t0 && tc - d < t1) edges.push_back(tc - d);
+          if (tc + d > t0 && tc + d < t1) edges.push_back(tc + d);
+        }
       }
-      std::sort(breaks.begin(), breaks.end());
+      std::sort(edges.begin(), edges.end());
       const Vec3 wo = -ray.direction;
       Vec3 previous = ray.at(t0);
-      for (size_t b = 0; b + 1 < breaks.size(); ++b) {
-        double a = breaks[b], len = breaks[b + 1] - a;
-        int panels = std::max(1, static_cast<int>(std::ceil(steps / double(kNodesPerPanel) * len / (t1 - t0))));
-        double h = len / panels;
-        for (int p = 0; p < panels; ++p) {
-          for (size_t q = 0; q < gl_nodes.size(); ++q) {
-            Vec3 x = ray.at(a + h * (p + 0.5 + 0.5 * gl_nodes[q]));
-            view_t *= glm::exp(-medium->sigma_t_scale() * medium->density_integral(previous, x));
-            previous = x;
-            Rgb sigma_s = medium->sigma_s(x);
-            if (sigma_s == Rgb(0.0)) continue;
-            radiance += 0.5 * h * gl_weights[q] * view_t * sigma_s * in_scattered(x, wo);
-          }
+      for (size_t e = 0; e + 1 < edges.size(); ++e) {
+        double a = edges[e], h = edges[e + 1] - a;
+        if (!(h > 0.0)) continue;
+        for (size_t q = 0; q < gl_nodes.size(); ++q) {
+          Vec3 x = ray.at(a + h * (0.5 + 0.5 * gl_nodes[q]));
+          view_t *= glm::exp(-medium->sigma_t_scale() * medium->density_integral(previous, x));
+          previous = x;
+          Rgb sigma_s = medium->sigma_s(x);
+          if (sigma_s == Rgb(0.0)) continue;
+          radiance += 0.5 * h * gl_weights[q] * view_t * sigma_s * in_scattered(x, wo);
         }
       }
       view_t *= glm::exp(-medium->sigma_t_scale() * medium->density_integral(previous, ray.at(t1)));
