@@ -164,4 +164,68 @@ double AirlightTable::eval(const AirlightMedium& medium, const AirlightSegment& 
   return medium.sigma_s * medium.intensity / r.h * std::max(0.0, integral);
 }
 
+namespace {
+
+// integral_0^2pi max(0, A cos phi + B)^n dphi, A >= 0: closed form for n = 1, Gauss-Legendre over the
+// positive arc otherwise (the integrand is smooth there).
+double azimuth_integral(double A, double B, double n) {
+  if (B >= A) {
+    if (n == 1.0) return 2.0 * kPi * B;
+  } else if (B <= -A) {
+    return 0.0;
+  }
+  double phi_c = B >= A ? kPi : std::acos(std::clamp(-B / A, -1.0, 1.0));
+  if (n == 1.0) return 2.0 * (A * std::sin(phi_c) + B * phi_c);
+  static const auto rule = [] {
+    std::pair<std::vector<double>, std::vector<double>> r;
+    gauss_legendre(48, r.first, r.second);
+    return r;
+  }();
+  double sum = 0.0;
+  for (size_t q = 0; q < rule.first.size(); ++q) {
+    double phi = 0.5 * phi_c * (rule.first[q] + 1.0);
+    sum += rule.second[q] * std::pow(std::max(0.0, A * std::cos(phi) + B), n);
+  }
+  return 2.0 * 0.5 * phi_c * sum;  // symmetric in phi
+}
+
+}  // namespace
+
+SurfaceAirlightTable::SurfaceAirlightTable(const AirlightTable& airlight, double exponent, int t_samples, int angle_samples,
+                                           int threads)
+    : exponent_(exponent), nt_(t_samples), na_(angle_samples) {
+  if (!(exponent >= 0.0 && exponent <= 1e5)) throw Error("shininess", to_text(exponent), "a Phong exponent in [0, 1e5]");
+  if (t_samples < 2 || angle_samples < 2) throw Error("samples", to_text(t_samples) + " x " + to_text(angle_samples), "at least 2 x 2");
+  const bool lambert = exponent == 0.0;
+  const double n = lambert ? 1.0 : exponent;
+  const double scale = lambert ? 1.0 / kPi : (n + 2.0) / (2.0 * kPi);
+  j_.assign(static_cast<size_t>(nt_) * static_cast<size_t>(na_), 0.0f);
+  parallel_for(na_, threads, 1, [&](long long k0, long long k1) {
+    for (auto k = static_cast<int>(k0); k < k1; ++k) {
+      double angle = kPi * k / (na_ - 1);
+      for (int i = 0; i < nt_; ++i) {
+        double m = static_cast<double>(i) / (nt_ - 1);
+        double T = i == nt_ - 1 ? 1e12 : m / (1.0 - m);
+        // Incident directions around the light: the lobe axis (normal or R) sits at `angle`.
+        auto f = [&](double gamma) {
+          double A = std::sin(gamma) * std::sin(angle), B = std::cos(gamma) * std::cos(angle);
+          return airlight.tail(T * std::sin(gamma), std::log(std::tan(0.5 * gamma))) * azimuth_integral(A, B, n);
+        };
+        double j = scale * integrate_adaptive(f, 0.0, kPi, 1e-6, 0.0, 2048).value;
+        j_[static_cast<size_t>(k) * static_cast<size_t>(nt_) + static_cast<size_t>(i)] = static_cast<float>((1.0 + T) * j);
+      }
+    }
+  });
+}
+
+double SurfaceAirlightTable::eval(double optical_depth, double angle) const {
+  double m = optical_depth / (1.0 + optical_depth);
+  double fi = std::clamp(m, 0.0, 1.0) * (nt_ - 1), fk = std::clamp(angle / kPi, 0.0, 1.0) * (na_ - 1);
+  int i = std::min(static_cast<int>(fi), nt_ - 2), k = std::min(static_cast<int>(fk), na_ - 2);
+  double x = fi - i, y = fk - k;
+  auto at = [&](int ii, int kk) { return static_cast<double>(j_[static_cast<size_t>(kk) * static_cast<size_t>(nt_) + static_cast<size_t>(ii)]); };
+  double v = (1 - y) * ((1 - x) * at(i, k) + x * at(i + 1, k)) + y * ((1 - x) * at(i, k + 1) + x * at(i + 1, k + 1));
+  return v / (1.0 + optical_depth);
+}
+
 }  // namespace haze

@@ -1,15 +1,17 @@
 // Method "analytic": closed-form single scattering in a homogeneous medium from point lights
 // (seed 002 ch. 4, seed 004). Per pixel and light: the airlight of the view segment inside the
 // medium from the tabulated tail form (airlight.h), plus the surface's direct radiance attenuated
-// along both legs (eq. 4.2, 4.10 in Haze's energy-normalized BRDFs). Like the thesis' model it has
-// no shadows and no multiple scattering; airlight scattered onto surfaces (eq. 4.11-4.15) is not
-// included yet.
+// along both legs (eq. 4.2, 4.10 in Haze's energy-normalized BRDFs) and the airlight scattered onto
+// it (eq. 4.11-4.15, tables J1 and J_n). Like the thesis' model it has no shadows and no multiple
+// scattering.
 #include "builtin_methods.h"
 
 #include <haze/core/airlight.h>
 #include <haze/core/error.h>
 
 #include <chrono>
+#include <map>
+#include <optional>
 
 namespace haze::internal {
 
@@ -21,6 +23,7 @@ class AnalyticMethod final : public Method {
     Settings settings(options.settings, "analytic");
     const int a_samples = static_cast<int>(settings.integer("table_a", 256, 16, 4096));
     const int eta_samples = static_cast<int>(settings.integer("table_eta", 512, 16, 4096));
+    const bool surface_airlight = settings.integer("surface_airlight", 1, 0, 1) == 1;
     settings.reject_unknown();
 
     if (!scene.medium) throw Error("medium", "missing", "a homogeneous medium for the analytic method");
@@ -42,6 +45,17 @@ class AnalyticMethod final : public Method {
     const Rgb sigma_t = desc.sigma_t * constant->value;
     const Rgb sigma_s = desc.albedo * sigma_t;
     AirlightTable table(desc.phase, a_samples, eta_samples, options.threads);
+    // J1 for diffuse surfaces and one J_n per Phong exponent in the scene.
+    std::optional<SurfaceAirlightTable> lambert;
+    std::map<double, SurfaceAirlightTable> phong;
+    if (surface_airlight) {
+      for (const auto& s : scene.surfaces) {
+        if (s.kd != Rgb(0.0) && !lambert) lambert.emplace(table, 0.0, 64, 64, options.threads);
+        if (s.ks != Rgb(0.0) && !phong.count(s.shininess))
+          phong.emplace(std::piecewise_construct, std::forward_as_tuple(s.shininess),
+                        std::forward_as_tuple(table, s.shininess, 64, 64, options.threads));
+      }
+    }
     double table_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
     const Camera& camera = scene.camera;
@@ -83,6 +97,24 @@ class AnalyticMethod final : public Method {
               double cos_i = glm::dot(normal, wi);
               if (cos_i <= 0.0) continue;
               surface += hit->brdf(wi, -ray.direction, normal) * light.intensity / d2 * cos_i * medium->transmittance(p, light.position);
+            }
+            // Airlight onto the surface, where the surface point is in the medium.
+            if (surface_airlight && bounds.contains(p)) {
+              Vec3 mirrored = glm::reflect(ray.direction, normal);
+              double cos_r = std::max(0.0, glm::dot(normal, mirrored));
+              for (const auto& light : lights) {
+                Vec3 to_light = light.position - p;
+                double d = glm::length(to_light);
+                Vec3 wi = to_light / d;
+                double theta_s = std::acos(std::clamp(glm::dot(normal, wi), -1.0, 1.0));
+                double theta_r = std::acos(std::clamp(glm::dot(mirrored, wi), -1.0, 1.0));
+                for (int c = 0; c < 3; ++c) {
+                  double T = sigma_t[c] * d;
+                  double j = lambert && hit->kd[c] > 0.0 ? hit->kd[c] * lambert->eval(T, theta_s) : 0.0;
+                  if (hit->ks[c] > 0.0) j += hit->ks[c] * phong.at(hit->shininess).eval(T, theta_r) * cos_r;
+                  surface[c] += sigma_s[c] * light.intensity[c] * std::exp(-T) / d * j;
+                }
+              }
             }
             radiance += view_t * surface;
           } else {

@@ -141,8 +141,13 @@ TEST(Analytic, MatchesQuadratureOnUnboundedAndBoundedFog) {
     RenderOptions quad;
     quad.settings = {{"steps", 4096}};
     auto exact = render(scene, "quadrature", quad);
-    auto fast = render(scene, "analytic");
+    RenderOptions no_surface_airlight;
+    no_surface_airlight.settings = {{"surface_airlight", 0}};  // quadrature lights surfaces directly only
+    auto fast = render(scene, "analytic", no_surface_airlight);
     EXPECT_LT(relative_rmse(fast.radiance, exact.radiance), 5e-4) << "bounded " << bounded;
+    // Airlight onto the surfaces only adds light.
+    auto full = render(scene, "analytic");
+    EXPECT_GT(full.radiance.mean().r, fast.radiance.mean().r);
   }
 }
 

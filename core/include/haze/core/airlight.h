@@ -80,4 +80,30 @@ class AirlightTable {
   std::vector<float> t_;
 };
 
+// Airlight scattered onto a surface (seed 002 eq. 4.11-4.15) in Haze's energy-normalized BRDFs:
+//   L_pa = sigma_s I e^(-T) / d_sp [kd J1(T, theta_s) + ks J_n(T, theta'_s) max(0, n . R)],
+// T = sigma_t d_sp, theta_s the angle between the normal and the light, theta'_s the angle between
+// the light and R, the view direction mirrored about the normal. With gamma the angle between an
+// incident direction and the light and K the airlight tail (the sin gamma of the solid angle
+// cancels the 1 / h of the airlight):
+//   J1 = 1/pi            integral_0^pi K(T sin gamma, ln tan(gamma/2)) Phi_1(gamma) dgamma,
+//   J_n = (n + 2)/(2 pi) integral_0^pi K(T sin gamma, ln tan(gamma/2)) Phi_n(gamma) dgamma,
+// Phi_1 = integral over azimuth of max(0, cos theta_i) (closed form), Phi_n the same of
+// max(0, omega . R)^n. The Phong form drops cos theta_i inside the lobe for max(0, n . R) outside
+// it, as the thesis' reparameterization does; no surface blocks the incident airlight.
+class SurfaceAirlightTable {
+ public:
+  // exponent 0 builds J1 (Lambert); n > 0 builds J_n (Phong).
+  SurfaceAirlightTable(const AirlightTable& airlight, double exponent, int t_samples = 64, int angle_samples = 64,
+                       int threads = 0);
+  // J(T, angle): bilinear in m = T / (1 + T) and the angle in [0, pi].
+  double eval(double optical_depth, double angle) const;
+  double exponent() const { return exponent_; }
+
+ private:
+  double exponent_;
+  int nt_, na_;
+  std::vector<float> j_;  // (1 + T) J, T fastest
+};
+
 }  // namespace haze
