@@ -1,6 +1,7 @@
 #include <haze/core/airlight.h>
 #include <haze/core/error.h>
 #include <haze/core/integrate.h>
+#include <haze/core/light.h>
 
 #include <algorithm>
 
@@ -95,6 +96,38 @@ double airlight_no_extinction(const AirlightMedium& medium, const AirlightSegmen
   Reduced r = reduce(segment);
   // atan((d_vp - t)/h) - atan(-t/h) = theta_d - theta0.
   return medium.sigma_s * medium.intensity * kInv4Pi / r.h * (r.theta_d - r.theta0);
+}
+
+double spot_airlight(const PhaseFunction& phase, const AirlightMedium& medium, const Vec3& viewer, const Vec3& direction,
+                     double length, const Vec3& light, const Vec3& axis, double exponent, double cone_deg, double rel_tol) {
+  AirlightSegment segment = AirlightSegment::from_points(viewer, direction, light, length);
+  check(medium, segment);
+  const double cos_c = std::cos(cone_deg * kPi / 180.0);
+  const double end = std::isfinite(length) ? length : kInfinity;
+  std::vector<double> cuts = cone_crossings(SpotLight{light, axis, Rgb(1.0), exponent, cone_deg}, {viewer, direction}, end);
+  cuts.insert(cuts.begin(), 0.0);
+  cuts.push_back(end);
+
+  Reduced r = reduce(segment);
+  Integrand base{phase, medium.sigma_t, r};
+  double total = 0.0;
+  for (size_t k = 0; k + 1 < cuts.size(); ++k) {
+    double x0 = cuts[k], x1 = cuts[k + 1];
+    double probe = std::isfinite(x1) ? 0.5 * (x0 + x1) : x0 + 1.0 + x0;
+    Vec3 e = viewer + probe * direction - light;
+    double len_e = glm::length(e);
+    if (!(len_e > 0.0) || glm::dot(e, axis) < cos_c * len_e) continue;  // this stretch is outside the cone
+    double th0 = std::atan2(x0 - r.t, r.h), th1 = std::isfinite(x1) ? std::atan2(x1 - r.t, r.h) : 0.5 * kPi;
+    auto f = [&](double theta) {
+      // The point at angle theta and its emission direction from the light.
+      double x = r.t + r.h * std::tan(theta);
+      Vec3 em = glm::normalize(viewer + x * direction - light);
+      double cos_psi = std::max(0.0, glm::dot(em, axis));
+      return base(theta) * std::pow(cos_psi, exponent);
+    };
+    total += integrate_adaptive(f, th0, th1, rel_tol, 0.0, 4096).value;
+  }
+  return medium.sigma_s * medium.intensity * std::exp(-medium.sigma_t * r.d_sv) / r.h * total;
 }
 
 AirlightTable::AirlightTable(const PhaseFunction& phase, int a_samples, int eta_samples, int threads,

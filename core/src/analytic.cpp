@@ -1,5 +1,5 @@
-// Method "analytic": closed-form single scattering in a homogeneous medium from point lights
-// (seed 002 ch. 4, seed 004). Per pixel and light: the airlight of the view segment inside the
+// Method "analytic": closed-form single scattering in a homogeneous medium from point and spot
+// lights (seed 002 ch. 4, seed 004). Per pixel and light: the airlight of the view segment inside the
 // medium from the tabulated tail form (airlight.h), plus the surface's direct radiance attenuated
 // along both legs (eq. 4.2, 4.10 in Haze's energy-normalized BRDFs) and the airlight scattered onto
 // it (eq. 4.11-4.15, tables J1 and J_n). Like the thesis' model it has no shadows and no multiple
@@ -30,13 +30,22 @@ class AnalyticMethod final : public Method {
     const MediumDesc& desc = *scene.medium;
     const auto* constant = std::get_if<ConstantDensity>(&desc.density);
     if (!constant) throw Error("medium.density.type", "heterogeneous", "\"constant\" for the analytic method (use propagation or reference)");
-    std::vector<PointLight> lights;
+    // Point lights use the airlight table; spot lights integrate the stretches inside their cone.
+    struct AnalyticLight {
+      Light light;
+      Vec3 position;
+      Rgb intensity;
+      const SpotLight* spot;
+    };
+    std::vector<AnalyticLight> lights;
     for (size_t i = 0; i < scene.lights.size(); ++i) {
       if (auto* p = std::get_if<PointLight>(&scene.lights[i])) {
-        lights.push_back(*p);
+        lights.push_back({*p, p->position, p->intensity, nullptr});
+      } else if (auto* sp = std::get_if<SpotLight>(&scene.lights[i])) {
+        lights.push_back({*sp, sp->position, sp->intensity, sp});
       } else {
-        throw Error("lights[" + std::to_string(i) + "].type", "not a point light",
-                    "point lights only for the analytic method (spot lights are planned)");
+        throw Error("lights[" + std::to_string(i) + "].type", "a directional or sky light",
+                    "point or spot lights for the analytic method");
       }
     }
 
@@ -82,37 +91,43 @@ class AnalyticMethod final : public Method {
             for (const auto& light : lights)
               for (int c = 0; c < 3; ++c) {
                 if (sigma_s[c] == 0.0 || light.intensity[c] == 0.0) continue;
-                AirlightSegment segment = AirlightSegment::from_points(entry, ray.direction, light.position, t1 - t0);
-                radiance[c] += table.eval({sigma_t[c], sigma_s[c], light.intensity[c]}, segment);
+                AirlightMedium m{sigma_t[c], sigma_s[c], light.intensity[c]};
+                if (light.spot) {
+                  radiance[c] += spot_airlight(desc.phase, m, entry, ray.direction, t1 - t0, light.position,
+                                               light.spot->direction, light.spot->exponent, light.spot->cone_deg);
+                } else {
+                  radiance[c] += table.eval(m, AirlightSegment::from_points(entry, ray.direction, light.position, t1 - t0));
+                }
               }
           }
           Rgb view_t = medium->transmittance_along(ray.origin, ray.direction, t_hit);
           if (hit) {
             Vec3 p = ray.at(t_hit);
             Rgb surface(0.0);
+            LightArrival a;
             for (const auto& light : lights) {
-              Vec3 to_light = light.position - p;
-              double d2 = glm::dot(to_light, to_light), d = std::sqrt(d2);
-              Vec3 wi = to_light / d;
-              double cos_i = glm::dot(normal, wi);
+              arrival(light.light, p, a);
+              double cos_i = glm::dot(normal, a.to_light);
               if (cos_i <= 0.0) continue;
-              surface += hit->brdf(wi, -ray.direction, normal) * light.intensity / d2 * cos_i * medium->transmittance(p, light.position);
+              surface += hit->brdf(a.to_light, -ray.direction, normal) * a.irradiance * cos_i * medium->transmittance(p, light.position);
             }
             // Airlight onto the surface, where the surface point is in the medium.
             if (surface_airlight && bounds.contains(p)) {
               Vec3 mirrored = glm::reflect(ray.direction, normal);
               double cos_r = std::max(0.0, glm::dot(normal, mirrored));
               for (const auto& light : lights) {
-                Vec3 to_light = light.position - p;
-                double d = glm::length(to_light);
-                Vec3 wi = to_light / d;
+                // A spot light's J tables are scaled by its intensity toward the surface point.
+                arrival(light.light, p, a);
+                Rgb intensity = a.irradiance * a.distance * a.distance;
+                double d = a.distance;
+                Vec3 wi = a.to_light;
                 double theta_s = std::acos(std::clamp(glm::dot(normal, wi), -1.0, 1.0));
                 double theta_r = std::acos(std::clamp(glm::dot(mirrored, wi), -1.0, 1.0));
                 for (int c = 0; c < 3; ++c) {
                   double T = sigma_t[c] * d;
                   double j = lambert && hit->kd[c] > 0.0 ? hit->kd[c] * lambert->eval(T, theta_s) : 0.0;
                   if (hit->ks[c] > 0.0) j += hit->ks[c] * phong.at(hit->shininess).eval(T, theta_r) * cos_r;
-                  surface[c] += sigma_s[c] * light.intensity[c] * std::exp(-T) / d * j;
+                  surface[c] += sigma_s[c] * intensity[c] * std::exp(-T) / d * j;
                 }
               }
             }

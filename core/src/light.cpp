@@ -1,5 +1,7 @@
 #include <haze/core/light.h>
 
+#include <algorithm>
+
 namespace haze {
 
 bool arrival(const Light& light, const Vec3& x, LightArrival& out) {
@@ -28,6 +30,31 @@ bool arrival(const Light& light, const Vec3& x, LightArrival& out) {
     return true;
   }
   return false;
+}
+
+std::vector<double> cone_crossings(const SpotLight& spot, const Ray& ray, double t_max) {
+  // Inside: (m + t d) . a >= cos(c) |m + t d|, m = origin - apex; squared, a quadratic in t.
+  const double cos_c = std::cos(spot.cone_deg * kPi / 180.0), c2 = cos_c * cos_c;
+  const Vec3 m = ray.origin - spot.position;
+  const double da = glm::dot(ray.direction, spot.direction), ma = glm::dot(m, spot.direction);
+  const double A = da * da - c2, B = 2.0 * (da * ma - c2 * glm::dot(m, ray.direction)), C = ma * ma - c2 * glm::dot(m, m);
+  std::vector<double> roots;
+  if (std::abs(A) > 1e-14) {
+    double disc = B * B - 4.0 * A * C;
+    if (disc > 0.0) {
+      double q = -0.5 * (B + std::copysign(std::sqrt(disc), B));
+      roots.push_back(q / A);
+      if (q != 0.0) roots.push_back(C / q);
+    }
+  } else if (B != 0.0) {
+    roots.push_back(-C / B);
+  }
+  if (da != 0.0) roots.push_back(-ma / da);  // the plane through the apex
+  std::vector<double> out;
+  for (double t : roots)
+    if (t > 0.0 && t < t_max) out.push_back(t);
+  std::sort(out.begin(), out.end());
+  return out;
 }
 
 }  // namespace haze

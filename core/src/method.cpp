@@ -22,7 +22,7 @@ struct Registry {
                             "unbiased volumetric path tracer with a standard-error image (the yardstick for every method)",
                             internal::make_reference_method};
     methods["analytic"] = {"analytic",
-                           "closed-form single scattering, homogeneous medium, point lights (seed 002; no shadows)",
+                           "closed-form single scattering, homogeneous medium, point and spot lights (seed 002; no shadows)",
                            internal::make_analytic_method};
   }
 };

@@ -100,7 +100,7 @@ struct Context {
         t1 = (rho > 0.0 && std::isfinite(sigma_min)) ? t0 + 30.0 / (sigma_min * rho) : t0;
       }
       // Panel edges: uniform, plus edges graded geometrically (h 2^k) away from each point or spot
-      // light's closest approach, where the integrand peaks with width h.
+      // light's closest approach, where the integrand peaks with width h, plus cone crossings.
       std::vector<double> edges;
       const int uniform_panels = std::max(1, steps / kNodesPerPanel);
       for (int i = 0; i <= uniform_panels; ++i) edges.push_back(t0 + (t1 - t0) * i / uniform_panels);
@@ -115,6 +115,10 @@ struct Context {
           if (tc - d > t0 && tc - d < t1) edges.push_back(tc - d);
           if (tc + d > t0 && tc + d < t1) edges.push_back(tc + d);
         }
+        // A spot light's cone boundary is a jump in the integrand: make it a panel edge.
+        if (auto* spot = std::get_if<SpotLight>(&light))
+          for (double t : cone_crossings(*spot, ray, t1))
+            if (t > t0) edges.push_back(t);
       }
       std::sort(edges.begin(), edges.end());
       const Vec3 wo = -ray.direction;

@@ -43,6 +43,15 @@ double airlight_quadrature(const PhaseFunction& phase, const AirlightMedium& med
 // evaluated at h = 1e-9 d_sv (and d_sv >= 1e-12): large, finite, never NaN.
 double airlight_no_extinction(const AirlightMedium& medium, const AirlightSegment& segment);
 
+// Airlight from a spot light, I(psi) = I0 cos^n(psi) inside the cone half-angle (the thesis' future
+// work, sec. 6.2.1): the view segment is cut to the stretches inside the cone (a quadratic in the
+// distance along the ray), and each stretch is integrated in the angle form by adaptive
+// Gauss-Kronrod to rel_tol. No table: the cone adds two angles and an exponent per light, and the
+// stretches are short where the cone is narrow. `medium.intensity` is I0.
+double spot_airlight(const PhaseFunction& phase, const AirlightMedium& medium, const Vec3& viewer, const Vec3& direction,
+                     double length, const Vec3& light, const Vec3& axis, double exponent, double cone_deg,
+                     double rel_tol = 1e-5);
+
 // The tabulated airlight for one phase function (the thesis' H(u, v) in a better-conditioned form).
 // With eta = asinh(tan theta) (so w = (1 + sin theta) / cos theta = e^eta, x + r = t + h e^eta and
 // dtheta = deta / cosh eta), the airlight is a difference of two tails,

@@ -6,6 +6,7 @@
 #include <haze/core/math.h>
 
 #include <variant>
+#include <vector>
 
 namespace haze {
 
@@ -42,5 +43,9 @@ struct LightArrival {
 
 // Delta lights only: a sky light has no single direction (returns false).
 bool arrival(const Light& light, const Vec3& x, LightArrival& out);
+
+// Distances t in (0, t_max) where the ray crosses the spot light's cone (its lateral surface or the
+// plane of its apex), sorted: between consecutive ones the ray is wholly inside or outside.
+std::vector<double> cone_crossings(const SpotLight& spot, const Ray& ray, double t_max);
 
 }  // namespace haze
