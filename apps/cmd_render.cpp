@@ -42,7 +42,7 @@ struct RenderArgs {
   bool json = false, no_png = false;
   std::vector<std::string> set;
   // Shortcuts for the reference path tracer's settings; unset unless given.
-  std::optional<long long> spp, max_scattering, seed;
+  std::optional<long long> spp, max_scattering, max_bounces, seed;
 };
 
 // "--set key=value": the value is JSON when it parses as JSON, else a string.
@@ -67,6 +67,7 @@ int run(const RenderArgs& a) {
   options.settings = parse_settings(a.set);
   if (a.spp) options.settings["spp"] = *a.spp;
   if (a.max_scattering) options.settings["max_scattering"] = *a.max_scattering;
+  if (a.max_bounces) options.settings["max_bounces"] = *a.max_bounces;
   if (a.seed) options.settings["seed"] = *a.seed;
   ProgressBar bar(method);
   options.progress = bar.callback();
@@ -97,7 +98,8 @@ Command add_render(CLI::App& app) {
   sub->add_option("--threads", a->threads, "Thread cap (0: all cores)")->check(CLI::NonNegativeNumber);
   sub->add_option("--set", a->set, "Method setting key=value (repeatable), e.g. --set steps=256");
   sub->add_option("--spp", a->spp, "Samples per pixel (reference)");
-  sub->add_option("--max-scattering", a->max_scattering, "Scattering events per path: -1 unlimited, 1 single, 0 none (reference)");
+  sub->add_option("--max-scattering", a->max_scattering, "Medium scattering events per path: -1 unlimited, 1 single, 0 none (reference)");
+  sub->add_option("--max-bounces", a->max_bounces, "Surface reflections per path: -1 unlimited (reference)");
   sub->add_option("--seed", a->seed, "Random seed (reference); the same seed gives the same image on any thread count");
   sub->add_flag("--json", a->json, "Print a JSON summary");
   sub->add_flag("--no-png", a->no_png, "Do not write the PNG preview");

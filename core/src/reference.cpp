@@ -41,7 +41,8 @@ struct Tracer {
   std::optional<MajorantGrid> majorants;
   double sigma_max = 0.0;  // largest channel of the medium's sigma_t scale
   Rgb sky{0.0};
-  int max_scattering = -1;
+  int max_scattering = -1;  // medium scattering events per path; -1 unlimited
+  int max_bounces = -1;     // surface reflections per path; -1 unlimited
   // Homogeneous media skip the majorant walk and density lookups: sigma_t is constant in bounds.
   bool homogeneous = false;
   Aabb bounds;
@@ -127,6 +128,7 @@ struct Tracer {
 
   Rgb trace(Ray ray, Rng& rng, long long& events) const {
     Rgb L(0.0), beta(1.0);
+    int volume_events = 0, bounces = 0;  // medium scattering events and surface reflections so far
     for (int depth = 0;; ++depth) {
       Vec3 normal;
       double t_surface;
@@ -172,17 +174,20 @@ struct Tracer {
         if (depth == 0) L += beta * (scene.background + sky);
         return L;
       }
-      // A real scattering event, in the medium or at a surface.
-      if (max_scattering >= 0 && depth + 1 > max_scattering) return L;
+      // A real event: paths with more medium scatterings or surface reflections than allowed end
+      // here; their light is not part of the requested orders.
       if (scattered) {
-        ++events;
+        if (max_scattering >= 0 && volume_events + 1 > max_scattering) return L;
+        ++volume_events, ++events;
         L += beta * volume_nee(x, ray.direction, rng);
-        if (depth + 1 == max_scattering) return L;
+        if (volume_events == max_scattering && bounces == max_bounces) return L;
         ray = {x, medium->phase().sample(ray.direction, rng).wo};
       } else {
+        if (max_bounces >= 0 && bounces + 1 > max_bounces) return L;
+        ++bounces;
         Vec3 p = ray.at(t_surface) + normal * kEpsilon, wo = -ray.direction;
         L += beta * surface_nee(*surface, p, normal, wo, rng);
-        if (depth + 1 == max_scattering) return L;
+        if (volume_events == max_scattering && bounces == max_bounces) return L;
         Vec3 w = sample_cosine(normal, rng);
         beta *= kPi * surface->brdf(w, wo, normal);
         ray = {p, w};
@@ -202,12 +207,13 @@ class ReferenceMethod final : public Method {
     Settings settings(options.settings, "reference");
     const long long spp = settings.integer("spp", 1024, 1, 1LL << 32);
     const int max_scattering = static_cast<int>(settings.integer("max_scattering", -1, -1, 100000));
+    const int max_bounces = static_cast<int>(settings.integer("max_bounces", -1, -1, 100000));
     const auto seed = static_cast<std::uint64_t>(settings.integer("seed", 1, 0, 1LL << 62));
     settings.reject_unknown();
 
     auto start = std::chrono::steady_clock::now();
     std::unique_ptr<Medium> medium = scene.medium ? make_medium(*scene.medium) : nullptr;
-    Tracer tracer{scene, medium.get(), std::nullopt, 0.0, Rgb(0.0), max_scattering, false, Aabb{}, Rgb(0.0)};
+    Tracer tracer{scene, medium.get(), std::nullopt, 0.0, Rgb(0.0), max_scattering, max_bounces, false, Aabb{}, Rgb(0.0)};
     if (medium) {
       tracer.majorants.emplace(*medium);
       tracer.sigma_max = max3(medium->sigma_t_scale());
@@ -264,6 +270,7 @@ class ReferenceMethod final : public Method {
     result.stats = {{"spp", spp},
                     {"seed", seed},
                     {"max_scattering", max_scattering},
+                    {"max_bounces", max_bounces},
                     {"samples", spp * pixels},
                     {"scattering_events", total_events},
                     {"events_per_second", static_cast<double>(total_events) / seconds},
