@@ -93,12 +93,50 @@ struct Tracer {
   }
 
   // Light scattered at x toward -d, per unit sigma_s: sum over lights p E T, plus the sky.
+  // Point and spot lights: their single-scattered light along a whole ray is estimated by
+  // equiangular sampling (Kulla and Fajardo 2012) instead of at delta-tracking vertices, where the
+  // 1/d^2 peak near a light would make the estimate heavy-tailed.
+  static bool is_local(const Light& light) {
+    return std::holds_alternative<PointLight>(light) || std::holds_alternative<SpotLight>(light);
+  }
+
+  // sum over point and spot lights of integral_{0}^{t_end} T(o, x) sigma_s(x) p E(x) T(x, light) dx,
+  // one equiangular sample per light: x = tc + h tan(theta), theta uniform, pdf h / (dtheta r^2).
+  Rgb equiangular_direct(const Ray& ray, double t_end, Rng& rng) const {
+    double t0 = 0.0, t1 = t_end;
+    if (!medium || !bounds.clip(ray, t0, t1) || !(t1 > t0)) return Rgb(0.0);
+    const PhaseFunction& phase = medium->phase();
+    Rgb sum(0.0);
+    LightArrival a;
+    for (const auto& light : scene.lights) {
+      if (!is_local(light)) continue;
+      const Vec3& position = std::holds_alternative<PointLight>(light) ? std::get<PointLight>(light).position
+                                                                       : std::get<SpotLight>(light).position;
+      double tc = glm::dot(position - ray.origin, ray.direction);
+      double h = std::max(glm::length(position - ray.at(tc)), 1e-12);
+      double theta_a = std::atan((t0 - tc) / h);
+      double theta_b = std::isfinite(t1) ? std::atan((t1 - tc) / h) : 0.5 * kPi;
+      double theta = theta_a + rng.uniform() * (theta_b - theta_a);
+      double x = tc + h * std::tan(theta);
+      if (!(x > t0 && x < t1)) continue;
+      double pdf = h / ((theta_b - theta_a) * (h * h + (x - tc) * (x - tc)));
+      Vec3 p = ray.at(x);
+      Rgb sigma_s = medium->sigma_s(p);
+      if (sigma_s == Rgb(0.0) || !arrival(light, p, a) || a.irradiance == Rgb(0.0)) continue;
+      Rgb view = transmittance(ray.origin, ray.direction, x, rng);
+      sum += view * sigma_s * phase.eval(a.to_light, ray.direction) * a.irradiance *
+             transmittance(p, a.to_light, a.distance, rng) / pdf;
+    }
+    return sum;
+  }
+
+  // Directional lights and the sky at a delta-tracking vertex (point and spot lights: above).
   Rgb volume_nee(const Vec3& x, const Vec3& d, Rng& rng) const {
     const PhaseFunction& phase = medium->phase();
     Rgb sum(0.0);
     LightArrival a;
     for (const auto& light : scene.lights) {
-      if (!arrival(light, x, a) || a.irradiance == Rgb(0.0)) continue;
+      if (is_local(light) || !arrival(light, x, a) || a.irradiance == Rgb(0.0)) continue;
       sum += phase.eval(a.to_light, d) * a.irradiance * transmittance(x, a.to_light, a.distance, rng);
     }
     if (sky != Rgb(0.0)) {
@@ -140,6 +178,7 @@ struct Tracer {
       // mean(beta) unchanged. For a grey medium this is plain delta tracking with weight 1.
       bool scattered = false;
       Vec3 x(0.0);
+      if (max_scattering < 0 || volume_events < max_scattering) L += beta * equiangular_direct(ray, t_surface, rng);
       if (medium) {
         auto walk = majorants->walk(ray, 0.0, t_surface);
         MajorantSegment seg;
