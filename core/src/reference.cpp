@@ -43,6 +43,7 @@ struct Tracer {
   Rgb sky{0.0};
   int max_scattering = -1;  // medium scattering events per path; -1 unlimited
   int max_bounces = -1;     // surface reflections per path; -1 unlimited
+  bool local_lights = false;  // any point or spot light (equiangular sampling has work to do)
   // Homogeneous media skip the majorant walk and density lookups: sigma_t is constant in bounds.
   bool homogeneous = false;
   Aabb bounds;
@@ -178,7 +179,8 @@ struct Tracer {
       // mean(beta) unchanged. For a grey medium this is plain delta tracking with weight 1.
       bool scattered = false;
       Vec3 x(0.0);
-      if (max_scattering < 0 || volume_events < max_scattering) L += beta * equiangular_direct(ray, t_surface, rng);
+      if (local_lights && (max_scattering < 0 || volume_events < max_scattering))
+        L += beta * equiangular_direct(ray, t_surface, rng);
       if (medium) {
         auto walk = majorants->walk(ray, 0.0, t_surface);
         MajorantSegment seg;
@@ -252,7 +254,7 @@ class ReferenceMethod final : public Method {
 
     auto start = std::chrono::steady_clock::now();
     std::unique_ptr<Medium> medium = scene.medium ? make_medium(*scene.medium) : nullptr;
-    Tracer tracer{scene, medium.get(), std::nullopt, 0.0, Rgb(0.0), max_scattering, max_bounces, false, Aabb{}, Rgb(0.0)};
+    Tracer tracer{scene, medium.get(), std::nullopt, 0.0, Rgb(0.0), max_scattering, max_bounces, false, false, Aabb{}, Rgb(0.0)};
     if (medium) {
       tracer.majorants.emplace(*medium);
       tracer.sigma_max = max3(medium->sigma_t_scale());
@@ -260,8 +262,10 @@ class ReferenceMethod final : public Method {
       tracer.bounds = medium->bounds();
       if (tracer.homogeneous) tracer.sigma_t_homogeneous = medium->sigma_t_scale() * medium->max_density(tracer.bounds);
     }
-    for (const auto& light : scene.lights)
+    for (const auto& light : scene.lights) {
       if (auto* s = std::get_if<SkyLight>(&light)) tracer.sky += s->radiance;
+      tracer.local_lights |= Tracer::is_local(light);
+    }
 
     const Camera& camera = scene.camera;
     const long long pixels = static_cast<long long>(camera.width_px) * camera.height_px;
