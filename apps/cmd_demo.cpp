@@ -41,6 +41,7 @@ int run(const DemoArgs& a) {
       std::string stem = path.stem().string();
       RenderOptions options;
       options.threads = a.threads;
+      options.cache_dir = default_cache_dir();
       ProgressBar bar(stem + " " + method.name);
       options.progress = bar.callback();
       try {

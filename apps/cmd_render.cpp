@@ -39,7 +39,7 @@ namespace {
 struct RenderArgs {
   std::string scene, method, out;
   int threads = 0;
-  bool json = false, no_png = false;
+  bool json = false, no_png = false, no_cache = false;
   std::vector<std::string> set;
   // Shortcuts for the reference path tracer's settings; unset unless given.
   std::optional<long long> spp, max_scattering, max_bounces, seed;
@@ -65,6 +65,7 @@ int run(const RenderArgs& a) {
   RenderOptions options;
   options.threads = a.threads;
   options.settings = parse_settings(a.set);
+  if (!a.no_cache) options.cache_dir = default_cache_dir();
   if (a.spp) options.settings["spp"] = *a.spp;
   if (a.max_scattering) options.settings["max_scattering"] = *a.max_scattering;
   if (a.max_bounces) options.settings["max_bounces"] = *a.max_bounces;
@@ -103,6 +104,7 @@ Command add_render(CLI::App& app) {
   sub->add_option("--seed", a->seed, "Random seed (reference); the same seed gives the same image on any thread count");
   sub->add_flag("--json", a->json, "Print a JSON summary");
   sub->add_flag("--no-png", a->no_png, "Do not write the PNG preview");
+  sub->add_flag("--no-cache", a->no_cache, "Rebuild precomputed tables instead of reading them from the cache");
   return {sub, [a] { return run(*a); }};
 }
 

@@ -22,6 +22,7 @@ Command add_phase(CLI::App& app);
 Command add_render(CLI::App& app);
 Command add_demo(CLI::App& app);
 Command add_compare(CLI::App& app);
+Command add_tables(CLI::App& app);
 
 // Writes the result's EXR (with its standard-error layer, if any) and a PNG preview beside it;
 // returns the JSON summary `haze render --json` prints.

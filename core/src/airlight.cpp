@@ -1,9 +1,14 @@
 #include <haze/core/airlight.h>
 #include <haze/core/error.h>
 #include <haze/core/integrate.h>
+#include <haze/core/image.h>
 #include <haze/core/light.h>
 
 #include <algorithm>
+#include <cstdio>
+#include <map>
+#include <optional>
+#include <thread>
 
 namespace haze {
 
@@ -159,6 +164,63 @@ AirlightTable::AirlightTable(const PhaseFunction& phase, int a_samples, int eta_
   tracker.throw_if_cancelled();
 }
 
+namespace {
+
+std::filesystem::path table_file(const std::filesystem::path& dir, const std::string& prefix, const std::string& key) {
+  std::uint64_t h = 1469598103934665603ULL;  // FNV-1a
+  for (unsigned char c : key) h = (h ^ c) * 1099511628211ULL;
+  char name[64];
+  std::snprintf(name, sizeof name, "%s-%016llx.exr", prefix.c_str(), static_cast<unsigned long long>(h));
+  return dir / name;
+}
+
+// The cached values when the file is there and was written for exactly this key.
+std::optional<std::vector<float>> load_table(const std::filesystem::path& file, const std::string& key, int width, int height) {
+  std::error_code ec;
+  if (!std::filesystem::exists(file, ec)) return std::nullopt;
+  try {
+    int w = 0, h = 0;
+    std::map<std::string, std::string> attributes;
+    auto values = read_exr_table(file, w, h, attributes);
+    if (w == width && h == height && attributes["key"] == key) return values;
+  } catch (const Error&) {
+  }
+  return std::nullopt;
+}
+
+void store_table(const std::filesystem::path& file, const std::string& key, int width, int height, const std::vector<float>& values) {
+  try {
+    std::filesystem::create_directories(file.parent_path());
+    // Write aside, then rename: a concurrent reader never sees half a file.
+    auto partial = file;
+    partial += ".partial" + std::to_string(std::hash<std::thread::id>{}(std::this_thread::get_id()));
+    write_exr_table(partial, width, height, values, {{"key", key}});
+    std::filesystem::rename(partial, file);
+  } catch (const std::exception&) {
+    // A cache that cannot be written costs a rebuild next time, nothing more.
+  }
+}
+
+}  // namespace
+
+std::string AirlightTable::key() const {
+  return "airlight-tail v1; " + phase_.key() + "; " + std::to_string(na_) + "x" + std::to_string(neta_);
+}
+
+AirlightTable AirlightTable::cached(const PhaseFunction& phase, const std::filesystem::path& dir, int a_samples, int eta_samples,
+                                    int threads, bool* from_cache) {
+  AirlightTable probe(phase, a_samples, eta_samples, std::vector<float>());
+  auto file = table_file(dir, "airlight", probe.key());
+  if (auto values = load_table(file, probe.key(), a_samples, eta_samples)) {
+    if (from_cache) *from_cache = true;
+    return AirlightTable(phase, a_samples, eta_samples, std::move(*values));
+  }
+  AirlightTable built(phase, a_samples, eta_samples, threads);
+  store_table(file, built.key(), a_samples, eta_samples, built.t_);
+  if (from_cache) *from_cache = false;
+  return built;
+}
+
 double AirlightTable::tail(double u, double eta0) const {
   double w0 = std::exp(std::min(eta0, 700.0));
   double a = u * (1.0 + w0);
@@ -249,6 +311,22 @@ SurfaceAirlightTable::SurfaceAirlightTable(const AirlightTable& airlight, double
       }
     }
   });
+}
+
+SurfaceAirlightTable SurfaceAirlightTable::cached(const AirlightTable& airlight, double exponent, const std::filesystem::path& dir,
+                                                 int t_samples, int angle_samples, int threads, bool* from_cache) {
+  char suffix[96];
+  std::snprintf(suffix, sizeof suffix, "; surface v1 n=%.17g %dx%d", exponent, t_samples, angle_samples);
+  std::string key = airlight.key() + suffix;
+  auto file = table_file(dir, exponent == 0.0 ? "surface-lambert" : "surface-phong", key);
+  if (auto values = load_table(file, key, t_samples, angle_samples)) {
+    if (from_cache) *from_cache = true;
+    return SurfaceAirlightTable(exponent, t_samples, angle_samples, std::move(*values));
+  }
+  SurfaceAirlightTable built(airlight, exponent, t_samples, angle_samples, threads);
+  store_table(file, key, t_samples, angle_samples, built.j_);
+  if (from_cache) *from_cache = false;
+  return built;
 }
 
 double SurfaceAirlightTable::eval(double optical_depth, double angle) const {

@@ -53,16 +53,29 @@ class AnalyticMethod final : public Method {
     auto medium = make_medium(desc);
     const Rgb sigma_t = desc.sigma_t * constant->value;
     const Rgb sigma_s = desc.albedo * sigma_t;
-    AirlightTable table(desc.phase, a_samples, eta_samples, options.threads);
+    // Tables come from options.cache_dir when it is set and holds them (haze::AirlightTable::cached).
+    const bool use_cache = !options.cache_dir.empty();
+    bool all_cached = use_cache, hit = false;
+    auto airlight_table = [&] {
+      if (!use_cache) return AirlightTable(desc.phase, a_samples, eta_samples, options.threads);
+      auto t = AirlightTable::cached(desc.phase, options.cache_dir, a_samples, eta_samples, options.threads, &hit);
+      all_cached &= hit;
+      return t;
+    };
+    const AirlightTable table = airlight_table();
+    auto surface_table = [&](double exponent) {
+      if (!use_cache) return SurfaceAirlightTable(table, exponent, 64, 64, options.threads);
+      auto t = SurfaceAirlightTable::cached(table, exponent, options.cache_dir, 64, 64, options.threads, &hit);
+      all_cached &= hit;
+      return t;
+    };
     // J1 for diffuse surfaces and one J_n per Phong exponent in the scene.
     std::optional<SurfaceAirlightTable> lambert;
     std::map<double, SurfaceAirlightTable> phong;
     if (surface_airlight) {
       for (const auto& s : scene.surfaces) {
-        if (s.kd != Rgb(0.0) && !lambert) lambert.emplace(table, 0.0, 64, 64, options.threads);
-        if (s.ks != Rgb(0.0) && !phong.count(s.shininess))
-          phong.emplace(std::piecewise_construct, std::forward_as_tuple(s.shininess),
-                        std::forward_as_tuple(table, s.shininess, 64, 64, options.threads));
+        if (s.kd != Rgb(0.0) && !lambert) lambert.emplace(surface_table(0.0));
+        if (s.ks != Rgb(0.0) && !phong.count(s.shininess)) phong.emplace(s.shininess, surface_table(s.shininess));
       }
     }
     double table_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -142,6 +155,7 @@ class AnalyticMethod final : public Method {
     });
     progress.throw_if_cancelled();
     result.stats = {{"table_seconds", table_seconds},
+                    {"tables_from_cache", all_cached},
                     {"table", {a_samples, eta_samples}},
                     {"seconds", std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()}};
     return result;

@@ -6,6 +6,7 @@
 #include <ImfHeader.h>
 #include <ImfInputFile.h>
 #include <ImfOutputFile.h>
+#include <ImfStringAttribute.h>
 #include <png.h>
 
 #include <cstdio>
@@ -86,6 +87,53 @@ Image read_exr(const std::filesystem::path& path, std::optional<Image>* std_erro
     throw;
   } catch (const std::exception& e) {
     throw Error("exr input " + path.string(), e.what(), "a readable OpenEXR file");
+  }
+}
+
+void write_exr_table(const std::filesystem::path& path, int width, int height, const std::vector<float>& values,
+                     const std::map<std::string, std::string>& attributes) {
+  if (width <= 0 || height <= 0 || values.size() != static_cast<size_t>(width) * static_cast<size_t>(height))
+    throw Error("table size", to_text(values.size()) + " values", to_text(width) + " x " + to_text(height));
+  try {
+    Imf::Header header(width, height);
+    header.channels().insert("T", Imf::Channel(Imf::FLOAT));
+    for (const auto& [key, value] : attributes) header.insert("haze." + key, Imf::StringAttribute(value));
+    Imf::FrameBuffer fb;
+    fb.insert("T", Imf::Slice(Imf::FLOAT, const_cast<char*>(reinterpret_cast<const char*>(values.data())), sizeof(float),
+                              sizeof(float) * static_cast<size_t>(width)));
+    Imf::OutputFile file(path.string().c_str(), header);
+    file.setFrameBuffer(fb);
+    file.writePixels(height);
+  } catch (const std::exception& e) {
+    throw Error("exr output " + path.string(), e.what(), "a writable file");
+  }
+}
+
+std::vector<float> read_exr_table(const std::filesystem::path& path, int& width, int& height,
+                                  std::map<std::string, std::string>& attributes) {
+  try {
+    Imf::InputFile file(path.string().c_str());
+    auto window = file.header().dataWindow();
+    width = window.max.x - window.min.x + 1, height = window.max.y - window.min.y + 1;
+    if (!file.header().channels().findChannel("T")) throw Error("exr table " + path.string(), "no channel T", "a Haze table");
+    attributes.clear();
+    for (auto it = file.header().begin(); it != file.header().end(); ++it) {
+      std::string name = it.name();
+      if (name.rfind("haze.", 0) != 0) continue;
+      if (auto* a = dynamic_cast<const Imf::StringAttribute*>(&it.attribute())) attributes[name.substr(5)] = a->value();
+    }
+    std::vector<float> values(static_cast<size_t>(width) * static_cast<size_t>(height));
+    Imf::FrameBuffer fb;
+    char* base = reinterpret_cast<char*>(values.data()) -
+                 (static_cast<ptrdiff_t>(window.min.y) * width + window.min.x) * static_cast<ptrdiff_t>(sizeof(float));
+    fb.insert("T", Imf::Slice(Imf::FLOAT, base, sizeof(float), sizeof(float) * static_cast<size_t>(width)));
+    file.setFrameBuffer(fb);
+    file.readPixels(window.min.y, window.max.y);
+    return values;
+  } catch (const Error&) {
+    throw;
+  } catch (const std::exception& e) {
+    throw Error("exr table " + path.string(), e.what(), "a readable OpenEXR table");
   }
 }
 

@@ -4,6 +4,7 @@
 #include <haze/core/method.h>
 
 #include <algorithm>
+#include <cstdlib>
 #include <map>
 #include <mutex>
 
@@ -59,6 +60,13 @@ std::unique_ptr<Method> create_method(const std::string& name) {
     throw Error("method.name", "\"" + name + "\"", "one of the available methods: " + names);
   }
   return it->second.create();
+}
+
+std::filesystem::path default_cache_dir() {
+  if (const char* dir = std::getenv("HAZE_CACHE_DIR"); dir && *dir) return dir;
+  if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg && *xdg) return std::filesystem::path(xdg) / "haze";
+  if (const char* home = std::getenv("HOME"); home && *home) return std::filesystem::path(home) / ".cache" / "haze";
+  return std::filesystem::temp_directory_path() / "haze";
 }
 
 RenderResult render(const Scene& scene, const std::string& method_name, RenderOptions options) {

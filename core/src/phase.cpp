@@ -2,6 +2,8 @@
 #include <haze/core/phase.h>
 
 #include <algorithm>
+#include <cstdio>
+#include <cstring>
 
 namespace haze {
 
@@ -92,6 +94,29 @@ PhaseType PhaseFunction::type() const { return static_cast<PhaseType>(model_.ind
 std::string PhaseFunction::name() const {
   static const char* names[] = {"isotropic", "rayleigh", "hg", "cornette_shanks", "double_hg", "tabulated"};
   return names[model_.index()];
+}
+
+std::string PhaseFunction::key() const {
+  char buf[160];
+  std::visit(Overloaded{[&](const HenyeyGreenstein& m) { std::snprintf(buf, sizeof buf, "hg g=%.17g", m.g); },
+                        [&](const CornetteShanks& m) { std::snprintf(buf, sizeof buf, "cornette_shanks g=%.17g", m.g); },
+                        [&](const DoubleHg& m) {
+                          std::snprintf(buf, sizeof buf, "double_hg g1=%.17g g2=%.17g w=%.17g", m.g1, m.g2, m.w);
+                        },
+                        [&](const Tabulated& t) {
+                          // FNV-1a over the normalized values' bits.
+                          std::uint64_t h = 1469598103934665603ULL;
+                          for (double v : t.values) {
+                            std::uint64_t bits;
+                            std::memcpy(&bits, &v, sizeof bits);
+                            for (int k = 0; k < 8; ++k) h = (h ^ ((bits >> (8 * k)) & 0xffu)) * 1099511628211ULL;
+                          }
+                          std::snprintf(buf, sizeof buf, "tabulated n=%zu fnv=%016llx", t.values.size(),
+                                        static_cast<unsigned long long>(h));
+                        },
+                        [&](const auto&) { std::snprintf(buf, sizeof buf, "%s", name().c_str()); }},
+             model_);
+  return buf;
 }
 
 double PhaseFunction::normalization() const {

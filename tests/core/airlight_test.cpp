@@ -8,6 +8,8 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <filesystem>
+#include <unistd.h>
 
 
 namespace haze {
@@ -169,6 +171,36 @@ TEST(Airlight, SurfaceTablesMatchBruteForce) {
                   "(the lobe-cosine approximation alone: %.5f)\n",
                   depth, theta_s, table / exact, phong_table / full, approx / full);
     }
+}
+
+// Tables cached as EXR: the second request reads what the first wrote, bit for bit; a file
+// written for other parameters is not taken for this one.
+TEST(Airlight, TablesRoundTripThroughTheCache) {
+  auto dir = std::filesystem::temp_directory_path() / ("haze_airlight_cache_" + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  PhaseFunction phase = PhaseFunction::henyey_greenstein(0.3);
+  bool hit = true;
+  AirlightTable built = AirlightTable::cached(phase, dir, 32, 64, 0, &hit);
+  EXPECT_FALSE(hit);
+  AirlightTable read = AirlightTable::cached(phase, dir, 32, 64, 0, &hit);
+  EXPECT_TRUE(hit);
+  EXPECT_EQ(read.values(), built.values());
+  EXPECT_EQ(read.key(), built.key());
+  SurfaceAirlightTable j = SurfaceAirlightTable::cached(read, 10.0, dir, 16, 16, 0, &hit);
+  EXPECT_FALSE(hit);
+  EXPECT_EQ(SurfaceAirlightTable::cached(read, 10.0, dir, 16, 16, 0, &hit).values(), j.values());
+  EXPECT_TRUE(hit);
+  // Another g or size is another table.
+  AirlightTable::cached(PhaseFunction::henyey_greenstein(0.30001), dir, 32, 64, 0, &hit);
+  EXPECT_FALSE(hit);
+  AirlightTable::cached(phase, dir, 32, 65, 0, &hit);
+  EXPECT_FALSE(hit);
+  // A damaged file is rebuilt, not an error.
+  for (const auto& entry : std::filesystem::directory_iterator(dir)) std::filesystem::resize_file(entry.path(), 100);
+  AirlightTable rebuilt = AirlightTable::cached(phase, dir, 32, 64, 0, &hit);
+  EXPECT_FALSE(hit);
+  EXPECT_EQ(rebuilt.values(), built.values());
+  std::filesystem::remove_all(dir);
 }
 
 TEST(Integrate, AdaptiveGaussKronrodResolvesPeaksAndEndpoints) {

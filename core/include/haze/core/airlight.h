@@ -12,6 +12,8 @@
 #include <haze/core/phase.h>
 #include <haze/core/progress.h>
 
+#include <filesystem>
+#include <string>
 #include <vector>
 
 namespace haze {
@@ -74,8 +76,17 @@ class AirlightTable {
   // (a short segment) the difference would cancel, so that stretch is integrated directly. A
   // segment through the light is evaluated at h = 1e-9 d_sv: large, finite, never NaN.
   double eval(const AirlightMedium& medium, const AirlightSegment& segment) const;
-  // K(u, eta0) by bilinear lookup.
+  // K(u, eta0) by bicubic lookup.
   double tail(double u, double eta0) const;
+
+  // The table for `phase` read from `dir` when a file for it is there, else built and written there
+  // (a single-channel EXR named by a hash of key()). A cache that cannot be read or written only
+  // costs the rebuild; `from_cache` says which happened.
+  static AirlightTable cached(const PhaseFunction& phase, const std::filesystem::path& dir, int a_samples = 256,
+                              int eta_samples = 512, int threads = 0, bool* from_cache = nullptr);
+  // What the values depend on: format version, phase key, sizes.
+  std::string key() const;
+  const PhaseFunction& phase() const { return phase_; }
 
   int a_samples() const { return na_; }
   int eta_samples() const { return neta_; }
@@ -84,6 +95,8 @@ class AirlightTable {
   static constexpr double kEtaMax = 30.0;
 
  private:
+  AirlightTable(const PhaseFunction& phase, int a_samples, int eta_samples, std::vector<float> values)
+      : phase_(phase), na_(a_samples), neta_(eta_samples), t_(std::move(values)) {}
   PhaseFunction phase_;
   int na_, neta_;
   std::vector<float> t_;
@@ -109,7 +122,14 @@ class SurfaceAirlightTable {
   double eval(double optical_depth, double angle) const;
   double exponent() const { return exponent_; }
 
+  // As AirlightTable::cached; the key adds the exponent and sizes to the airlight table's.
+  static SurfaceAirlightTable cached(const AirlightTable& airlight, double exponent, const std::filesystem::path& dir,
+                                     int t_samples = 64, int angle_samples = 64, int threads = 0, bool* from_cache = nullptr);
+  const std::vector<float>& values() const { return j_; }
+
  private:
+  SurfaceAirlightTable(double exponent, int t_samples, int angle_samples, std::vector<float> values)
+      : exponent_(exponent), nt_(t_samples), na_(angle_samples), j_(std::move(values)) {}
   double exponent_;
   int nt_, na_;
   std::vector<float> j_;  // (1 + T) J, T fastest

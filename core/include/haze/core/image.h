@@ -5,6 +5,8 @@
 #include <haze/core/math.h>
 
 #include <filesystem>
+#include <map>
+#include <string>
 #include <optional>
 #include <vector>
 
@@ -42,6 +44,13 @@ void write_exr(const std::filesystem::path& path, const Image& image, const Imag
 Image read_exr(const std::filesystem::path& path, std::optional<Image>* std_error = nullptr);
 // 8-bit sRGB preview, tone-mapped with exposure then Reinhard x / (1 + x): not data.
 void write_png(const std::filesystem::path& path, const Image& image, double exposure = 1.0);
+
+// One float channel "T" (a precomputed table, x fastest) with string attributes, as an EXR.
+void write_exr_table(const std::filesystem::path& path, int width, int height, const std::vector<float>& values,
+                     const std::map<std::string, std::string>& attributes);
+// Reads a table written by write_exr_table; sizes and attributes come back through the arguments.
+std::vector<float> read_exr_table(const std::filesystem::path& path, int& width, int& height,
+                                  std::map<std::string, std::string>& attributes);
 
 // Root mean square over pixels and channels.
 double rms(const Image& image);

@@ -9,6 +9,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <filesystem>
 #include <functional>
 #include <memory>
 #include <optional>
@@ -21,7 +22,13 @@ struct RenderOptions {
   int threads = 0;  // 0: every core oneTBB offers; otherwise a cap
   nlohmann::json settings = nlohmann::json::object();  // the method's settings ("name" ignored)
   ProgressCallback progress;  // optional; return false to cancel (render throws haze::Cancelled)
+  // Where methods may keep precomputed tables between runs; empty: build them every time. The
+  // `haze` command passes default_cache_dir().
+  std::filesystem::path cache_dir;
 };
+
+// $HAZE_CACHE_DIR, else $XDG_CACHE_HOME/haze, else $HOME/.cache/haze, else the temporary directory.
+std::filesystem::path default_cache_dir();
 
 struct RenderResult {
   Image radiance;

@@ -34,6 +34,9 @@ class PhaseFunction {
 
   PhaseType type() const;
   std::string name() const;  // the scene-file type name: "hg", "rayleigh", ...
+  // The name with every parameter at full precision (a tabulated one by a hash of its values):
+  // equal keys mean equal functions. Used to name cached tables.
+  std::string key() const;
   // Mean cosine <mu> = b_1.
   double mean_cosine() const;
   // Factor applied to make a tabulated function integrate to 1 (1 for the analytic ones).
