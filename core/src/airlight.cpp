@@ -64,7 +64,7 @@ double tail_integral(const PhaseFunction& phase, double u, double eta0) {
   };
   // Past eta0 + 45 (and 45 past 0) the integrand is below e^-45 of its start.
   double end = std::max(eta0, 0.0) + 45.0;
-  return integrate_adaptive(f, eta0, end, 1e-10, 0.0, 1 << 14).value;
+  return integrate_adaptive(f, eta0, end, 1e-5, 0.0, 1 << 14).value;
 }
 
 void catmull_rom_weights(double x, double w[4]) {
@@ -306,7 +306,7 @@ SurfaceAirlightTable::SurfaceAirlightTable(const AirlightTable& airlight, double
           double A = std::sin(gamma) * std::sin(angle), B = std::cos(gamma) * std::cos(angle);
           return airlight.tail(T * std::sin(gamma), std::log(std::tan(0.5 * gamma))) * azimuth_integral(A, B, n);
         };
-        double j = scale * integrate_adaptive(f, 0.0, kPi, 1e-6, 0.0, 2048).value;
+        double j = scale * integrate_adaptive(f, 0.0, kPi, 1e-4, 0.0, 2048).value;
         j_[static_cast<size_t>(k) * static_cast<size_t>(nt_) + static_cast<size_t>(i)] = static_cast<float>((1.0 + T) * j);
       }
     }

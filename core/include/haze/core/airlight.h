@@ -66,7 +66,7 @@ double spot_airlight(const PhaseFunction& phase, const AirlightMedium& medium, c
 // behaviour at small u; m = 1 is the exact limit). Lookups are bicubic (Catmull-Rom). At the
 // default 256 x 512 the worst relative error against quadrature over 10^4 random segments with
 // the extremes (tests/core/airlight_test.cpp) is 5.8e-4 for HG g in [-0.95, 0.95]; a table takes
-// about 0.7 s on 2 threads.
+// about 0.4 s on 2 threads.
 class AirlightTable {
  public:
   AirlightTable(const PhaseFunction& phase, int a_samples = 256, int eta_samples = 512, int threads = 0,
