@@ -164,6 +164,81 @@ AirlightTable::AirlightTable(const PhaseFunction& phase, int a_samples, int eta_
   tracker.throw_if_cancelled();
 }
 
+LegendreAirlightTables::LegendreAirlightTables(int terms, int a_samples, int eta_samples, int threads)
+    : terms_(terms), na_(a_samples), neta_(eta_samples) {
+  if (terms < 1 || terms > 256) throw Error("terms", to_text(terms), "a number of Legendre orders in [1, 256]");
+  if (a_samples < 2 || eta_samples < 2) throw Error("samples", to_text(a_samples) + " x " + to_text(eta_samples), "at least 2 x 2");
+  const size_t cells = static_cast<size_t>(na_) * static_cast<size_t>(neta_);
+  tables_.assign(static_cast<size_t>(terms_), std::vector<float>(cells, 0.0f));
+  parallel_for(neta_, threads, 1, [&](long long j0, long long j1) {
+    std::vector<double> p(static_cast<size_t>(terms_));
+    auto legendre = [&](double x) {  // P_0 .. P_{terms-1} at x
+      p[0] = 1.0;
+      if (terms_ > 1) p[1] = x;
+      for (int k = 2; k < terms_; ++k) p[static_cast<size_t>(k)] = ((2.0 * k - 1.0) * x * p[static_cast<size_t>(k - 1)] - (k - 1.0) * p[static_cast<size_t>(k - 2)]) / k;
+    };
+    for (auto j = static_cast<int>(j0); j < j1; ++j) {
+      double eta0 = -AirlightTable::kEtaMax + 2.0 * AirlightTable::kEtaMax * j / (neta_ - 1);
+      double w0 = std::exp(eta0);
+      for (int i = 0; i < na_; ++i) {
+        double m = static_cast<double>(i) / (na_ - 1);
+        size_t cell = static_cast<size_t>(j) * static_cast<size_t>(na_) + static_cast<size_t>(i);
+        if (i == na_ - 1) {
+          legendre(-std::tanh(eta0));
+          double scale = (1.0 + w0) * (1.0 + w0) / (1.0 + w0 * w0);
+          for (int k = 0; k < terms_; ++k) tables_[static_cast<size_t>(k)][cell] = static_cast<float>(p[static_cast<size_t>(k)] * scale);
+          continue;
+        }
+        double a = m * m / (1.0 - m * m), u = a / (1.0 + w0);
+        auto f = [&](double eta, double* out) {
+          double weight = std::exp(-u * (std::exp(eta) - w0)) / std::cosh(eta);
+          legendre(-std::tanh(eta));
+          for (int k = 0; k < terms_; ++k) out[k] = weight * p[static_cast<size_t>(k)];
+        };
+        auto k_values = integrate_adaptive_vector(f, terms_, eta0, std::max(eta0, 0.0) + 45.0, 1e-6, 1 << 14);
+        for (int k = 0; k < terms_; ++k)
+          tables_[static_cast<size_t>(k)][cell] = static_cast<float>(k_values[static_cast<size_t>(k)] * 0.5 * (1.0 + w0) * (1.0 + a));
+      }
+    }
+  });
+}
+
+int LegendreAirlightTables::terms_for(double g, double tolerance, int max_terms) {
+  if (!(tolerance > 0.0 && tolerance < 1.0)) throw Error("tolerance", to_text(tolerance), "a number in (0, 1)");
+  if (!(std::abs(g) < 1.0)) throw Error("g", to_text(g), "|g| < 1");
+  // The dropped terms are at most sum_{k>=K} (2k+1) |g|^k / (4 pi) anywhere; relative to the
+  // smallest value of p, (1 - g^2) / (4 pi (1 + |g|)^3), that bounds the relative airlight error.
+  const double x = std::abs(g), floor = (1.0 - g * g) / std::pow(1.0 + x, 3.0);
+  for (int k = 1; k <= max_terms; ++k) {
+    double tail = std::pow(x, k) * ((2.0 * k + 1.0) / (1.0 - x) + 2.0 * x / ((1.0 - x) * (1.0 - x)));
+    if (tail <= tolerance * floor) return k;
+  }
+  return max_terms;
+}
+
+double LegendreAirlightTables::truncation_bound(double g, int terms) {
+  const double x = std::abs(g), floor = (1.0 - g * g) / std::pow(1.0 + x, 3.0);
+  return std::pow(x, terms) * ((2.0 * terms + 1.0) / (1.0 - x) + 2.0 * x / ((1.0 - x) * (1.0 - x))) / floor;
+}
+
+AirlightTable LegendreAirlightTables::combine(const std::vector<double>& moments) const {
+  if (moments.empty() || moments.size() > static_cast<size_t>(terms_))
+    throw Error("moments", to_text(moments.size()) + " values", "1 to " + to_text(terms_) + " Legendre moments");
+  std::vector<double> sum(tables_[0].size(), 0.0);
+  for (int k = 0; k < static_cast<int>(moments.size()); ++k) {
+    double c = (2.0 * k + 1.0) * kInv4Pi * moments[static_cast<size_t>(k)];
+    const auto& t = tables_[static_cast<size_t>(k)];
+    for (size_t i = 0; i < sum.size(); ++i) sum[i] += c * static_cast<double>(t[i]);
+  }
+  std::vector<float> values(sum.begin(), sum.end());
+  // The phase kept for direct integration of short segments: the truncated series' source.
+  return AirlightTable(PhaseFunction::henyey_greenstein(moments.size() > 1 ? moments[1] : 0.0), na_, neta_, std::move(values));
+}
+
+AirlightTable LegendreAirlightTables::combine_hg(double g, int terms) const {
+  return combine(PhaseFunction::henyey_greenstein(g).legendre_moments(terms > 0 ? terms : terms_));
+}
+
 namespace {
 
 std::filesystem::path table_file(const std::filesystem::path& dir, const std::string& prefix, const std::string& key) {

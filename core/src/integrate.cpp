@@ -76,4 +76,70 @@ IntegrationResult integrate_adaptive(const std::function<double(double)>& f, dou
   return result;
 }
 
+std::vector<double> integrate_adaptive_vector(const std::function<void(double, double*)>& f, int dims, double a, double b,
+                                              double rel_tol, int max_intervals) {
+  if (!(std::isfinite(a) && std::isfinite(b))) throw Error("integration bounds", to_text(a) + ", " + to_text(b), "finite bounds");
+  if (dims < 1) throw Error("dims", to_text(dims), "at least 1 component");
+  const auto n = static_cast<size_t>(dims);
+  struct Piece {
+    double a, b, error;
+    std::vector<double> value;
+    bool operator<(const Piece& o) const { return error < o.error; }
+  };
+  std::vector<double> fx(n), sum_k(n), sum_g(n);
+  auto rule = [&](double lo, double hi) {
+    double c = 0.5 * (lo + hi), h = 0.5 * (hi - lo);
+    std::fill(sum_k.begin(), sum_k.end(), 0.0);
+    std::fill(sum_g.begin(), sum_g.end(), 0.0);
+    f(c, fx.data());
+    for (size_t d = 0; d < n; ++d) sum_k[d] = kWk[7] * fx[d], sum_g[d] = kWg[3] * fx[d];
+    for (int j = 0; j < 7; ++j) {
+      double x = h * kXk[j];
+      std::vector<double> left(n);
+      f(c - x, left.data());
+      f(c + x, fx.data());
+      for (size_t d = 0; d < n; ++d) {
+        double s = left[d] + fx[d];
+        sum_k[d] += kWk[j] * s;
+        if (j % 2 == 1) sum_g[d] += kWg[j / 2] * s;
+      }
+    }
+    Piece p{lo, hi, 0.0, std::vector<double>(n)};
+    for (size_t d = 0; d < n; ++d) p.value[d] = sum_k[d] * h;
+    for (size_t d = 0; d < n; ++d) p.error = std::max(p.error, std::abs((sum_k[d] - sum_g[d]) * h));
+    return p;
+  };
+  std::priority_queue<Piece> work;
+  work.push(rule(a, b));
+  std::vector<double> total = work.top().value;
+  double error = work.top().error;
+  int intervals = 1;
+  auto magnitude = [&] {
+    double m = 0.0;
+    for (double v : total) m = std::max(m, std::abs(v));
+    return m;
+  };
+  while (error > rel_tol * magnitude() && intervals < max_intervals) {
+    Piece worst = work.top();
+    work.pop();
+    double mid = 0.5 * (worst.a + worst.b);
+    if (!(mid > worst.a && mid < worst.b)) {
+      work.push(worst);
+      break;
+    }
+    Piece left = rule(worst.a, mid), right = rule(mid, worst.b);
+    for (size_t d = 0; d < n; ++d) total[d] += left.value[d] + right.value[d] - worst.value[d];
+    error += left.error + right.error - worst.error;
+    work.push(std::move(left));
+    work.push(std::move(right));
+    ++intervals;
+  }
+  std::fill(total.begin(), total.end(), 0.0);
+  while (!work.empty()) {
+    for (size_t d = 0; d < n; ++d) total[d] += work.top().value[d];
+    work.pop();
+  }
+  return total;
+}
+
 }  // namespace haze

@@ -173,6 +173,28 @@ TEST(Airlight, SurfaceTablesMatchBruteForce) {
     }
 }
 
+// Dynamic g: Legendre tables built once, recombined for each g, against the exact HG airlight.
+// With terms_for's bound the measured error stays below the tolerance plus the table's own error.
+TEST(Airlight, LegendreTablesFollowGWithinTheTruncationBound) {
+  auto start = std::chrono::steady_clock::now();
+  LegendreAirlightTables legendre(32, 128, 512);
+  double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  for (double g : {-0.3, 0.2, 0.5}) {
+    const double tolerance = 1e-2;
+    int terms = LegendreAirlightTables::terms_for(g, tolerance, 32);
+    ASSERT_LT(terms, 32) << g;
+    start = std::chrono::steady_clock::now();
+    AirlightTable table = legendre.combine_hg(g, terms);
+    double combine_ms = 1e3 * std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    SweepStats stats = sweep(PhaseFunction::henyey_greenstein(g), table, 400, 7);
+    std::printf("Legendre (32 orders of 128 x 512, built in %.2f s): g %+.1f, tolerance %.0e -> %d terms (bound %.1e), "
+                "combined in %.1f ms, worst relative error %.2e\n",
+                seconds, g, tolerance, terms, LegendreAirlightTables::truncation_bound(g, terms), combine_ms, stats.worst);
+    EXPECT_LE(LegendreAirlightTables::truncation_bound(g, terms), tolerance);
+    EXPECT_LT(stats.worst, tolerance + 5e-3) << g;
+  }
+}
+
 // Tables cached as EXR: the second request reads what the first wrote, bit for bit; a file
 // written for other parameters is not taken for this one.
 TEST(Airlight, TablesRoundTripThroughTheCache) {

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <functional>
+#include <vector>
 
 namespace haze {
 
@@ -15,5 +16,10 @@ struct IntegrationResult {
 // integral_a^b f(x) dx to max(rel_tol * |value|, abs_tol), at most max_intervals subintervals.
 IntegrationResult integrate_adaptive(const std::function<double(double)>& f, double a, double b, double rel_tol = 1e-10,
                                      double abs_tol = 0.0, int max_intervals = 4096);
+
+// The same for a vector-valued integrand f(x, out) writing `dims` values: every component shares
+// the nodes, and the interval with the largest error in any component is split next.
+std::vector<double> integrate_adaptive_vector(const std::function<void(double, double*)>& f, int dims, double a, double b,
+                                              double rel_tol = 1e-10, int max_intervals = 4096);
 
 }  // namespace haze
