@@ -24,6 +24,7 @@ class AnalyticMethod final : public Method {
     const int a_samples = static_cast<int>(settings.integer("table_a", 256, 16, 4096));
     const int eta_samples = static_cast<int>(settings.integer("table_eta", 512, 16, 4096));
     const bool surface_airlight = settings.integer("surface_airlight", 1, 0, 1) == 1;
+    const bool airlight = settings.integer("airlight", 1, 0, 1) == 1;
     settings.reject_unknown();
 
     if (!scene.medium) throw Error("medium", "missing", "a homogeneous medium for the analytic method");
@@ -98,7 +99,7 @@ class AnalyticMethod final : public Method {
           }
           Rgb radiance(0.0);
           double t0 = 0.0, t1 = t_hit;
-          bool in_medium = bounds.clip(ray, t0, t1) && t1 > t0;
+          bool in_medium = airlight && bounds.clip(ray, t0, t1) && t1 > t0;
           if (in_medium) {
             Vec3 entry = ray.at(t0);
             for (const auto& light : lights)

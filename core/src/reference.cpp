@@ -44,6 +44,7 @@ struct Tracer {
   int max_scattering = -1;  // medium scattering events per path; -1 unlimited
   int max_bounces = -1;     // surface reflections per path; -1 unlimited
   bool local_lights = false;  // any point or spot light (equiangular sampling has work to do)
+  bool view_scattering = true;  // false: the camera ray to the first surface does not scatter
   // Homogeneous media skip the majorant walk and density lookups: sigma_t is constant in bounds.
   bool homogeneous = false;
   Aabb bounds;
@@ -179,9 +180,13 @@ struct Tracer {
       // mean(beta) unchanged. For a grey medium this is plain delta tracking with weight 1.
       bool scattered = false;
       Vec3 x(0.0);
-      if (local_lights && (max_scattering < 0 || volume_events < max_scattering))
+      // view_scattering 0: the camera ray only attenuates, so the image is the surfaces' radiance
+      // seen through the medium (what the analytic model's surface terms compute).
+      const bool may_scatter = view_scattering || depth > 0;
+      if (!may_scatter) beta *= transmittance(ray.origin, ray.direction, t_surface, rng);
+      if (may_scatter && local_lights && (max_scattering < 0 || volume_events < max_scattering))
         L += beta * equiangular_direct(ray, t_surface, rng);
-      if (medium) {
+      if (medium && may_scatter) {
         auto walk = majorants->walk(ray, 0.0, t_surface);
         MajorantSegment seg;
         while (!scattered && walk.next(seg)) {
@@ -249,12 +254,14 @@ class ReferenceMethod final : public Method {
     const long long spp = settings.integer("spp", 1024, 1, 1LL << 32);
     const int max_scattering = static_cast<int>(settings.integer("max_scattering", -1, -1, 100000));
     const int max_bounces = static_cast<int>(settings.integer("max_bounces", -1, -1, 100000));
+    const bool view_scattering = settings.integer("view_scattering", 1, 0, 1) == 1;
     const auto seed = static_cast<std::uint64_t>(settings.integer("seed", 1, 0, 1LL << 62));
     settings.reject_unknown();
 
     auto start = std::chrono::steady_clock::now();
     std::unique_ptr<Medium> medium = scene.medium ? make_medium(*scene.medium) : nullptr;
-    Tracer tracer{scene, medium.get(), std::nullopt, 0.0, Rgb(0.0), max_scattering, max_bounces, false, false, Aabb{}, Rgb(0.0)};
+    Tracer tracer{scene, medium.get(), std::nullopt, 0.0, Rgb(0.0), max_scattering, max_bounces, false, view_scattering,
+                  false, Aabb{}, Rgb(0.0)};
     if (medium) {
       tracer.majorants.emplace(*medium);
       tracer.sigma_max = max3(medium->sigma_t_scale());
