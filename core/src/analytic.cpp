@@ -89,14 +89,9 @@ class AnalyticMethod final : public Method {
       for (auto y = static_cast<int>(y0); y < y1 && !progress.cancelled(); ++y) {
         for (int x = 0; x < camera.width_px; ++x) {
           Ray ray = camera.pixel_ray(x, y);
-          double t_hit = kInfinity;
-          const Surface* hit = nullptr;
+          double t_hit;
           Vec3 normal(0.0);
-          for (const auto& s : scene.surfaces) {
-            double t;
-            Vec3 n;
-            if (s.intersect(ray, 1e-7, t_hit, t, n)) t_hit = t, hit = &s, normal = n;
-          }
+          const Surface* hit = nearest_surface(scene.surfaces, ray, kInfinity, t_hit, normal);
           Rgb radiance(0.0);
           double t0 = 0.0, t1 = t_hit;
           bool in_medium = airlight && bounds.clip(ray, t0, t1) && t1 > t0;

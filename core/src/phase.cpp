@@ -264,7 +264,6 @@ void gauss_legendre(int n, std::vector<double>& nodes, std::vector<double>& weig
         double p2 = ((2.0 * k - 1.0) * x * p1 - (k - 1.0) * p0) / k;
         p0 = p1, p1 = p2;
       }
-      if (n == 1) p1 = x, p0 = 1.0;
       dp = n * (x * p1 - p0) / (x * x - 1.0);
       double dx = p1 / dp;
       x -= dx;

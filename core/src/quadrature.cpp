@@ -30,9 +30,7 @@ struct Context {
   bool occluded(const Vec3& x, const Vec3& dir, double distance) const {
     double t;
     Vec3 n;
-    for (const auto& s : scene.surfaces)
-      if (s.intersect({x, dir}, kEpsilon, distance * (1.0 - 1e-9), t, n)) return true;
-    return false;
+    return nearest_surface(scene.surfaces, {x, dir}, distance * (1.0 - 1e-9), t, n) != nullptr;
   }
 
   Rgb transmittance(const Vec3& x, const Vec3& dir, double distance) const {
@@ -80,14 +78,9 @@ struct Context {
   }
 
   Rgb pixel(const Ray& ray, const std::vector<double>& gl_nodes, const std::vector<double>& gl_weights) const {
-    double t_hit = kInfinity;
-    const Surface* hit = nullptr;
+    double t_hit;
     Vec3 normal(0.0);
-    for (const auto& s : scene.surfaces) {
-      double t;
-      Vec3 n;
-      if (s.intersect(ray, kEpsilon, t_hit, t, n)) t_hit = t, hit = &s, normal = n;
-    }
+    const Surface* hit = nearest_surface(scene.surfaces, ray, kInfinity, t_hit, normal);
     Rgb radiance(0.0), view_t(1.0);
     double t0 = 0.0, t1 = t_hit;
     if (medium && medium->bounds().clip(ray, t0, t1) && t1 > t0) {

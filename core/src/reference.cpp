@@ -50,22 +50,11 @@ struct Tracer {
   Aabb bounds;
   Rgb sigma_t_homogeneous{0.0};
 
-  const Surface* nearest_surface(const Ray& ray, double t_max, double& t, Vec3& normal) const {
-    const Surface* hit = nullptr;
-    t = t_max;
-    for (const auto& s : scene.surfaces) {
-      double ts;
-      Vec3 n;
-      if (s.intersect(ray, kEpsilon, t, ts, n)) t = ts, normal = n, hit = &s;
-    }
-    return hit;
-  }
-
   // Transmittance from x along dir over distance (infinite for directional lights and the sky).
   Rgb transmittance(const Vec3& x, const Vec3& dir, double distance, Rng& rng) const {
     double t;
     Vec3 n;
-    if (nearest_surface({x, dir}, distance * (1.0 - 1e-9), t, n)) return Rgb(0.0);
+    if (nearest_surface(scene.surfaces, {x, dir}, distance * (1.0 - 1e-9), t, n)) return Rgb(0.0);
     if (!medium) return Rgb(1.0);
     if (homogeneous) {
       double t0 = 0.0, t1 = distance;
@@ -172,7 +161,7 @@ struct Tracer {
     for (int depth = 0;; ++depth) {
       Vec3 normal;
       double t_surface;
-      const Surface* surface = nearest_surface(ray, kInfinity, t_surface, normal);
+      const Surface* surface = nearest_surface(scene.surfaces, ray, kInfinity, t_surface, normal);
 
       // Spectral delta tracking (Kutz et al. 2017, history-aware): tentative collisions at rate
       // sigma_bar = density majorant times the largest channel; scatter, null or absorb with

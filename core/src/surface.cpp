@@ -38,4 +38,15 @@ Rgb Surface::brdf(const Vec3& wi, const Vec3& wo, const Vec3& n) const {
   return f;
 }
 
+const Surface* nearest_surface(const std::vector<Surface>& surfaces, const Ray& ray, double t_max, double& t, Vec3& normal) {
+  const Surface* hit = nullptr;
+  t = t_max;
+  for (const auto& s : surfaces) {
+    double ts;
+    Vec3 n;
+    if (s.intersect(ray, 1e-7, t, ts, n)) t = ts, normal = n, hit = &s;
+  }
+  return hit;
+}
+
 }  // namespace haze

@@ -6,6 +6,7 @@
 #include <haze/core/math.h>
 
 #include <variant>
+#include <vector>
 
 namespace haze {
 
@@ -30,5 +31,9 @@ struct Surface {
   // f(wi, wo) per steradian: wi points toward the light, wo toward the viewer, n the unit normal.
   Rgb brdf(const Vec3& wi, const Vec3& wo, const Vec3& n) const;
 };
+
+// The nearest of `surfaces` hit by the ray with t in (1e-7, t_max), or nullptr; writes its t and
+// normal (facing the ray's origin).
+const Surface* nearest_surface(const std::vector<Surface>& surfaces, const Ray& ray, double t_max, double& t, Vec3& normal);
 
 }  // namespace haze
