@@ -1,0 +1,41 @@
+// The analytic airlight over batches of view segments in float32 lanes, Highway runtime dispatch
+// (the fast path of method `analytic`). ISA-free header: per-target code in src/airlight_batch-inl.h.
+//
+// Lanes: float32. Per segment and light: the two tails of the tabulated airlight (airlight.h) with
+// bilinear lookups, float Log/Exp (Highway contrib, <= 4 ulp). Segments where float cannot resolve
+// the geometry (the ray within 1e-3 d_sv of the light) or where the two tails nearly cancel are
+// handed to the float64 path, AirlightTable::eval. Error against that path: see
+// tests/simd/airlight_batch_test.cpp (bilinear lookups cost about 3e-3 relative at 256 x 512).
+#pragma once
+
+#include <haze/core/airlight.h>
+
+#include <cstddef>
+
+namespace haze::simd {
+
+// Segments as structure of arrays: start (viewer or medium entry), unit direction, length (+inf
+// for an unbounded segment).
+struct SegmentBatch {
+  const float* ox;
+  const float* oy;
+  const float* oz;
+  const float* dx;
+  const float* dy;
+  const float* dz;
+  const float* length;
+  size_t count;
+};
+
+// One colour channel of one point light in a homogeneous medium.
+struct AirlightChannel {
+  float x, y, z;     // light position
+  float sigma_t, sigma_s, intensity;
+};
+
+// out[i] += airlight of segment i (best compiled target this CPU supports).
+void add_airlight(const AirlightTable& table, const AirlightChannel& light, const SegmentBatch& batch, float* out);
+// The scalar reference: the same float32 formulas, one segment at a time.
+void add_airlight_reference(const AirlightTable& table, const AirlightChannel& light, const SegmentBatch& batch, float* out);
+
+}  // namespace haze::simd

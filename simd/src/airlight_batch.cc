@@ -1,0 +1,90 @@
+// Dispatch, fallback and scalar reference for the batched airlight (Highway skeleton layout).
+#undef HWY_TARGET_INCLUDE
+#define HWY_TARGET_INCLUDE "airlight_batch.cc"
+#include <hwy/foreach_target.h>  // IWYU pragma: keep
+
+#include "airlight_batch-inl.h"
+
+#include <hwy/highway.h>
+
+#if HWY_ONCE
+#include <haze/simd/airlight_batch.h>
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+namespace haze::simd {
+
+HWY_EXPORT(AirlightBatch);
+
+namespace {
+
+float tail_scalar(const AirlightTable& table, float u, float eta, float w) {
+  const int na = table.a_samples(), ne = table.eta_samples();
+  const float eta_max = static_cast<float>(AirlightTable::kEtaMax);
+  float a = std::min(u * (1.0f + w), 1e30f);
+  float m = std::sqrt(a / (1.0f + a));
+  float fa = m * static_cast<float>(na - 1);
+  float fe = (std::clamp(eta, -eta_max, eta_max) + eta_max) * (static_cast<float>(ne - 1) / (2.0f * eta_max));
+  float fi = std::min(std::floor(fa), static_cast<float>(na - 2)), fj = std::min(std::floor(fe), static_cast<float>(ne - 2));
+  float x = fa - fi, y = fe - fj;
+  const float* t = table.values().data() + static_cast<size_t>(fj * static_cast<float>(na) + fi);
+  float t0 = t[0] + x * (t[1] - t[0]), t1 = t[na] + x * (t[na + 1] - t[na]);
+  return 2.0f * (t0 + y * (t1 - t0)) / ((1.0f + w) * (1.0f + a));
+}
+
+// One segment in float32, the formulas of the SIMD kernel; false where float64 must redo it.
+bool airlight_scalar(const AirlightTable& table, const AirlightChannel& l, const SegmentBatch& b, size_t i, float& value) {
+  float tx = l.x - b.ox[i], ty = l.y - b.oy[i], tz = l.z - b.oz[i];
+  float d2 = tx * tx + ty * ty + tz * tz, d_sv = std::sqrt(d2);
+  float t = tx * b.dx[i] + ty * b.dy[i] + tz * b.dz[i];
+  float floor_h = 1e-6f * d_sv;
+  float h2 = std::max(d2 - t * t, floor_h * floor_h), h = std::sqrt(h2);
+  float u = l.sigma_t * h;
+  float w0 = t <= 0.0f ? (d_sv - t) / h : h / (d_sv + t);
+  float near = std::exp(-l.sigma_t * d_sv) * tail_scalar(table, u, std::log(w0), w0);
+  float far = 0.0f;
+  if (b.length[i] < 3e38f) {
+    float xi = b.length[i] - t, d_sp = std::sqrt(xi * xi + h2);
+    float wd = xi >= 0.0f ? (xi + d_sp) / h : h / (d_sp - xi);
+    far = std::exp(-l.sigma_t * (b.length[i] + d_sp)) * tail_scalar(table, u, std::log(wd), wd);
+  }
+  value = l.sigma_s * l.intensity * (near - far) / h;
+  return !(far >= 0.5f * near || h < 1e-3f * d_sv);
+}
+
+// The float64 path for one segment.
+float airlight_double(const AirlightTable& table, const AirlightChannel& l, const SegmentBatch& b, size_t i) {
+  Vec3 origin(b.ox[i], b.oy[i], b.oz[i]), dir(b.dx[i], b.dy[i], b.dz[i]);
+  double length = b.length[i] < 3e38f ? static_cast<double>(b.length[i]) : kInfinity;
+  AirlightSegment s = AirlightSegment::from_points(origin, glm::normalize(dir), Vec3(l.x, l.y, l.z), length);
+  return static_cast<float>(table.eval({l.sigma_t, l.sigma_s, l.intensity}, s));
+}
+
+}  // namespace
+
+void add_airlight_reference(const AirlightTable& table, const AirlightChannel& light, const SegmentBatch& batch, float* out) {
+  for (size_t i = 0; i < batch.count; ++i) {
+    float value;
+    out[i] += airlight_scalar(table, light, batch, i, value) ? value : airlight_double(table, light, batch, i);
+  }
+}
+
+void add_airlight(const AirlightTable& table, const AirlightChannel& light, const SegmentBatch& batch, float* out) {
+  std::vector<float> result(batch.count), fallback(batch.count);
+  const float params[6] = {light.x, light.y, light.z, light.sigma_t, light.sigma_s, light.intensity};
+  size_t done = HWY_DYNAMIC_DISPATCH(AirlightBatch)(table.values().data(), table.a_samples(), table.eta_samples(),
+                                                    static_cast<float>(AirlightTable::kEtaMax), params, batch.ox, batch.oy,
+                                                    batch.oz, batch.dx, batch.dy, batch.dz, batch.length, batch.count,
+                                                    result.data(), fallback.data());
+  for (size_t i = 0; i < done; ++i) out[i] += fallback[i] != 0.0f ? airlight_double(table, light, batch, i) : result[i];
+  // The last partial vector through the scalar reference (same formulas).
+  for (size_t i = done; i < batch.count; ++i) {
+    float value;
+    out[i] += airlight_scalar(table, light, batch, i, value) ? value : airlight_double(table, light, batch, i);
+  }
+}
+
+}  // namespace haze::simd
+#endif  // HWY_ONCE
