@@ -2,10 +2,12 @@
 
 #include <haze/grids/methods.h>
 #include <haze/particles/methods.h>
+#include <haze/simd/airlight_batch.h>
 
 namespace haze::app {
 
 void register_all_methods() {
+  simd::install();
   grids::register_methods();
   particles::register_methods();
 }

@@ -5,6 +5,7 @@
 #include <haze/core/light.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cstdio>
 #include <map>
 #include <optional>
@@ -163,6 +164,26 @@ AirlightTable::AirlightTable(const PhaseFunction& phase, int a_samples, int eta_
   });
   tracker.throw_if_cancelled();
 }
+
+void add_airlight_float64(const AirlightTable& table, const AirlightChannel& light, const SegmentBatch& batch, float* out) {
+  const AirlightMedium medium{light.sigma_t, light.sigma_s, light.intensity};
+  for (size_t i = 0; i < batch.count; ++i) {
+    Vec3 origin(batch.ox[i], batch.oy[i], batch.oz[i]), dir(batch.dx[i], batch.dy[i], batch.dz[i]);
+    double length = std::isfinite(batch.length[i]) ? static_cast<double>(batch.length[i]) : kInfinity;
+    out[i] += static_cast<float>(
+        table.eval(medium, AirlightSegment::from_points(origin, glm::normalize(dir), Vec3(light.x, light.y, light.z), length)));
+  }
+}
+
+namespace {
+std::atomic<AirlightBatchFunction> batch_function{add_airlight_float64};
+}  // namespace
+
+void set_airlight_batch_function(AirlightBatchFunction function) {
+  batch_function.store(function ? function : add_airlight_float64);
+}
+
+AirlightBatchFunction airlight_batch_function() { return batch_function.load(); }
 
 LegendreAirlightTables::LegendreAirlightTables(int terms, int a_samples, int eta_samples, int threads)
     : terms_(terms), na_(a_samples), neta_(eta_samples) {

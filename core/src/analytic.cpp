@@ -9,6 +9,7 @@
 #include <haze/core/airlight.h>
 #include <haze/core/error.h>
 
+#include <array>
 #include <chrono>
 #include <map>
 #include <optional>
@@ -85,29 +86,61 @@ class AnalyticMethod final : public Method {
     const Aabb bounds = medium->bounds();
     RenderResult result{Image(camera.width_px, camera.height_px), std::nullopt, {}};
     ProgressTracker progress(options.progress, camera.height_px);
+    const AirlightBatchFunction add_airlight = airlight_batch_function();
     parallel_for(camera.height_px, options.threads, 1, [&](long long y0, long long y1) {
+      // Per row: the view segments inside the medium as float arrays, then each point light's
+      // airlight over the whole row in one batch (SIMD when haze::simd::install() has run).
+      std::vector<float> ox, oy, oz, dx, dy, dz, seg;
+      std::vector<int> slot(static_cast<size_t>(camera.width_px));
+      std::array<std::vector<float>, 3> batch_airlight;
       for (auto y = static_cast<int>(y0); y < y1 && !progress.cancelled(); ++y) {
+        for (auto* v : {&ox, &oy, &oz, &dx, &dy, &dz, &seg}) v->clear();
+        for (int x = 0; x < camera.width_px; ++x) {
+          Ray ray = camera.pixel_ray(x, y);
+          double t_hit;
+          Vec3 normal(0.0);
+          nearest_surface(scene.surfaces, ray, kInfinity, t_hit, normal);
+          double t0 = 0.0, t1 = t_hit;
+          slot[static_cast<size_t>(x)] = -1;
+          if (!(airlight && bounds.clip(ray, t0, t1) && t1 > t0)) continue;
+          slot[static_cast<size_t>(x)] = static_cast<int>(ox.size());
+          Vec3 entry = ray.at(t0);
+          ox.push_back(static_cast<float>(entry.x)), oy.push_back(static_cast<float>(entry.y)), oz.push_back(static_cast<float>(entry.z));
+          dx.push_back(static_cast<float>(ray.direction.x)), dy.push_back(static_cast<float>(ray.direction.y));
+          dz.push_back(static_cast<float>(ray.direction.z));
+          seg.push_back(std::isfinite(t1) ? static_cast<float>(t1 - t0) : INFINITY);
+        }
+        const SegmentBatch batch{ox.data(), oy.data(), oz.data(), dx.data(), dy.data(), dz.data(), seg.data(), ox.size()};
+        for (int c = 0; c < 3; ++c) {
+          batch_airlight[static_cast<size_t>(c)].assign(ox.size(), 0.0f);
+          for (const auto& light : lights) {
+            if (light.spot || sigma_s[c] == 0.0 || light.intensity[c] == 0.0) continue;
+            add_airlight(table,
+                         {static_cast<float>(light.position.x), static_cast<float>(light.position.y), static_cast<float>(light.position.z),
+                          static_cast<float>(sigma_t[c]), static_cast<float>(sigma_s[c]), static_cast<float>(light.intensity[c])},
+                         batch, batch_airlight[static_cast<size_t>(c)].data());
+          }
+        }
         for (int x = 0; x < camera.width_px; ++x) {
           Ray ray = camera.pixel_ray(x, y);
           double t_hit;
           Vec3 normal(0.0);
           const Surface* hit = nearest_surface(scene.surfaces, ray, kInfinity, t_hit, normal);
           Rgb radiance(0.0);
-          double t0 = 0.0, t1 = t_hit;
-          bool in_medium = airlight && bounds.clip(ray, t0, t1) && t1 > t0;
-          if (in_medium) {
+          if (int k = slot[static_cast<size_t>(x)]; k >= 0) {
+            for (int c = 0; c < 3; ++c) radiance[c] = static_cast<double>(batch_airlight[static_cast<size_t>(c)][static_cast<size_t>(k)]);
+            double t0 = 0.0, t1 = t_hit;
+            bounds.clip(ray, t0, t1);
             Vec3 entry = ray.at(t0);
-            for (const auto& light : lights)
+            for (const auto& light : lights) {
+              if (!light.spot) continue;
               for (int c = 0; c < 3; ++c) {
                 if (sigma_s[c] == 0.0 || light.intensity[c] == 0.0) continue;
-                AirlightMedium m{sigma_t[c], sigma_s[c], light.intensity[c]};
-                if (light.spot) {
-                  radiance[c] += spot_airlight(desc.phase, m, entry, ray.direction, t1 - t0, light.position,
-                                               light.spot->direction, light.spot->exponent, light.spot->cone_deg);
-                } else {
-                  radiance[c] += table.eval(m, AirlightSegment::from_points(entry, ray.direction, light.position, t1 - t0));
-                }
+                radiance[c] += spot_airlight(desc.phase, {sigma_t[c], sigma_s[c], light.intensity[c]}, entry, ray.direction,
+                                             t1 - t0, light.position, light.spot->direction, light.spot->exponent,
+                                             light.spot->cone_deg);
               }
+            }
           }
           Rgb view_t = medium->transmittance_along(ray.origin, ray.direction, t_hit);
           if (hit) {
@@ -151,6 +184,7 @@ class AnalyticMethod final : public Method {
     });
     progress.throw_if_cancelled();
     result.stats = {{"table_seconds", table_seconds},
+                    {"airlight_path", add_airlight == &add_airlight_float64 ? "float64" : "simd"},
                     {"tables_from_cache", all_cached},
                     {"table", {a_samples, eta_samples}},
                     {"seconds", std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()}};

@@ -56,10 +56,9 @@ bool airlight_scalar(const AirlightTable& table, const AirlightChannel& l, const
 
 // The float64 path for one segment.
 float airlight_double(const AirlightTable& table, const AirlightChannel& l, const SegmentBatch& b, size_t i) {
-  Vec3 origin(b.ox[i], b.oy[i], b.oz[i]), dir(b.dx[i], b.dy[i], b.dz[i]);
-  double length = b.length[i] < 3e38f ? static_cast<double>(b.length[i]) : kInfinity;
-  AirlightSegment s = AirlightSegment::from_points(origin, glm::normalize(dir), Vec3(l.x, l.y, l.z), length);
-  return static_cast<float>(table.eval({l.sigma_t, l.sigma_s, l.intensity}, s));
+  float value = 0.0f;
+  add_airlight_float64(table, l, {b.ox + i, b.oy + i, b.oz + i, b.dx + i, b.dy + i, b.dz + i, b.length + i, 1}, &value);
+  return value;
 }
 
 }  // namespace
@@ -85,6 +84,8 @@ void add_airlight(const AirlightTable& table, const AirlightChannel& light, cons
     out[i] += airlight_scalar(table, light, batch, i, value) ? value : airlight_double(table, light, batch, i);
   }
 }
+
+void install() { set_airlight_batch_function(&add_airlight); }
 
 }  // namespace haze::simd
 #endif  // HWY_ONCE

@@ -129,6 +129,33 @@ class LegendreAirlightTables {
   std::vector<std::vector<float>> tables_;  // per order: K_k (1 + w0) (1 + a) / 2, a fastest
 };
 
+// Batches of view segments for fast airlight evaluation (structure of arrays, float32): start
+// (viewer or medium entry), unit direction, length (+inf when unbounded).
+struct SegmentBatch {
+  const float* ox;
+  const float* oy;
+  const float* oz;
+  const float* dx;
+  const float* dy;
+  const float* dz;
+  const float* length;
+  size_t count;
+};
+
+// One colour channel of one point light in a homogeneous medium.
+struct AirlightChannel {
+  float x, y, z;  // light position
+  float sigma_t, sigma_s, intensity;
+};
+
+// out[i] += airlight of segment i. Core's own is the float64 loop over AirlightTable::eval;
+// haze::simd::install() replaces it with the Highway kernel (core does not depend on simd).
+using AirlightBatchFunction = void (*)(const AirlightTable& table, const AirlightChannel& light, const SegmentBatch& batch,
+                                       float* out);
+void add_airlight_float64(const AirlightTable& table, const AirlightChannel& light, const SegmentBatch& batch, float* out);
+void set_airlight_batch_function(AirlightBatchFunction function);
+AirlightBatchFunction airlight_batch_function();
+
 // Airlight scattered onto a surface (seed 002 eq. 4.11-4.15) in Haze's energy-normalized BRDFs:
 //   L_pa = sigma_s I e^(-T) / d_sp [kd J1(T, theta_s) + ks J_n(T, theta'_s) max(0, n . R)],
 // T = sigma_t d_sp, theta_s the angle between the normal and the light, theta'_s the angle between

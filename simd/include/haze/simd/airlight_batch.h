@@ -14,28 +14,12 @@
 
 namespace haze::simd {
 
-// Segments as structure of arrays: start (viewer or medium entry), unit direction, length (+inf
-// for an unbounded segment).
-struct SegmentBatch {
-  const float* ox;
-  const float* oy;
-  const float* oz;
-  const float* dx;
-  const float* dy;
-  const float* dz;
-  const float* length;
-  size_t count;
-};
-
-// One colour channel of one point light in a homogeneous medium.
-struct AirlightChannel {
-  float x, y, z;     // light position
-  float sigma_t, sigma_s, intensity;
-};
-
 // out[i] += airlight of segment i (best compiled target this CPU supports).
 void add_airlight(const AirlightTable& table, const AirlightChannel& light, const SegmentBatch& batch, float* out);
 // The scalar reference: the same float32 formulas, one segment at a time.
 void add_airlight_reference(const AirlightTable& table, const AirlightChannel& light, const SegmentBatch& batch, float* out);
+
+// Makes method `analytic` use add_airlight (haze::set_airlight_batch_function); `haze` calls it.
+void install();
 
 }  // namespace haze::simd
