@@ -216,7 +216,7 @@ LegendreAirlightTables::LegendreAirlightTables(int terms, int a_samples, int eta
           legendre(-std::tanh(eta));
           for (int k = 0; k < terms_; ++k) out[k] = weight * p[static_cast<size_t>(k)];
         };
-        auto k_values = integrate_adaptive_vector(f, terms_, eta0, std::max(eta0, 0.0) + 45.0, 1e-6, 1 << 14);
+        auto k_values = integrate_adaptive_vector(f, terms_, eta0, std::max(eta0, 0.0) + 45.0, 1e-5, 1 << 14);
         for (int k = 0; k < terms_; ++k)
           tables_[static_cast<size_t>(k)][cell] = static_cast<float>(k_values[static_cast<size_t>(k)] * 0.5 * (1.0 + w0) * (1.0 + a));
       }

@@ -86,7 +86,7 @@ std::vector<double> integrate_adaptive_vector(const std::function<void(double, d
     std::vector<double> value;
     bool operator<(const Piece& o) const { return error < o.error; }
   };
-  std::vector<double> fx(n), sum_k(n), sum_g(n);
+  std::vector<double> fx(n), left(n), sum_k(n), sum_g(n);
   auto rule = [&](double lo, double hi) {
     double c = 0.5 * (lo + hi), h = 0.5 * (hi - lo);
     std::fill(sum_k.begin(), sum_k.end(), 0.0);
@@ -95,7 +95,6 @@ std::vector<double> integrate_adaptive_vector(const std::function<void(double, d
     for (size_t d = 0; d < n; ++d) sum_k[d] = kWk[7] * fx[d], sum_g[d] = kWg[3] * fx[d];
     for (int j = 0; j < 7; ++j) {
       double x = h * kXk[j];
-      std::vector<double> left(n);
       f(c - x, left.data());
       f(c + x, fx.data());
       for (size_t d = 0; d < n; ++d) {
