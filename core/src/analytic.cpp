@@ -92,15 +92,23 @@ class AnalyticMethod final : public Method {
       // airlight over the whole row in one batch (SIMD when haze::simd::install() has run).
       std::vector<float> ox, oy, oz, dx, dy, dz, seg;
       std::vector<int> slot(static_cast<size_t>(camera.width_px));
+      struct PixelHit {
+        Ray ray;
+        double t_hit;
+        Vec3 normal;
+        const Surface* hit;
+      };
+      std::vector<PixelHit> row(static_cast<size_t>(camera.width_px));
       std::array<std::vector<float>, 3> batch_airlight;
       for (auto y = static_cast<int>(y0); y < y1 && !progress.cancelled(); ++y) {
         for (auto* v : {&ox, &oy, &oz, &dx, &dy, &dz, &seg}) v->clear();
         for (int x = 0; x < camera.width_px; ++x) {
-          Ray ray = camera.pixel_ray(x, y);
-          double t_hit;
-          Vec3 normal(0.0);
-          nearest_surface(scene.surfaces, ray, kInfinity, t_hit, normal);
-          double t0 = 0.0, t1 = t_hit;
+          PixelHit& px = row[static_cast<size_t>(x)];
+          px.ray = camera.pixel_ray(x, y);
+          px.normal = Vec3(0.0);
+          px.hit = nearest_surface(scene.surfaces, px.ray, kInfinity, px.t_hit, px.normal);
+          const Ray& ray = px.ray;
+          double t0 = 0.0, t1 = px.t_hit;
           slot[static_cast<size_t>(x)] = -1;
           if (!(airlight && bounds.clip(ray, t0, t1) && t1 > t0)) continue;
           slot[static_cast<size_t>(x)] = static_cast<int>(ox.size());
@@ -122,10 +130,7 @@ class AnalyticMethod final : public Method {
           }
         }
         for (int x = 0; x < camera.width_px; ++x) {
-          Ray ray = camera.pixel_ray(x, y);
-          double t_hit;
-          Vec3 normal(0.0);
-          const Surface* hit = nearest_surface(scene.surfaces, ray, kInfinity, t_hit, normal);
+          const auto& [ray, t_hit, normal, hit] = row[static_cast<size_t>(x)];
           Rgb radiance(0.0);
           if (int k = slot[static_cast<size_t>(x)]; k >= 0) {
             for (int c = 0; c < 3; ++c) radiance[c] = static_cast<double>(batch_airlight[static_cast<size_t>(c)][static_cast<size_t>(k)]);
