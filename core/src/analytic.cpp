@@ -18,6 +18,54 @@ namespace haze::internal {
 
 namespace {
 
+// Point lights use the airlight table; spot lights integrate the stretches inside their cone.
+struct AnalyticLight {
+  Light light;
+  Vec3 position;
+  Rgb intensity;
+  const SpotLight* spot;
+};
+
+// What surface shading needs: the medium, the lights and the J tables.
+struct SurfaceShading {
+  const Medium& medium;
+  const std::vector<AnalyticLight>& lights;
+  Rgb sigma_t, sigma_s;
+  bool surface_airlight;
+  const std::optional<SurfaceAirlightTable>& lambert;
+  const std::map<double, SurfaceAirlightTable>& phong;
+
+  // Radiance leaving surface point p toward the viewer (eq. 4.9): direct light attenuated on the way
+  // in (eq. 4.10), plus the airlight scattered onto it (eq. 4.15) where p is in the medium.
+  Rgb operator()(const Surface& surface, const Vec3& p, const Vec3& normal, const Vec3& view_dir) const {
+    Rgb radiance(0.0);
+    LightArrival a;
+    for (const auto& light : lights) {
+      arrival(light.light, p, a);
+      double cos_i = glm::dot(normal, a.to_light);
+      if (cos_i <= 0.0) continue;
+      radiance += surface.brdf(a.to_light, -view_dir, normal) * a.irradiance * cos_i * medium.transmittance(p, light.position);
+    }
+    if (!surface_airlight || !medium.bounds().contains(p)) return radiance;
+    const Vec3 mirrored = glm::reflect(view_dir, normal);
+    const double cos_r = std::max(0.0, glm::dot(normal, mirrored));
+    for (const auto& light : lights) {
+      // A spot light's J tables are scaled by its intensity toward the surface point.
+      arrival(light.light, p, a);
+      const Rgb intensity = a.irradiance * a.distance * a.distance;
+      const double theta_s = std::acos(std::clamp(glm::dot(normal, a.to_light), -1.0, 1.0));
+      const double theta_r = std::acos(std::clamp(glm::dot(mirrored, a.to_light), -1.0, 1.0));
+      for (int c = 0; c < 3; ++c) {
+        double T = sigma_t[c] * a.distance;
+        double j = lambert && surface.kd[c] > 0.0 ? surface.kd[c] * lambert->eval(T, theta_s) : 0.0;
+        if (surface.ks[c] > 0.0) j += surface.ks[c] * phong.at(surface.shininess).eval(T, theta_r) * cos_r;
+        radiance[c] += sigma_s[c] * intensity[c] * std::exp(-T) / a.distance * j;
+      }
+    }
+    return radiance;
+  }
+};
+
 class AnalyticMethod final : public Method {
  public:
   RenderResult render(const Scene& scene, const RenderOptions& options) const override {
@@ -32,13 +80,6 @@ class AnalyticMethod final : public Method {
     const MediumDesc& desc = *scene.medium;
     const auto* constant = std::get_if<ConstantDensity>(&desc.density);
     if (!constant) throw Error("medium.density.type", "heterogeneous", "\"constant\" for the analytic method (use propagation or reference)");
-    // Point lights use the airlight table; spot lights integrate the stretches inside their cone.
-    struct AnalyticLight {
-      Light light;
-      Vec3 position;
-      Rgb intensity;
-      const SpotLight* spot;
-    };
     std::vector<AnalyticLight> lights;
     for (size_t i = 0; i < scene.lights.size(); ++i) {
       if (auto* p = std::get_if<PointLight>(&scene.lights[i])) {
@@ -87,6 +128,7 @@ class AnalyticMethod final : public Method {
     RenderResult result{Image(camera.width_px, camera.height_px), std::nullopt, {}};
     ProgressTracker progress(options.progress, camera.height_px);
     const AirlightBatchFunction add_airlight = airlight_batch_function();
+    const SurfaceShading shade{*medium, lights, sigma_t, sigma_s, surface_airlight, lambert, phong};
     parallel_for(camera.height_px, options.threads, 1, [&](long long y0, long long y1) {
       // Per row: the view segments inside the medium as float arrays, then each point light's
       // airlight over the whole row in one batch (SIMD when haze::simd::install() has run).
@@ -149,35 +191,7 @@ class AnalyticMethod final : public Method {
           }
           Rgb view_t = medium->transmittance_along(ray.origin, ray.direction, t_hit);
           if (hit) {
-            Vec3 p = ray.at(t_hit);
-            Rgb surface(0.0);
-            LightArrival a;
-            for (const auto& light : lights) {
-              arrival(light.light, p, a);
-              double cos_i = glm::dot(normal, a.to_light);
-              if (cos_i <= 0.0) continue;
-              surface += hit->brdf(a.to_light, -ray.direction, normal) * a.irradiance * cos_i * medium->transmittance(p, light.position);
-            }
-            // Airlight onto the surface, where the surface point is in the medium.
-            if (surface_airlight && bounds.contains(p)) {
-              Vec3 mirrored = glm::reflect(ray.direction, normal);
-              double cos_r = std::max(0.0, glm::dot(normal, mirrored));
-              for (const auto& light : lights) {
-                // A spot light's J tables are scaled by its intensity toward the surface point.
-                arrival(light.light, p, a);
-                Rgb intensity = a.irradiance * a.distance * a.distance;
-                double d = a.distance;
-                Vec3 wi = a.to_light;
-                double theta_s = std::acos(std::clamp(glm::dot(normal, wi), -1.0, 1.0));
-                double theta_r = std::acos(std::clamp(glm::dot(mirrored, wi), -1.0, 1.0));
-                for (int c = 0; c < 3; ++c) {
-                  double T = sigma_t[c] * d;
-                  double j = lambert && hit->kd[c] > 0.0 ? hit->kd[c] * lambert->eval(T, theta_s) : 0.0;
-                  if (hit->ks[c] > 0.0) j += hit->ks[c] * phong.at(hit->shininess).eval(T, theta_r) * cos_r;
-                  surface[c] += sigma_s[c] * intensity[c] * std::exp(-T) / d * j;
-                }
-              }
-            }
+            Rgb surface = shade(*hit, ray.at(t_hit), normal, ray.direction);
             radiance += view_t * surface;
           } else {
             radiance += view_t * scene.background;
