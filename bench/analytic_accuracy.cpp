@@ -20,20 +20,12 @@ struct Errors {
   double worst, median, rms;
 };
 
-// Random segments as in tests/core/airlight_test.cpp: optical depths 1e-6 to 50, rays near the light,
-// lights behind the viewer, segments from 1e-3 to 1e3 times the light distance or infinite.
+// The randomized sweep with the extremes (haze::random_airlight_case), as the tests use.
 Errors measure(const PhaseFunction& phase, const AirlightTable& table, int n, std::uint64_t seed) {
   Rng rng(seed, 3);
   std::vector<double> errors;
   for (int k = 0; k < n; ++k) {
-    double d_sv = std::exp(std::log(1e-3) + rng.uniform() * std::log(1e6));
-    double depth = std::exp(std::log(1e-6) + rng.uniform() * std::log(50.0 / 1e-6));
-    double gamma = kPi * rng.uniform();
-    if (k % 5 == 0) gamma = 1e-6 + rng.uniform() * 1e-4;
-    if (k % 5 == 1) gamma = kPi - 1e-6 - rng.uniform() * 1e-3;
-    double d_vp = (k % 7 == 0) ? kInfinity : d_sv * std::exp(std::log(1e-3) + rng.uniform() * std::log(1e6));
-    AirlightMedium m{depth / d_sv, 0.7 * depth / d_sv, 1.0};
-    AirlightSegment s{d_sv, gamma, d_vp};
+    auto [m, s] = random_airlight_case(rng, k);
     double exact = airlight_quadrature(phase, m, s, 1e-9);
     errors.push_back(std::abs(table.eval(m, s) - exact) / exact);
   }

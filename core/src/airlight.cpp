@@ -97,6 +97,17 @@ double airlight_quadrature(const PhaseFunction& phase, const AirlightMedium& med
   return medium.sigma_s * medium.intensity * std::exp(-medium.sigma_t * r.d_sv) / r.h * result.value;
 }
 
+AirlightCase random_airlight_case(Rng& rng, int k) {
+  double d_sv = std::exp(std::log(1e-3) + rng.uniform() * std::log(1e6));
+  double depth = std::exp(std::log(1e-6) + rng.uniform() * std::log(50.0 / 1e-6));
+  double gamma = kPi * rng.uniform();
+  if (k % 5 == 0) gamma = 1e-6 + rng.uniform() * 1e-4;
+  if (k % 5 == 1) gamma = kPi - 1e-6 - rng.uniform() * 1e-3;
+  double d_vp = (k % 7 == 0) ? kInfinity : d_sv * std::exp(std::log(1e-3) + rng.uniform() * std::log(1e6));
+  if (k % 11 == 0) d_sv = 1e-6 * (std::isfinite(d_vp) ? d_vp : 1.0);
+  return {{depth / d_sv, 0.7 * depth / d_sv, 1.0}, {d_sv, gamma, d_vp}};
+}
+
 double airlight_no_extinction(const AirlightMedium& medium, const AirlightSegment& segment) {
   check(medium, segment);
   Reduced r = reduce(segment);

@@ -57,23 +57,12 @@ struct SweepStats {
   int count = 0;
 };
 
-// Random configurations: optical depth sigma_t d_sv log-uniform in [1e-6, 50]; gamma uniform, near
-// 0 (the ray passing within 1e-6 to 1e-4 d_sv of the light ahead) and near pi (the light behind the
-// viewer); the segment infinite or 1e-3 to 1e3 d_sv long; every 11th with the viewer next to the
-// light (d_sv = 1e-6 of the segment).
+// The randomized sweep with the extremes (haze::random_airlight_case).
 SweepStats sweep(const PhaseFunction& phase, const AirlightTable& table, int n, std::uint64_t seed) {
   Rng rng(seed, 17);
   SweepStats stats;
   for (int k = 0; k < n; ++k) {
-    double d_sv = std::exp(std::log(1e-3) + rng.uniform() * std::log(1e6));
-    double depth = std::exp(std::log(1e-6) + rng.uniform() * std::log(50.0 / 1e-6));
-    double gamma = kPi * rng.uniform();
-    if (k % 5 == 0) gamma = 1e-6 + rng.uniform() * 1e-4;
-    if (k % 5 == 1) gamma = kPi - 1e-6 - rng.uniform() * 1e-3;
-    double d_vp = (k % 7 == 0) ? kInfinity : d_sv * std::exp(std::log(1e-3) + rng.uniform() * std::log(1e6));
-    if (k % 11 == 0) d_sv = 1e-6 * (std::isfinite(d_vp) ? d_vp : 1.0);
-    AirlightMedium m{depth / d_sv, 0.7 * depth / d_sv, 1.0};
-    AirlightSegment s{d_sv, gamma, d_vp};
+    auto [m, s] = random_airlight_case(rng, k);
     double exact = airlight_quadrature(phase, m, s, 1e-9);
     double fast = table.eval(m, s);
     EXPECT_TRUE(std::isfinite(fast));

@@ -11,6 +11,7 @@
 
 #include <haze/core/phase.h>
 #include <haze/core/progress.h>
+#include <haze/core/rng.h>
 
 #include <filesystem>
 #include <string>
@@ -39,6 +40,17 @@ struct AirlightMedium {
 // The segment must not touch the light (h > 0 and d_sv > 0).
 double airlight_quadrature(const PhaseFunction& phase, const AirlightMedium& medium, const AirlightSegment& segment,
                            double rel_tol = 1e-10);
+
+// The randomized sweep the tables are measured with (tests, bench/analytic_accuracy): case k has
+// optical depth sigma_t d_sv log-uniform in [1e-6, 50]; gamma uniform, or within 1e-6 to 1e-4 of
+// the light ahead (k % 5 == 0), or of the light behind the viewer (k % 5 == 1); a segment of 1e-3 to
+// 1e3 d_sv or infinite (k % 7 == 0); the viewer next to the light (d_sv 1e-6 of the segment, every
+// 11th). sigma_s = 0.7 sigma_t, I = 1.
+struct AirlightCase {
+  AirlightMedium medium;
+  AirlightSegment segment;
+};
+AirlightCase random_airlight_case(Rng& rng, int k);
 
 // Seed 004 / BEYOND.md: isotropic phase and no extinction,
 // L = sigma_s I / (4 pi h) [atan((d_vp - t) / h) - atan(-t / h)]. A segment through the light is
