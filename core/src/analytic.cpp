@@ -31,6 +31,7 @@ struct SurfaceShading {
   const Medium& medium;
   const std::vector<AnalyticLight>& lights;
   Rgb sigma_t, sigma_s;
+  bool grey;
   bool surface_airlight;
   const std::optional<SurfaceAirlightTable>& lambert;
   const std::map<double, SurfaceAirlightTable>& phong;
@@ -55,11 +56,15 @@ struct SurfaceShading {
       const Rgb intensity = a.irradiance * a.distance * a.distance;
       const double theta_s = std::acos(std::clamp(glm::dot(normal, a.to_light), -1.0, 1.0));
       const double theta_r = std::acos(std::clamp(glm::dot(mirrored, a.to_light), -1.0, 1.0));
+      // J depends on the channel only through T; a grey medium looks it up once.
+      double j_d = 0.0, j_s = 0.0;
       for (int c = 0; c < 3; ++c) {
         double T = sigma_t[c] * a.distance;
-        double j = lambert && surface.kd[c] > 0.0 ? surface.kd[c] * lambert->eval(T, theta_s) : 0.0;
-        if (surface.ks[c] > 0.0) j += surface.ks[c] * phong.at(surface.shininess).eval(T, theta_r) * cos_r;
-        radiance[c] += sigma_s[c] * intensity[c] * std::exp(-T) / a.distance * j;
+        if (c == 0 || !grey) {
+          j_d = lambert && surface.kd != Rgb(0.0) ? lambert->eval(T, theta_s) : 0.0;
+          j_s = surface.ks != Rgb(0.0) ? phong.at(surface.shininess).eval(T, theta_r) * cos_r : 0.0;
+        }
+        radiance[c] += sigma_s[c] * intensity[c] * std::exp(-T) / a.distance * (surface.kd[c] * j_d + surface.ks[c] * j_s);
       }
     }
     return radiance;
@@ -96,6 +101,8 @@ class AnalyticMethod final : public Method {
     auto medium = make_medium(desc);
     const Rgb sigma_t = desc.sigma_t * constant->value;
     const Rgb sigma_s = desc.albedo * sigma_t;
+    // A grey medium (the same coefficients in every channel) needs one airlight evaluation per light.
+    const bool grey = sigma_t.r == sigma_t.g && sigma_t.g == sigma_t.b && sigma_s.r == sigma_s.g && sigma_s.g == sigma_s.b;
     // Tables come from options.cache_dir when it is set and holds them (haze::AirlightTable::cached).
     const bool use_cache = !options.cache_dir.empty();
     bool all_cached = use_cache, hit = false;
@@ -128,7 +135,7 @@ class AnalyticMethod final : public Method {
     RenderResult result{Image(camera.width_px, camera.height_px), std::nullopt, {}};
     ProgressTracker progress(options.progress, camera.height_px);
     const AirlightBatchFunction add_airlight = airlight_batch_function();
-    const SurfaceShading shade{*medium, lights, sigma_t, sigma_s, surface_airlight, lambert, phong};
+    const SurfaceShading shade{*medium, lights, sigma_t, sigma_s, grey, surface_airlight, lambert, phong};
     parallel_for(camera.height_px, options.threads, 1, [&](long long y0, long long y1) {
       // Per row: the view segments inside the medium as float arrays, then each point light's
       // airlight over the whole row in one batch (SIMD when haze::simd::install() has run).
@@ -142,6 +149,7 @@ class AnalyticMethod final : public Method {
       };
       std::vector<PixelHit> row(static_cast<size_t>(camera.width_px));
       std::array<std::vector<float>, 3> batch_airlight;
+      std::vector<float> unit;
       for (auto y = static_cast<int>(y0); y < y1 && !progress.cancelled(); ++y) {
         for (auto* v : {&ox, &oy, &oz, &dx, &dy, &dz, &seg}) v->clear();
         for (int x = 0; x < camera.width_px; ++x) {
@@ -161,13 +169,25 @@ class AnalyticMethod final : public Method {
           seg.push_back(std::isfinite(t1) ? static_cast<float>(t1 - t0) : INFINITY);
         }
         const SegmentBatch batch{ox.data(), oy.data(), oz.data(), dx.data(), dy.data(), dz.data(), seg.data(), ox.size()};
-        for (int c = 0; c < 3; ++c) {
-          batch_airlight[static_cast<size_t>(c)].assign(ox.size(), 0.0f);
-          for (const auto& light : lights) {
-            if (light.spot || sigma_s[c] == 0.0 || light.intensity[c] == 0.0) continue;
-            add_airlight(table,
-                         {static_cast<float>(light.position.x), static_cast<float>(light.position.y), static_cast<float>(light.position.z),
-                          static_cast<float>(sigma_t[c]), static_cast<float>(sigma_s[c]), static_cast<float>(light.intensity[c])},
+        for (auto& channel : batch_airlight) channel.assign(ox.size(), 0.0f);
+        for (const auto& light : lights) {
+          if (light.spot) continue;
+          const Vec3& p = light.position;
+          if (grey) {
+            // One batch at unit intensity, scaled per channel: airlight is linear in I.
+            unit.assign(ox.size(), 0.0f);
+            add_airlight(table, {static_cast<float>(p.x), static_cast<float>(p.y), static_cast<float>(p.z),
+                                 static_cast<float>(sigma_t[0]), static_cast<float>(sigma_s[0]), 1.0f},
+                         batch, unit.data());
+            for (int c = 0; c < 3; ++c)
+              for (size_t i = 0; i < unit.size(); ++i)
+                batch_airlight[static_cast<size_t>(c)][i] += static_cast<float>(light.intensity[c]) * unit[i];
+            continue;
+          }
+          for (int c = 0; c < 3; ++c) {
+            if (sigma_s[c] == 0.0 || light.intensity[c] == 0.0) continue;
+            add_airlight(table, {static_cast<float>(p.x), static_cast<float>(p.y), static_cast<float>(p.z), static_cast<float>(sigma_t[c]),
+                                 static_cast<float>(sigma_s[c]), static_cast<float>(light.intensity[c])},
                          batch, batch_airlight[static_cast<size_t>(c)].data());
           }
         }

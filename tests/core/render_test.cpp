@@ -201,6 +201,17 @@ TEST(Analytic, SurfaceRadianceMatchesReference) {
   EXPECT_LT(bias, 0.02);
 }
 
+// A grey medium takes the one-evaluation-per-light path; it must agree with the per-channel one.
+TEST(Analytic, GreyShortcutMatchesPerChannelPath) {
+  Scene scene = analytic_scene();
+  scene.medium->sigma_t = Rgb(0.3);
+  scene.surfaces.push_back({Sphere{Vec3(0.4, 0.6, 0.8), 0.6}, Rgb(0.6, 0.25, 0.0), Rgb(0.4), 24.0});
+  auto grey = render(scene, "analytic");
+  scene.medium->sigma_t = Rgb(0.3, 0.3, 0.3 * (1.0 + 1e-12));  // not grey: per-channel path
+  auto per_channel = render(scene, "analytic");
+  EXPECT_LT(relative_rmse(grey.radiance, per_channel.radiance), 1e-6);
+}
+
 TEST(Analytic, RejectsWhatItDoesNotModel) {
   Scene scene = analytic_scene();
   scene.lights.push_back(DirectionalLight{});
