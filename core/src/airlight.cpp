@@ -264,7 +264,14 @@ AirlightTable LegendreAirlightTables::combine(const std::vector<double>& moments
   }
   std::vector<float> values(sum.begin(), sum.end());
   // The phase kept for direct integration of short segments: the truncated series' source.
-  return AirlightTable(PhaseFunction::henyey_greenstein(moments.size() > 1 ? moments[1] : 0.0), na_, neta_, std::move(values));
+  std::string origin = "legendre";
+  for (double b : moments) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, " %.17g", b);
+    origin.append(buf);
+  }
+  return AirlightTable(PhaseFunction::henyey_greenstein(moments.size() > 1 ? moments[1] : 0.0), na_, neta_, std::move(values),
+                       origin);
 }
 
 AirlightTable LegendreAirlightTables::combine_hg(double g, int terms) const {
@@ -311,7 +318,9 @@ void store_table(const std::filesystem::path& file, const std::string& key, int 
 }  // namespace
 
 std::string AirlightTable::key() const {
-  return "airlight-tail v1; " + phase_.key() + "; " + std::to_string(na_) + "x" + std::to_string(neta_);
+  std::string key = "airlight-tail v1; " + phase_.key() + "; " + std::to_string(na_) + "x" + std::to_string(neta_);
+  if (!origin_.empty()) key.append("; ").append(origin_);
+  return key;
 }
 
 AirlightTable AirlightTable::cached(const PhaseFunction& phase, const std::filesystem::path& dir, int a_samples, int eta_samples,
@@ -418,6 +427,28 @@ SurfaceAirlightTable::SurfaceAirlightTable(const AirlightTable& airlight, double
       }
     }
   });
+}
+
+LegendreAirlightTables LegendreAirlightTables::cached(int terms, const std::filesystem::path& dir, int a_samples, int eta_samples,
+                                                     int threads, bool* from_cache) {
+  const std::string key = "legendre-tail v1; orders " + std::to_string(terms) + "; " + std::to_string(a_samples) + "x" +
+                          std::to_string(eta_samples);
+  auto file = table_file(dir, "legendre", key);
+  const size_t cells = static_cast<size_t>(a_samples) * static_cast<size_t>(eta_samples);
+  if (auto values = load_table(file, key, a_samples, eta_samples * terms)) {
+    std::vector<std::vector<float>> tables(static_cast<size_t>(terms));
+    for (size_t k = 0; k < tables.size(); ++k)
+      tables[k].assign(values->begin() + static_cast<std::ptrdiff_t>(k * cells), values->begin() + static_cast<std::ptrdiff_t>((k + 1) * cells));
+    if (from_cache) *from_cache = true;
+    return LegendreAirlightTables(terms, a_samples, eta_samples, std::move(tables));
+  }
+  LegendreAirlightTables built(terms, a_samples, eta_samples, threads);
+  std::vector<float> stacked;
+  stacked.reserve(cells * static_cast<size_t>(terms));
+  for (const auto& t : built.tables_) stacked.insert(stacked.end(), t.begin(), t.end());
+  store_table(file, key, a_samples, eta_samples * terms, stacked);
+  if (from_cache) *from_cache = false;
+  return built;
 }
 
 SurfaceAirlightTable SurfaceAirlightTable::cached(const AirlightTable& airlight, double exponent, const std::filesystem::path& dir,

@@ -79,6 +79,9 @@ class AnalyticMethod final : public Method {
     const int eta_samples = static_cast<int>(settings.integer("table_eta", 512, 16, 4096));
     const bool surface_airlight = settings.integer("surface_airlight", 1, 0, 1) == 1;
     const bool airlight = settings.integer("airlight", 1, 0, 1) == 1;
+    // Dynamic g (seed 002 sec. 4.3): > 0 builds g-independent Legendre tables (cached) and sums
+    // them for the scene's g with enough orders for this relative tolerance.
+    const double dynamic_g = settings.number("dynamic_g_tolerance", 0.0, 0.0, 0.5);
     settings.reject_unknown();
 
     if (!scene.medium) throw Error("medium", "missing", "a homogeneous medium for the analytic method");
@@ -112,7 +115,22 @@ class AnalyticMethod final : public Method {
       all_cached &= hit;
       return t;
     };
-    const AirlightTable table = airlight_table();
+    int legendre_terms = 0;
+    double truncation_bound = 0.0;
+    auto legendre_table = [&] {
+      const auto* hg = desc.phase.parameters<PhaseFunction::HenyeyGreenstein>();
+      if (!hg) throw Error("medium.phase.type", "\"" + desc.phase.name() + "\"", "\"hg\" for method.dynamic_g_tolerance");
+      legendre_terms = LegendreAirlightTables::terms_for(hg->g, dynamic_g, 64);
+      truncation_bound = LegendreAirlightTables::truncation_bound(hg->g, legendre_terms);
+      // Orders in steps of 16, so nearby g and tolerances share cached tables.
+      const int orders = (legendre_terms + 15) / 16 * 16;
+      LegendreAirlightTables tables = use_cache ? LegendreAirlightTables::cached(orders, options.cache_dir, a_samples, eta_samples,
+                                                                                 options.threads, &hit)
+                                                : LegendreAirlightTables(orders, a_samples, eta_samples, options.threads);
+      all_cached &= use_cache && hit;
+      return tables.combine_hg(hg->g, legendre_terms);
+    };
+    const AirlightTable table = dynamic_g > 0.0 ? legendre_table() : airlight_table();
     auto surface_table = [&](double exponent) {
       if (!use_cache) return SurfaceAirlightTable(table, exponent, 64, 64, options.threads);
       auto t = SurfaceAirlightTable::cached(table, exponent, options.cache_dir, 64, 64, options.threads, &hit);
@@ -226,6 +244,8 @@ class AnalyticMethod final : public Method {
                     {"airlight_path", add_airlight == &add_airlight_float64 ? "float64" : "simd"},
                     {"tables_from_cache", all_cached},
                     {"table", {a_samples, eta_samples}},
+                    {"legendre_terms", legendre_terms},
+                    {"truncation_bound", truncation_bound},
                     {"seconds", std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()}};
     return result;
   }

@@ -212,6 +212,25 @@ TEST(Analytic, GreyShortcutMatchesPerChannelPath) {
   EXPECT_LT(relative_rmse(grey.radiance, per_channel.radiance), 1e-6);
 }
 
+// Dynamic g: Legendre tables summed for the scene's g stay within the requested tolerance of the
+// exact-phase table, and report the orders used and their bound.
+TEST(Analytic, DynamicGStaysWithinItsTolerance) {
+  Scene scene = analytic_scene();
+  scene.medium->phase = PhaseFunction::henyey_greenstein(0.3);
+  RenderOptions exact, dynamic;
+  exact.settings = {{"table_a", 128}, {"table_eta", 256}};
+  dynamic.settings = {{"table_a", 128}, {"table_eta", 256}, {"dynamic_g_tolerance", 1e-2}};
+  auto a = render(scene, "analytic", exact), b = render(scene, "analytic", dynamic);
+  double rel = relative_rmse(b.radiance, a.radiance);
+  std::printf("dynamic g: %d Legendre orders (bound %.1e), relative RMSE against the exact-phase table %.1e\n",
+              b.stats["legendre_terms"].get<int>(), b.stats["truncation_bound"].get<double>(), rel);
+  EXPECT_GT(b.stats["legendre_terms"].get<int>(), 3);
+  EXPECT_LE(b.stats["truncation_bound"].get<double>(), 1e-2);
+  EXPECT_LT(rel, 1e-2);
+  scene.medium->phase = PhaseFunction::rayleigh();
+  EXPECT_THROW(render(scene, "analytic", dynamic), Error);
+}
+
 TEST(Analytic, RejectsWhatItDoesNotModel) {
   Scene scene = analytic_scene();
   scene.lights.push_back(DirectionalLight{});

@@ -108,11 +108,12 @@ class AirlightTable {
 
  private:
   friend class LegendreAirlightTables;
-  AirlightTable(const PhaseFunction& phase, int a_samples, int eta_samples, std::vector<float> values)
-      : phase_(phase), na_(a_samples), neta_(eta_samples), t_(std::move(values)) {}
+  AirlightTable(const PhaseFunction& phase, int a_samples, int eta_samples, std::vector<float> values, std::string origin = "")
+      : phase_(phase), na_(a_samples), neta_(eta_samples), t_(std::move(values)), origin_(std::move(origin)) {}
   PhaseFunction phase_;
   int na_, neta_;
   std::vector<float> t_;
+  std::string origin_;  // how the values were made when not by direct integration (part of key())
 };
 
 // Dynamic g (seed 002 sec. 4.3, eq. 4.16-4.18) in the tail form: one table per Legendre order k
@@ -136,7 +137,13 @@ class LegendreAirlightTables {
   AirlightTable combine_hg(double g, int terms = 0) const;
   int terms() const { return terms_; }
 
+  // As AirlightTable::cached: all orders in one EXR, keyed by version, orders and sizes.
+  static LegendreAirlightTables cached(int terms, const std::filesystem::path& dir, int a_samples = 256, int eta_samples = 512,
+                                       int threads = 0, bool* from_cache = nullptr);
+
  private:
+  LegendreAirlightTables(int terms, int a_samples, int eta_samples, std::vector<std::vector<float>> tables)
+      : terms_(terms), na_(a_samples), neta_(eta_samples), tables_(std::move(tables)) {}
   int terms_, na_, neta_;
   std::vector<std::vector<float>> tables_;  // per order: K_k (1 + w0) (1 + a) / 2, a fastest
 };
