@@ -2,11 +2,14 @@
 // against the scalar reference, on 1 and 2 threads; rows are split over threads.
 // Run: build/release/bench/haze_bench_analytic --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
 #include <haze/core/camera.h>
+#include <haze/core/method.h>
 #include <haze/core/progress.h>
 #include <haze/simd/airlight_batch.h>
 #include <haze/simd/phase_batch.h>
 
 #include <benchmark/benchmark.h>
+
+#include <filesystem>
 
 namespace {
 
@@ -68,5 +71,38 @@ void BM_AirlightFrame(benchmark::State& state) {
 }
 BENCHMARK(BM_AirlightFrame<true>)->Name("analytic/airlight_1080p_4_lights/simd/threads")->Arg(1)->Arg(2)->UseRealTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_AirlightFrame<false>)->Name("analytic/airlight_1080p_4_lights/scalar/threads")->Arg(1)->Arg(2)->UseRealTime()->Unit(benchmark::kMillisecond);
+
+// The frame: 1920 x 1080, 4 point lights, airlight plus Lambert and Phong surface radiance
+// with dynamic g, through haze::render (tables read from a cache built before timing). Arg 1: the
+// Highway airlight (simd::install); arg 0: core's float64 airlight loop.
+void BM_AnalyticFrame(benchmark::State& state) {
+  Scene scene;
+  scene.camera.position = Vec3(0, 1.5, 6);
+  scene.camera.look_at = Vec3(0, 1, 0);
+  scene.camera.width_px = 1920, scene.camera.height_px = 1080;
+  MediumDesc m;
+  m.sigma_t = Rgb(0.26);
+  m.albedo = Rgb(0.9);
+  m.phase = PhaseFunction::henyey_greenstein(0.6);
+  scene.medium = m;
+  scene.lights = {PointLight{Vec3(-1.2, 1.8, 0.0), Rgb(14, 11, 7)}, PointLight{Vec3(1.6, 0.9, -1.5), Rgb(3, 5, 10)},
+                  PointLight{Vec3(0.3, 2.8, -0.5), Rgb(8)}, PointLight{Vec3(-2.0, 0.5, 1.5), Rgb(2, 1, 1)}};
+  scene.surfaces = {{Plane{Vec3(0), Vec3(0, 1, 0)}, Rgb(0.5), Rgb(0.0), 1.0},
+                    {Sphere{Vec3(0.4, 0.6, 0.8), 0.6}, Rgb(0.6, 0.25, 0.2), Rgb(0.4), 24.0}};
+  RenderOptions options;
+  options.threads = static_cast<int>(state.range(1));
+  options.settings = {{"dynamic_g_tolerance", 1e-2}};
+  options.cache_dir = std::filesystem::temp_directory_path() / "haze_bench_analytic_cache";
+  if (state.range(0)) {
+    simd::install();
+  } else {
+    set_airlight_batch_function(nullptr);
+  }
+  render(scene, "analytic", options);  // fills the cache
+  for (auto _ : state) benchmark::DoNotOptimize(render(scene, "analytic", options).radiance.data().data());
+  set_airlight_batch_function(nullptr);
+  state.SetLabel(state.range(0) ? "simd airlight" : "float64 airlight");
+}
+BENCHMARK(BM_AnalyticFrame)->Name("analytic/frame_1080p_4_lights_dynamic_g/simd,threads")->Args({1, 2})->Args({0, 2})->UseRealTime()->Unit(benchmark::kMillisecond);
 
 }  // namespace
