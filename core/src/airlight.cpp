@@ -422,17 +422,70 @@ SurfaceAirlightTable::SurfaceAirlightTable(const AirlightTable& airlight, double
           double A = std::sin(gamma) * std::sin(angle), B = std::cos(gamma) * std::cos(angle);
           return airlight.tail(T * std::sin(gamma), std::log(std::tan(0.5 * gamma))) * azimuth_integral(A, B, n);
         };
-        double j = scale * integrate_adaptive(f, 0.0, kPi, 1e-4, 0.0, 2048).value;
+        // Relative 1e-4, or absolute 1e-7 / (1 + T) for the near-cancelling integrals of high
+        // Legendre orders.
+        double j = scale * integrate_adaptive(f, 0.0, kPi, 1e-4, 1e-7 / (1.0 + T), 2048).value;
         j_[static_cast<size_t>(k) * static_cast<size_t>(nt_) + static_cast<size_t>(i)] = static_cast<float>((1.0 + T) * j);
       }
     }
   });
 }
 
+std::string LegendreAirlightTables::key() const {
+  return "legendre-tail v1; orders " + std::to_string(terms_) + "; " + std::to_string(na_) + "x" + std::to_string(neta_);
+}
+
+AirlightTable LegendreAirlightTables::order(int k) const {
+  if (k < 0 || k >= terms_) throw Error("order", to_text(k), "a Legendre order below " + to_text(terms_));
+  std::string origin = key() + "; order " + std::to_string(k);
+  return AirlightTable(PhaseFunction::isotropic(), na_, neta_, tables_[static_cast<size_t>(k)], origin);
+}
+
+LegendreSurfaceTables::LegendreSurfaceTables(const LegendreAirlightTables& legendre, double exponent, int t_samples,
+                                             int angle_samples, int threads)
+    : exponent_(exponent), nt_(t_samples), na_(angle_samples) {
+  for (int k = 0; k < legendre.terms(); ++k)
+    j_.push_back(SurfaceAirlightTable(legendre.order(k), exponent, t_samples, angle_samples, threads).j_);
+}
+
+LegendreSurfaceTables LegendreSurfaceTables::cached(const LegendreAirlightTables& legendre, double exponent,
+                                                    const std::filesystem::path& dir, int t_samples, int angle_samples,
+                                                    int threads, bool* from_cache) {
+  char suffix[96];
+  std::snprintf(suffix, sizeof suffix, "; surface v1 n=%.17g %dx%d", exponent, t_samples, angle_samples);
+  const std::string key = legendre.key() + suffix;
+  auto file = table_file(dir, "legendre-surface", key);
+  const size_t cells = static_cast<size_t>(t_samples) * static_cast<size_t>(angle_samples);
+  const int terms = legendre.terms();
+  if (auto values = load_table(file, key, t_samples, angle_samples * terms)) {
+    std::vector<std::vector<float>> tables(static_cast<size_t>(terms));
+    for (size_t k = 0; k < tables.size(); ++k)
+      tables[k].assign(values->begin() + static_cast<std::ptrdiff_t>(k * cells), values->begin() + static_cast<std::ptrdiff_t>((k + 1) * cells));
+    if (from_cache) *from_cache = true;
+    return LegendreSurfaceTables(exponent, t_samples, angle_samples, std::move(tables));
+  }
+  LegendreSurfaceTables built(legendre, exponent, t_samples, angle_samples, threads);
+  std::vector<float> stacked;
+  for (const auto& t : built.j_) stacked.insert(stacked.end(), t.begin(), t.end());
+  store_table(file, key, t_samples, angle_samples * terms, stacked);
+  if (from_cache) *from_cache = false;
+  return built;
+}
+
+SurfaceAirlightTable LegendreSurfaceTables::combine_hg(double g, int terms) const {
+  if (terms < 1 || terms > static_cast<int>(j_.size())) throw Error("terms", to_text(terms), "1 to " + to_text(j_.size()) + " orders");
+  std::vector<double> sum(j_[0].size(), 0.0);
+  for (int k = 0; k < terms; ++k) {
+    double c = (2.0 * k + 1.0) * kInv4Pi * std::pow(g, k);
+    for (size_t i = 0; i < sum.size(); ++i) sum[i] += c * static_cast<double>(j_[static_cast<size_t>(k)][i]);
+  }
+  return SurfaceAirlightTable(exponent_, nt_, na_, std::vector<float>(sum.begin(), sum.end()));
+}
+
 LegendreAirlightTables LegendreAirlightTables::cached(int terms, const std::filesystem::path& dir, int a_samples, int eta_samples,
                                                      int threads, bool* from_cache) {
-  const std::string key = "legendre-tail v1; orders " + std::to_string(terms) + "; " + std::to_string(a_samples) + "x" +
-                          std::to_string(eta_samples);
+  LegendreAirlightTables probe(terms, a_samples, eta_samples, std::vector<std::vector<float>>());
+  const std::string key = probe.key();
   auto file = table_file(dir, "legendre", key);
   const size_t cells = static_cast<size_t>(a_samples) * static_cast<size_t>(eta_samples);
   if (auto values = load_table(file, key, a_samples, eta_samples * terms)) {

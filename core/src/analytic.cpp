@@ -115,23 +115,34 @@ class AnalyticMethod final : public Method {
       all_cached &= hit;
       return t;
     };
+    // Dynamic g: g-independent Legendre tables (airlight and surface), summed for the scene's g.
     int legendre_terms = 0;
     double truncation_bound = 0.0;
-    auto legendre_table = [&] {
+    std::optional<LegendreAirlightTables> legendre;
+    double g = 0.0;
+    if (dynamic_g > 0.0) {
       const auto* hg = desc.phase.parameters<PhaseFunction::HenyeyGreenstein>();
       if (!hg) throw Error("medium.phase.type", "\"" + desc.phase.name() + "\"", "\"hg\" for method.dynamic_g_tolerance");
-      legendre_terms = LegendreAirlightTables::terms_for(hg->g, dynamic_g, 64);
-      truncation_bound = LegendreAirlightTables::truncation_bound(hg->g, legendre_terms);
+      g = hg->g;
+      legendre_terms = LegendreAirlightTables::terms_for(g, dynamic_g, 64);
+      truncation_bound = LegendreAirlightTables::truncation_bound(g, legendre_terms);
       // Orders in steps of 16, so nearby g and tolerances share cached tables.
       const int orders = (legendre_terms + 15) / 16 * 16;
-      LegendreAirlightTables tables = use_cache ? LegendreAirlightTables::cached(orders, options.cache_dir, a_samples, eta_samples,
-                                                                                 options.threads, &hit)
-                                                : LegendreAirlightTables(orders, a_samples, eta_samples, options.threads);
-      all_cached &= use_cache && hit;
-      return tables.combine_hg(hg->g, legendre_terms);
-    };
-    const AirlightTable table = dynamic_g > 0.0 ? legendre_table() : airlight_table();
+      if (use_cache) {
+        legendre.emplace(LegendreAirlightTables::cached(orders, options.cache_dir, a_samples, eta_samples, options.threads, &hit));
+        all_cached &= hit;
+      } else {
+        legendre.emplace(orders, a_samples, eta_samples, options.threads);
+      }
+    }
+    const AirlightTable table = legendre ? legendre->combine_hg(g, legendre_terms) : airlight_table();
     auto surface_table = [&](double exponent) {
+      if (legendre) {
+        if (!use_cache) return LegendreSurfaceTables(*legendre, exponent, 64, 64, options.threads).combine_hg(g, legendre_terms);
+        auto t = LegendreSurfaceTables::cached(*legendre, exponent, options.cache_dir, 64, 64, options.threads, &hit);
+        all_cached &= hit;
+        return t.combine_hg(g, legendre_terms);
+      }
       if (!use_cache) return SurfaceAirlightTable(table, exponent, 64, 64, options.threads);
       auto t = SurfaceAirlightTable::cached(table, exponent, options.cache_dir, 64, 64, options.threads, &hit);
       all_cached &= hit;

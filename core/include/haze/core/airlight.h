@@ -137,6 +137,10 @@ class LegendreAirlightTables {
   AirlightTable combine_hg(double g, int terms = 0) const;
   int terms() const { return terms_; }
 
+  // The tail of order k alone, K_k, as a table (to build per-order surface tables).
+  AirlightTable order(int k) const;
+  std::string key() const;
+
   // As AirlightTable::cached: all orders in one EXR, keyed by version, orders and sizes.
   static LegendreAirlightTables cached(int terms, const std::filesystem::path& dir, int a_samples = 256, int eta_samples = 512,
                                        int threads = 0, bool* from_cache = nullptr);
@@ -201,11 +205,31 @@ class SurfaceAirlightTable {
   const std::vector<float>& values() const { return j_; }
 
  private:
+  friend class LegendreSurfaceTables;
   SurfaceAirlightTable(double exponent, int t_samples, int angle_samples, std::vector<float> values)
       : exponent_(exponent), nt_(t_samples), na_(angle_samples), j_(std::move(values)) {}
   double exponent_;
   int nt_, na_;
   std::vector<float> j_;  // (1 + T) J, T fastest
+};
+
+// Dynamic g for the surface airlight: J tables built from each Legendre order's tail (J is linear
+// in the tail), summed for a given g like the airlight tables.
+class LegendreSurfaceTables {
+ public:
+  LegendreSurfaceTables(const LegendreAirlightTables& legendre, double exponent, int t_samples = 64, int angle_samples = 64,
+                        int threads = 0);
+  static LegendreSurfaceTables cached(const LegendreAirlightTables& legendre, double exponent, const std::filesystem::path& dir,
+                                      int t_samples = 64, int angle_samples = 64, int threads = 0, bool* from_cache = nullptr);
+  // J for HG(g) truncated to `terms` orders (at most the orders built).
+  SurfaceAirlightTable combine_hg(double g, int terms) const;
+
+ private:
+  LegendreSurfaceTables(double exponent, int t_samples, int angle_samples, std::vector<std::vector<float>> tables)
+      : exponent_(exponent), nt_(t_samples), na_(angle_samples), j_(std::move(tables)) {}
+  double exponent_;
+  int nt_, na_;
+  std::vector<std::vector<float>> j_;  // per order
 };
 
 }  // namespace haze
