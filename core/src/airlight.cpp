@@ -315,6 +315,24 @@ void store_table(const std::filesystem::path& file, const std::string& key, int 
   }
 }
 
+// Several equal-sized tables (one per Legendre order) kept as one EXR, stacked along y.
+std::optional<std::vector<std::vector<float>>> load_stacked(const std::filesystem::path& file, const std::string& key, int width,
+                                                            int height, int count) {
+  auto values = load_table(file, key, width, height * count);
+  if (!values) return std::nullopt;
+  const auto cells = static_cast<std::ptrdiff_t>(width) * height;
+  std::vector<std::vector<float>> tables(static_cast<size_t>(count));
+  for (std::ptrdiff_t k = 0; k < count; ++k) tables[static_cast<size_t>(k)].assign(values->begin() + k * cells, values->begin() + (k + 1) * cells);
+  return tables;
+}
+
+void store_stacked(const std::filesystem::path& file, const std::string& key, int width, int height,
+                   const std::vector<std::vector<float>>& tables) {
+  std::vector<float> stacked;
+  for (const auto& t : tables) stacked.insert(stacked.end(), t.begin(), t.end());
+  store_table(file, key, width, height * static_cast<int>(tables.size()), stacked);
+}
+
 }  // namespace
 
 std::string AirlightTable::key() const {
@@ -455,19 +473,12 @@ LegendreSurfaceTables LegendreSurfaceTables::cached(const LegendreAirlightTables
   std::snprintf(suffix, sizeof suffix, "; surface v1 n=%.17g %dx%d", exponent, t_samples, angle_samples);
   const std::string key = legendre.key() + suffix;
   auto file = table_file(dir, "legendre-surface", key);
-  const size_t cells = static_cast<size_t>(t_samples) * static_cast<size_t>(angle_samples);
-  const int terms = legendre.terms();
-  if (auto values = load_table(file, key, t_samples, angle_samples * terms)) {
-    std::vector<std::vector<float>> tables(static_cast<size_t>(terms));
-    for (size_t k = 0; k < tables.size(); ++k)
-      tables[k].assign(values->begin() + static_cast<std::ptrdiff_t>(k * cells), values->begin() + static_cast<std::ptrdiff_t>((k + 1) * cells));
+  if (auto tables = load_stacked(file, key, t_samples, angle_samples, legendre.terms())) {
     if (from_cache) *from_cache = true;
-    return LegendreSurfaceTables(exponent, t_samples, angle_samples, std::move(tables));
+    return LegendreSurfaceTables(exponent, t_samples, angle_samples, std::move(*tables));
   }
   LegendreSurfaceTables built(legendre, exponent, t_samples, angle_samples, threads);
-  std::vector<float> stacked;
-  for (const auto& t : built.j_) stacked.insert(stacked.end(), t.begin(), t.end());
-  store_table(file, key, t_samples, angle_samples * terms, stacked);
+  store_stacked(file, key, t_samples, angle_samples, built.j_);
   if (from_cache) *from_cache = false;
   return built;
 }
@@ -487,19 +498,12 @@ LegendreAirlightTables LegendreAirlightTables::cached(int terms, const std::file
   LegendreAirlightTables probe(terms, a_samples, eta_samples, std::vector<std::vector<float>>());
   const std::string key = probe.key();
   auto file = table_file(dir, "legendre", key);
-  const size_t cells = static_cast<size_t>(a_samples) * static_cast<size_t>(eta_samples);
-  if (auto values = load_table(file, key, a_samples, eta_samples * terms)) {
-    std::vector<std::vector<float>> tables(static_cast<size_t>(terms));
-    for (size_t k = 0; k < tables.size(); ++k)
-      tables[k].assign(values->begin() + static_cast<std::ptrdiff_t>(k * cells), values->begin() + static_cast<std::ptrdiff_t>((k + 1) * cells));
+  if (auto tables = load_stacked(file, key, a_samples, eta_samples, terms)) {
     if (from_cache) *from_cache = true;
-    return LegendreAirlightTables(terms, a_samples, eta_samples, std::move(tables));
+    return LegendreAirlightTables(terms, a_samples, eta_samples, std::move(*tables));
   }
   LegendreAirlightTables built(terms, a_samples, eta_samples, threads);
-  std::vector<float> stacked;
-  stacked.reserve(cells * static_cast<size_t>(terms));
-  for (const auto& t : built.tables_) stacked.insert(stacked.end(), t.begin(), t.end());
-  store_table(file, key, a_samples, eta_samples * terms, stacked);
+  store_stacked(file, key, a_samples, eta_samples, built.tables_);
   if (from_cache) *from_cache = false;
   return built;
 }

@@ -206,6 +206,17 @@ TEST(Airlight, TablesRoundTripThroughTheCache) {
   EXPECT_FALSE(hit);
   AirlightTable::cached(phase, dir, 32, 65, 0, &hit);
   EXPECT_FALSE(hit);
+  // Legendre tables (all orders in one file) and their surface tables round-trip too.
+  LegendreAirlightTables orders = LegendreAirlightTables::cached(4, dir, 16, 32, 0, &hit);
+  EXPECT_FALSE(hit);
+  LegendreAirlightTables orders_read = LegendreAirlightTables::cached(4, dir, 16, 32, 0, &hit);
+  EXPECT_TRUE(hit);
+  EXPECT_EQ(orders_read.combine_hg(0.4).values(), orders.combine_hg(0.4).values());
+  auto surface = LegendreSurfaceTables::cached(orders, 0.0, dir, 8, 8, 0, &hit);
+  EXPECT_FALSE(hit);
+  EXPECT_EQ(LegendreSurfaceTables::cached(orders_read, 0.0, dir, 8, 8, 0, &hit).combine_hg(0.4, 4).values(),
+            surface.combine_hg(0.4, 4).values());
+  EXPECT_TRUE(hit);
   // A damaged file is rebuilt, not an error.
   for (const auto& entry : std::filesystem::directory_iterator(dir)) std::filesystem::resize_file(entry.path(), 100);
   AirlightTable rebuilt = AirlightTable::cached(phase, dir, 32, 64, 0, &hit);
