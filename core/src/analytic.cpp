@@ -12,6 +12,8 @@
 #include <array>
 #include <chrono>
 #include <map>
+#include <memory>
+#include <mutex>
 #include <optional>
 
 namespace haze::internal {
@@ -73,6 +75,19 @@ struct SurfaceShading {
 
 class AnalyticMethod final : public Method {
  public:
+  // Tables stay with this object between renders: reuse one object (haze::create_method) to
+  // change g, lights or the camera every frame without rebuilding or rereading them.
+  template <class T, class Make>
+  std::shared_ptr<const T> memo(const std::string& key, bool& reused, Make make) const {
+    std::lock_guard lock(mutex_);
+    if (auto it = tables_.find(key); it != tables_.end()) return std::static_pointer_cast<const T>(it->second);
+    bool hit = false;  // read from the disk cache
+    auto value = std::make_shared<const T>(make(hit));
+    reused &= hit;
+    tables_[key] = value;
+    return value;
+  }
+
   RenderResult render(const Scene& scene, const RenderOptions& options) const override {
     Settings settings(options.settings, "analytic");
     const int a_samples = static_cast<int>(settings.integer("table_a", 256, 16, 4096));
@@ -106,19 +121,21 @@ class AnalyticMethod final : public Method {
     const Rgb sigma_s = desc.albedo * sigma_t;
     // A grey medium (the same coefficients in every channel) needs one airlight evaluation per light.
     const bool grey = sigma_t.r == sigma_t.g && sigma_t.g == sigma_t.b && sigma_s.r == sigma_s.g && sigma_s.g == sigma_s.b;
-    // Tables come from options.cache_dir when it is set and holds them (haze::AirlightTable::cached).
+    // Tables come from this object's memory when an earlier render made them, else from
+    // options.cache_dir when it is set and holds them, else they are built.
     const bool use_cache = !options.cache_dir.empty();
-    bool all_cached = use_cache, hit = false;
+    bool all_reused = true;
+    const std::string sizes = std::to_string(a_samples) + "x" + std::to_string(eta_samples);
     auto airlight_table = [&] {
-      if (!use_cache) return AirlightTable(desc.phase, a_samples, eta_samples, options.threads);
-      auto t = AirlightTable::cached(desc.phase, options.cache_dir, a_samples, eta_samples, options.threads, &hit);
-      all_cached &= hit;
-      return t;
+      return memo<AirlightTable>("airlight " + desc.phase.key() + " " + sizes, all_reused, [&](bool& hit) {
+        if (!use_cache) return AirlightTable(desc.phase, a_samples, eta_samples, options.threads);
+        return AirlightTable::cached(desc.phase, options.cache_dir, a_samples, eta_samples, options.threads, &hit);
+      });
     };
     // Dynamic g: g-independent Legendre tables (airlight and surface), summed for the scene's g.
     int legendre_terms = 0;
     double truncation_bound = 0.0;
-    std::optional<LegendreAirlightTables> legendre;
+    std::shared_ptr<const LegendreAirlightTables> legendre;
     double g = 0.0;
     if (dynamic_g > 0.0) {
       const auto* hg = desc.phase.parameters<PhaseFunction::HenyeyGreenstein>();
@@ -126,27 +143,27 @@ class AnalyticMethod final : public Method {
       g = hg->g;
       legendre_terms = LegendreAirlightTables::terms_for(g, dynamic_g, 64);
       truncation_bound = LegendreAirlightTables::truncation_bound(g, legendre_terms);
-      // Orders in steps of 16, so nearby g and tolerances share cached tables.
+      // Orders in steps of 16, so nearby g and tolerances share tables.
       const int orders = (legendre_terms + 15) / 16 * 16;
-      if (use_cache) {
-        legendre.emplace(LegendreAirlightTables::cached(orders, options.cache_dir, a_samples, eta_samples, options.threads, &hit));
-        all_cached &= hit;
-      } else {
-        legendre.emplace(orders, a_samples, eta_samples, options.threads);
-      }
+      legendre = memo<LegendreAirlightTables>("legendre " + std::to_string(orders) + " " + sizes, all_reused, [&](bool& hit) {
+        if (!use_cache) return LegendreAirlightTables(orders, a_samples, eta_samples, options.threads);
+        return LegendreAirlightTables::cached(orders, options.cache_dir, a_samples, eta_samples, options.threads, &hit);
+      });
     }
-    const AirlightTable table = legendre ? legendre->combine_hg(g, legendre_terms) : airlight_table();
+    const AirlightTable table = legendre ? legendre->combine_hg(g, legendre_terms) : *airlight_table();
     auto surface_table = [&](double exponent) {
+      const std::string n = " n=" + to_text(exponent);
       if (legendre) {
-        if (!use_cache) return LegendreSurfaceTables(*legendre, exponent, 64, 64, options.threads).combine_hg(g, legendre_terms);
-        auto t = LegendreSurfaceTables::cached(*legendre, exponent, options.cache_dir, 64, 64, options.threads, &hit);
-        all_cached &= hit;
-        return t.combine_hg(g, legendre_terms);
+        return memo<LegendreSurfaceTables>(legendre->key() + n, all_reused, [&](bool& hit) {
+                 if (!use_cache) return LegendreSurfaceTables(*legendre, exponent, 64, 64, options.threads);
+                 return LegendreSurfaceTables::cached(*legendre, exponent, options.cache_dir, 64, 64, options.threads, &hit);
+               })
+            ->combine_hg(g, legendre_terms);
       }
-      if (!use_cache) return SurfaceAirlightTable(table, exponent, 64, 64, options.threads);
-      auto t = SurfaceAirlightTable::cached(table, exponent, options.cache_dir, 64, 64, options.threads, &hit);
-      all_cached &= hit;
-      return t;
+      return *memo<SurfaceAirlightTable>(table.key() + n, all_reused, [&](bool& hit) {
+        if (!use_cache) return SurfaceAirlightTable(table, exponent, 64, 64, options.threads);
+        return SurfaceAirlightTable::cached(table, exponent, options.cache_dir, 64, 64, options.threads, &hit);
+      });
     };
     // J1 for diffuse surfaces and one J_n per Phong exponent in the scene.
     std::optional<SurfaceAirlightTable> lambert;
@@ -253,13 +270,17 @@ class AnalyticMethod final : public Method {
     progress.throw_if_cancelled();
     result.stats = {{"table_seconds", table_seconds},
                     {"airlight_path", add_airlight == &add_airlight_float64 ? "float64" : "simd"},
-                    {"tables_from_cache", all_cached},
+                    {"tables_reused", all_reused},
                     {"table", {a_samples, eta_samples}},
                     {"legendre_terms", legendre_terms},
                     {"truncation_bound", truncation_bound},
                     {"seconds", std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()}};
     return result;
   }
+
+ private:
+  mutable std::mutex mutex_;
+  mutable std::map<std::string, std::shared_ptr<const void>> tables_;
 };
 
 }  // namespace

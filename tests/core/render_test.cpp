@@ -232,6 +232,23 @@ TEST(Analytic, DynamicGStaysWithinItsTolerance) {
   EXPECT_THROW(render(scene, "analytic", dynamic), Error);
 }
 
+// One method object keeps its tables: a new g on the next frame reuses the Legendre tables and
+// gives exactly what a fresh object computes.
+TEST(Analytic, ReusedMethodKeepsTablesAcrossFrames) {
+  Scene scene = analytic_scene();
+  scene.medium->phase = PhaseFunction::henyey_greenstein(0.3);
+  scene.surfaces[0].ks = Rgb(0.0);
+  RenderOptions options;
+  options.settings = {{"table_a", 64}, {"table_eta", 128}, {"dynamic_g_tolerance", 1e-2}};
+  auto method = create_method("analytic");
+  auto first = method->render(scene, options);
+  EXPECT_FALSE(first.stats["tables_reused"].get<bool>());
+  scene.medium->phase = PhaseFunction::henyey_greenstein(0.35);
+  auto second = method->render(scene, options);
+  EXPECT_TRUE(second.stats["tables_reused"].get<bool>());
+  EXPECT_EQ(second.radiance.data(), create_method("analytic")->render(scene, options).radiance.data());
+}
+
 TEST(Analytic, RejectsWhatItDoesNotModel) {
   Scene scene = analytic_scene();
   scene.lights.push_back(DirectionalLight{});
