@@ -315,6 +315,13 @@ void store_table(const std::filesystem::path& file, const std::string& key, int 
   }
 }
 
+// What a surface table adds to the key of the airlight table(s) it is built from.
+std::string surface_key_suffix(double exponent, int t_samples, int angle_samples) {
+  char suffix[96];
+  std::snprintf(suffix, sizeof suffix, "; surface v1 n=%.17g %dx%d", exponent, t_samples, angle_samples);
+  return suffix;
+}
+
 // Several equal-sized tables (one per Legendre order) kept as one EXR, stacked along y.
 std::optional<std::vector<std::vector<float>>> load_stacked(const std::filesystem::path& file, const std::string& key, int width,
                                                             int height, int count) {
@@ -469,9 +476,7 @@ LegendreSurfaceTables::LegendreSurfaceTables(const LegendreAirlightTables& legen
 LegendreSurfaceTables LegendreSurfaceTables::cached(const LegendreAirlightTables& legendre, double exponent,
                                                     const std::filesystem::path& dir, int t_samples, int angle_samples,
                                                     int threads, bool* from_cache) {
-  char suffix[96];
-  std::snprintf(suffix, sizeof suffix, "; surface v1 n=%.17g %dx%d", exponent, t_samples, angle_samples);
-  const std::string key = legendre.key() + suffix;
+  const std::string key = legendre.key() + surface_key_suffix(exponent, t_samples, angle_samples);
   auto file = table_file(dir, "legendre-surface", key);
   if (auto tables = load_stacked(file, key, t_samples, angle_samples, legendre.terms())) {
     if (from_cache) *from_cache = true;
@@ -510,9 +515,7 @@ LegendreAirlightTables LegendreAirlightTables::cached(int terms, const std::file
 
 SurfaceAirlightTable SurfaceAirlightTable::cached(const AirlightTable& airlight, double exponent, const std::filesystem::path& dir,
                                                  int t_samples, int angle_samples, int threads, bool* from_cache) {
-  char suffix[96];
-  std::snprintf(suffix, sizeof suffix, "; surface v1 n=%.17g %dx%d", exponent, t_samples, angle_samples);
-  std::string key = airlight.key() + suffix;
+  const std::string key = airlight.key() + surface_key_suffix(exponent, t_samples, angle_samples);
   auto file = table_file(dir, exponent == 0.0 ? "surface-lambert" : "surface-phong", key);
   if (auto values = load_table(file, key, t_samples, angle_samples)) {
     if (from_cache) *from_cache = true;
