@@ -76,7 +76,7 @@ BENCHMARK(BM_AirlightFrame<false>)->Name("analytic/airlight_1080p_4_lights/scala
 // with dynamic g changing every frame (0.58 and 0.62 in turn), one method object kept across
 // frames (its Legendre tables stay in memory; they come from a disk cache built before timing).
 // Arg 1: the Highway airlight (simd::install); arg 0: core's float64 airlight loop.
-void BM_AnalyticFrame(benchmark::State& state) {
+Scene frame_scene() {
   Scene scene;
   scene.camera.position = Vec3(0, 1.5, 6);
   scene.camera.look_at = Vec3(0, 1, 0);
@@ -90,6 +90,11 @@ void BM_AnalyticFrame(benchmark::State& state) {
                   PointLight{Vec3(0.3, 2.8, -0.5), Rgb(8)}, PointLight{Vec3(-2.0, 0.5, 1.5), Rgb(2, 1, 1)}};
   scene.surfaces = {{Plane{Vec3(0), Vec3(0, 1, 0)}, Rgb(0.5), Rgb(0.0), 1.0},
                     {Sphere{Vec3(0.4, 0.6, 0.8), 0.6}, Rgb(0.6, 0.25, 0.2), Rgb(0.4), 24.0}};
+  return scene;
+}
+
+void BM_AnalyticFrame(benchmark::State& state) {
+  Scene scene = frame_scene();
   RenderOptions options;
   options.threads = static_cast<int>(state.range(1));
   options.settings = {{"dynamic_g_tolerance", 1e-2}};
@@ -110,5 +115,17 @@ void BM_AnalyticFrame(benchmark::State& state) {
   state.SetLabel(state.range(0) ? "simd airlight" : "float64 airlight");
 }
 BENCHMARK(BM_AnalyticFrame)->Name("analytic/frame_1080p_4_lights_dynamic_g/simd,threads")->Args({1, 2})->Args({0, 2})->UseRealTime()->Unit(benchmark::kMillisecond);
+
+// Every table the frame needs, built from scratch (no cache, a fresh method object): the dynamic-g
+// airlight orders and the per-order J1 and J_24 tables. The issue's budget is 2 s.
+void BM_FrameTables(benchmark::State& state) {
+  Scene scene = frame_scene();
+  scene.camera.width_px = 4, scene.camera.height_px = 4;
+  RenderOptions options;
+  options.threads = 2;
+  options.settings = {{"dynamic_g_tolerance", 1e-2}};
+  for (auto _ : state) benchmark::DoNotOptimize(create_method("analytic")->render(scene, options).stats);
+}
+BENCHMARK(BM_FrameTables)->Name("analytic/frame_tables_dynamic_g/threads:2")->UseRealTime()->Unit(benchmark::kMillisecond)->Iterations(1);
 
 }  // namespace

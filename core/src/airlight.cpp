@@ -10,6 +10,7 @@
 #include <map>
 #include <optional>
 #include <thread>
+#include <unordered_map>
 
 namespace haze {
 
@@ -203,12 +204,6 @@ LegendreAirlightTables::LegendreAirlightTables(int terms, int a_samples, int eta
   const size_t cells = static_cast<size_t>(na_) * static_cast<size_t>(neta_);
   tables_.assign(static_cast<size_t>(terms_), std::vector<float>(cells, 0.0f));
   parallel_for(neta_, threads, 1, [&](long long j0, long long j1) {
-    std::vector<double> p(static_cast<size_t>(terms_));
-    auto legendre = [&](double x) {  // P_0 .. P_{terms-1} at x
-      p[0] = 1.0;
-      if (terms_ > 1) p[1] = x;
-      for (int k = 2; k < terms_; ++k) p[static_cast<size_t>(k)] = ((2.0 * k - 1.0) * x * p[static_cast<size_t>(k - 1)] - (k - 1.0) * p[static_cast<size_t>(k - 2)]) / k;
-    };
     for (auto j = static_cast<int>(j0); j < j1; ++j) {
       double eta0 = -AirlightTable::kEtaMax + 2.0 * AirlightTable::kEtaMax * j / (neta_ - 1);
       double w0 = std::exp(eta0);
@@ -216,18 +211,41 @@ LegendreAirlightTables::LegendreAirlightTables(int terms, int a_samples, int eta
         double m = static_cast<double>(i) / (na_ - 1);
         size_t cell = static_cast<size_t>(j) * static_cast<size_t>(na_) + static_cast<size_t>(i);
         if (i == na_ - 1) {
-          legendre(-std::tanh(eta0));
           double scale = (1.0 + w0) * (1.0 + w0) / (1.0 + w0 * w0);
-          for (int k = 0; k < terms_; ++k) tables_[static_cast<size_t>(k)][cell] = static_cast<float>(p[static_cast<size_t>(k)] * scale);
+          for (int k = 0; k < terms_; ++k)
+            tables_[static_cast<size_t>(k)][cell] = static_cast<float>(std::legendre(static_cast<unsigned>(k), -std::tanh(eta0)) * scale);
           continue;
         }
         double a = m * m / (1.0 - m * m), u = a / (1.0 + w0);
-        auto f = [&](double eta, double* out) {
-          double weight = std::exp(-u * (std::exp(eta) - w0)) / std::cosh(eta);
-          legendre(-std::tanh(eta));
-          for (int k = 0; k < terms_; ++k) out[k] = weight * p[static_cast<size_t>(k)];
+        // In psi = pi - 2 atan(e^eta) the tail is a finite, smooth integral (e^eta = cot(psi/2),
+        // deta / cosh eta = -dpsi, -tanh eta = -cos psi):
+        //   K_k = integral_0^psi0 e^(-u (cot(psi/2) - cot(psi0/2))) P_k(-cos psi) dpsi,
+        // the exponent's difference written without cancellation. A few panels resolve it where the
+        // eta form needed dozens over its long tail.
+        const double psi0 = 2.0 * std::atan(1.0 / w0), sin_half0 = std::sin(0.5 * psi0);
+        auto f = [&](const double* psi, int count, double* out) {
+          constexpr int kMax = 15;  // nodes per Gauss-Kronrod panel
+          double x[kMax], prev[kMax], cur[kMax];
+          const auto terms = static_cast<size_t>(terms_);
+          for (int q = 0; q < count; ++q) {
+            double s = std::sin(0.5 * psi[q]);
+            cur[q] = u == 0.0 ? 1.0 : s > 0.0 ? std::exp(-u * std::sin(0.5 * (psi0 - psi[q])) / (s * sin_half0)) : 0.0;
+            x[q] = -std::cos(psi[q]);
+            prev[q] = 0.0;
+          }
+          // weight P_k by (k + 1) P_{k+1} = (2k + 1) x P_k - k P_{k-1}, across the panel's nodes at once
+          // (one serial chain per node made this recurrence the build's bottleneck).
+          for (size_t k = 0; k < terms; ++k) {
+            for (int q = 0; q < count; ++q) out[static_cast<size_t>(q) * terms + k] = cur[q];
+            const double c_a = (2.0 * static_cast<double>(k) + 1.0) / (static_cast<double>(k) + 1.0);
+            const double c_b = static_cast<double>(k) / (static_cast<double>(k) + 1.0);
+            for (int q = 0; q < count; ++q) {
+              double next = c_a * x[q] * cur[q] - c_b * prev[q];
+              prev[q] = cur[q], cur[q] = next;
+            }
+          }
         };
-        auto k_values = integrate_adaptive_vector(f, terms_, eta0, std::max(eta0, 0.0) + 45.0, 1e-5, 1 << 14);
+        auto k_values = integrate_adaptive_nodes(f, terms_, 0.0, psi0, 1e-5, 1 << 14);
         for (int k = 0; k < terms_; ++k)
           tables_[static_cast<size_t>(k)][cell] = static_cast<float>(k_values[static_cast<size_t>(k)] * 0.5 * (1.0 + w0) * (1.0 + a));
       }
@@ -362,26 +380,47 @@ AirlightTable AirlightTable::cached(const PhaseFunction& phase, const std::files
   return built;
 }
 
-double AirlightTable::tail(double u, double eta0) const {
-  double w0 = std::exp(std::min(eta0, 700.0));
-  double a = u * (1.0 + w0);
-  double m = std::sqrt(a / (1.0 + a));
-  double fa = (std::isfinite(a) ? m : 1.0) * (na_ - 1);
-  double fe = (std::clamp(eta0, -kEtaMax, kEtaMax) + kEtaMax) / (2.0 * kEtaMax) * (neta_ - 1);
-  int i = std::min(static_cast<int>(fa), na_ - 2), j = std::min(static_cast<int>(fe), neta_ - 2);
-  // Bicubic Catmull-Rom: T's curvature limits bilinear lookups to ~3e-3 at these sizes.
-  double wx[4], wy[4];
-  catmull_rom_weights(fa - i, wx);
-  catmull_rom_weights(fe - j, wy);
-  double t = 0.0;
-  for (int k = 0; k < 4; ++k) {
-    size_t row = static_cast<size_t>(std::clamp(j - 1 + k, 0, neta_ - 1)) * static_cast<size_t>(na_);
-    double sum = 0.0;
-    for (int l = 0; l < 4; ++l) sum += wx[l] * static_cast<double>(t_[row + static_cast<size_t>(std::clamp(i - 1 + l, 0, na_ - 1))]);
-    t += wy[k] * sum;
+namespace {
+
+// The bicubic (Catmull-Rom) stencil of K(u, eta0) on an a x eta table, shared by every table on
+// that grid (one per Legendre order): K = scale * sum_q weight[q] T[offset[q]].
+struct TailStencil {
+  size_t offset[16];
+  double weight[16];
+  double scale;
+
+  TailStencil(int na, int neta, double u, double eta0) {
+    double w0 = std::exp(std::min(eta0, 700.0));
+    double a = u * (1.0 + w0);
+    double m = std::sqrt(a / (1.0 + a));
+    double fa = (std::isfinite(a) ? m : 1.0) * (na - 1);
+    double fe = (std::clamp(eta0, -AirlightTable::kEtaMax, AirlightTable::kEtaMax) + AirlightTable::kEtaMax) /
+                (2.0 * AirlightTable::kEtaMax) * (neta - 1);
+    int i = std::min(static_cast<int>(fa), na - 2), j = std::min(static_cast<int>(fe), neta - 2);
+    // Bicubic: T's curvature limits bilinear lookups to ~3e-3 at the default sizes.
+    double wx[4], wy[4];
+    catmull_rom_weights(fa - i, wx);
+    catmull_rom_weights(fe - j, wy);
+    for (int k = 0; k < 4; ++k) {
+      size_t row = static_cast<size_t>(std::clamp(j - 1 + k, 0, neta - 1)) * static_cast<size_t>(na);
+      for (int l = 0; l < 4; ++l) {
+        offset[4 * k + l] = row + static_cast<size_t>(std::clamp(i - 1 + l, 0, na - 1));
+        weight[4 * k + l] = wy[k] * wx[l];
+      }
+    }
+    scale = 2.0 / ((1.0 + w0) * (1.0 + a));
   }
-  return 2.0 * t / ((1.0 + w0) * (1.0 + a));
-}
+
+  double operator()(const std::vector<float>& table) const {
+    double t = 0.0;
+    for (int q = 0; q < 16; ++q) t += weight[q] * static_cast<double>(table[offset[q]]);
+    return scale * t;
+  }
+};
+
+}  // namespace
+
+double AirlightTable::tail(double u, double eta0) const { return TailStencil(na_, neta_, u, eta0)(t_); }
 
 double AirlightTable::eval(const AirlightMedium& medium, const AirlightSegment& segment) const {
   check(medium, segment);
@@ -417,44 +456,99 @@ double azimuth_integral(double A, double B, double n) {
     gauss_legendre(48, r.first, r.second);
     return r;
   }();
+  // Integer exponents (the usual Phong n) by repeated squaring: std::pow dominated the table build.
+  const bool integer = n == std::floor(n) && n <= 65536.0;
+  const auto ni = static_cast<unsigned>(n);
+  auto power = [&](double x) {
+    if (!integer) return std::pow(x, n);
+    double result = 1.0;
+    for (unsigned e = ni; e; e >>= 1, x *= x)
+      if (e & 1u) result *= x;
+    return result;
+  };
   double sum = 0.0;
   for (size_t q = 0; q < rule.first.size(); ++q) {
     double phi = 0.5 * phi_c * (rule.first[q] + 1.0);
-    sum += rule.second[q] * std::pow(std::max(0.0, A * std::cos(phi) + B), n);
+    sum += rule.second[q] * power(std::max(0.0, A * std::cos(phi) + B));
   }
   return 2.0 * 0.5 * phi_c * sum;  // symmetric in phi
+}
+
+// J for several tail tables on one a x eta grid (one per Legendre order, or a single one): the
+// azimuthal integral and the lookup stencil at each node are shared by all of them, and one
+// adaptive quadrature serves every table (its error is relative to the largest, order 0).
+// Returns per table (1 + T) J, T fastest.
+std::vector<std::vector<float>> surface_tables(const std::vector<const std::vector<float>*>& tails, int a_samples,
+                                               int eta_samples, double exponent, int t_samples, int angle_samples,
+                                               int threads) {
+  if (!(exponent >= 0.0 && exponent <= 1e5)) throw Error("shininess", to_text(exponent), "a Phong exponent in [0, 1e5]");
+  if (t_samples < 2 || angle_samples < 2) throw Error("samples", to_text(t_samples) + " x " + to_text(angle_samples), "at least 2 x 2");
+  const bool lambert = exponent == 0.0;
+  const double n = lambert ? 1.0 : exponent;
+  const double scale = lambert ? 1.0 / kPi : (n + 2.0) / (2.0 * kPi);
+  const int count = static_cast<int>(tails.size());
+  const size_t cells = static_cast<size_t>(t_samples) * static_cast<size_t>(angle_samples);
+  std::vector<std::vector<float>> j(tails.size(), std::vector<float>(cells, 0.0f));
+  // The tails interleaved (all tables' values for one grid cell together): a stencil then reads 16
+  // short runs instead of 16 scattered values from each table.
+  const size_t grid = tails[0]->size();
+  std::vector<double> interleaved(grid * tails.size());
+  for (size_t c = 0; c < grid; ++c)
+    for (size_t q = 0; q < tails.size(); ++q) interleaved[c * tails.size() + q] = static_cast<double>((*tails[q])[c]);
+  parallel_for(angle_samples, threads, 1, [&](long long k0, long long k1) {
+    for (auto k = static_cast<int>(k0); k < k1; ++k) {
+      double angle = kPi * k / (angle_samples - 1);
+      // Phi depends on gamma and the angle only, and the bisections for different T share most
+      // nodes: computed once per node.
+      std::unordered_map<double, double> phi_at;
+      for (int i = 0; i < t_samples; ++i) {
+        double m = static_cast<double>(i) / (t_samples - 1);
+        double T = i == t_samples - 1 ? 1e12 : m / (1.0 - m);
+        // Incident directions around the light: the lobe axis (normal or R) sits at `angle`.
+        auto f = [&](double gamma, double* out) {
+          auto [it, added] = phi_at.try_emplace(gamma, 0.0);
+          if (added) it->second = azimuth_integral(std::sin(gamma) * std::sin(angle), std::cos(gamma) * std::cos(angle), n);
+          const double phi = it->second;
+          if (phi == 0.0) {
+            std::fill(out, out + count, 0.0);
+            return;
+          }
+          TailStencil stencil(a_samples, eta_samples, T * std::sin(gamma), std::log(std::tan(0.5 * gamma)));
+          std::fill(out, out + count, 0.0);
+          for (int l = 0; l < 16; ++l) {
+            const double* run = interleaved.data() + stencil.offset[l] * tails.size();
+            const double w = phi * stencil.scale * stencil.weight[l];
+            for (int q = 0; q < count; ++q) out[q] += w * run[q];
+          }
+        };
+        // Phi has kinks where the lobe's horizon enters the circle of directions at gamma (cos(gamma
+        // +- angle) = 0): integrating between them spares the quadrature from bisecting into them.
+        const double kinks[2] = {std::abs(0.5 * kPi - angle), std::min(0.5 * kPi + angle, 1.5 * kPi - angle)};
+        std::vector<double> values(tails.size(), 0.0);
+        double lo = 0.0;
+        for (double hi : {std::min(kinks[0], kinks[1]), std::max(kinks[0], kinks[1]), kPi}) {
+          if (hi <= lo) continue;
+          auto piece = integrate_adaptive_vector(f, count, lo, hi, 1e-5, 2048);
+          for (size_t q = 0; q < values.size(); ++q) values[q] += piece[q];
+          lo = hi;
+        }
+        size_t cell = static_cast<size_t>(k) * static_cast<size_t>(t_samples) + static_cast<size_t>(i);
+        for (int q = 0; q < count; ++q) j[static_cast<size_t>(q)][cell] = static_cast<float>((1.0 + T) * scale * values[static_cast<size_t>(q)]);
+      }
+    }
+  });
+  return j;
 }
 
 }  // namespace
 
 SurfaceAirlightTable::SurfaceAirlightTable(const AirlightTable& airlight, double exponent, int t_samples, int angle_samples,
                                            int threads)
-    : exponent_(exponent), nt_(t_samples), na_(angle_samples) {
-  if (!(exponent >= 0.0 && exponent <= 1e5)) throw Error("shininess", to_text(exponent), "a Phong exponent in [0, 1e5]");
-  if (t_samples < 2 || angle_samples < 2) throw Error("samples", to_text(t_samples) + " x " + to_text(angle_samples), "at least 2 x 2");
-  const bool lambert = exponent == 0.0;
-  const double n = lambert ? 1.0 : exponent;
-  const double scale = lambert ? 1.0 / kPi : (n + 2.0) / (2.0 * kPi);
-  j_.assign(static_cast<size_t>(nt_) * static_cast<size_t>(na_), 0.0f);
-  parallel_for(na_, threads, 1, [&](long long k0, long long k1) {
-    for (auto k = static_cast<int>(k0); k < k1; ++k) {
-      double angle = kPi * k / (na_ - 1);
-      for (int i = 0; i < nt_; ++i) {
-        double m = static_cast<double>(i) / (nt_ - 1);
-        double T = i == nt_ - 1 ? 1e12 : m / (1.0 - m);
-        // Incident directions around the light: the lobe axis (normal or R) sits at `angle`.
-        auto f = [&](double gamma) {
-          double A = std::sin(gamma) * std::sin(angle), B = std::cos(gamma) * std::cos(angle);
-          return airlight.tail(T * std::sin(gamma), std::log(std::tan(0.5 * gamma))) * azimuth_integral(A, B, n);
-        };
-        // Relative 1e-4, or absolute 1e-7 / (1 + T) for the near-cancelling integrals of high
-        // Legendre orders.
-        double j = scale * integrate_adaptive(f, 0.0, kPi, 1e-4, 1e-7 / (1.0 + T), 2048).value;
-        j_[static_cast<size_t>(k) * static_cast<size_t>(nt_) + static_cast<size_t>(i)] = static_cast<float>((1.0 + T) * j);
-      }
-    }
-  });
-}
+    : exponent_(exponent),
+      nt_(t_samples),
+      na_(angle_samples),
+      j_(std::move(surface_tables({&airlight.values()}, airlight.a_samples(), airlight.eta_samples(), exponent, t_samples,
+                                  angle_samples, threads)[0])) {}
 
 std::string LegendreAirlightTables::key() const {
   return "legendre-tail v1; orders " + std::to_string(terms_) + "; " + std::to_string(na_) + "x" + std::to_string(neta_);
@@ -469,8 +563,9 @@ AirlightTable LegendreAirlightTables::order(int k) const {
 LegendreSurfaceTables::LegendreSurfaceTables(const LegendreAirlightTables& legendre, double exponent, int t_samples,
                                              int angle_samples, int threads)
     : exponent_(exponent), nt_(t_samples), na_(angle_samples) {
-  for (int k = 0; k < legendre.terms(); ++k)
-    j_.push_back(SurfaceAirlightTable(legendre.order(k), exponent, t_samples, angle_samples, threads).j_);
+  std::vector<const std::vector<float>*> tails;
+  for (const auto& table : legendre.tables_) tails.push_back(&table);
+  j_ = surface_tables(tails, legendre.na_, legendre.neta_, exponent, t_samples, angle_samples, threads);
 }
 
 LegendreSurfaceTables LegendreSurfaceTables::cached(const LegendreAirlightTables& legendre, double exponent,

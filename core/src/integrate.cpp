@@ -78,6 +78,15 @@ IntegrationResult integrate_adaptive(const std::function<double(double)>& f, dou
 
 std::vector<double> integrate_adaptive_vector(const std::function<void(double, double*)>& f, int dims, double a, double b,
                                               double rel_tol, int max_intervals) {
+  const auto n = static_cast<size_t>(std::max(dims, 0));
+  auto each = [&](const double* x, int count, double* out) {
+    for (int q = 0; q < count; ++q) f(x[q], out + static_cast<size_t>(q) * n);
+  };
+  return integrate_adaptive_nodes(each, dims, a, b, rel_tol, max_intervals);
+}
+
+std::vector<double> integrate_adaptive_nodes(const std::function<void(const double*, int, double*)>& f, int dims, double a,
+                                             double b, double rel_tol, int max_intervals) {
   if (!(std::isfinite(a) && std::isfinite(b))) throw Error("integration bounds", to_text(a) + ", " + to_text(b), "finite bounds");
   if (dims < 1) throw Error("dims", to_text(dims), "at least 1 component");
   const auto n = static_cast<size_t>(dims);
@@ -86,26 +95,25 @@ std::vector<double> integrate_adaptive_vector(const std::function<void(double, d
     std::vector<double> value;
     bool operator<(const Piece& o) const { return error < o.error; }
   };
-  std::vector<double> fx(n), left(n), sum_k(n), sum_g(n);
+  // Nodes in the order c, c - x_0, c + x_0, c - x_1, ...; values node-major.
+  double x[15];
+  std::vector<double> fx(15 * n);
   auto rule = [&](double lo, double hi) {
     double c = 0.5 * (lo + hi), h = 0.5 * (hi - lo);
-    std::fill(sum_k.begin(), sum_k.end(), 0.0);
-    std::fill(sum_g.begin(), sum_g.end(), 0.0);
-    f(c, fx.data());
-    for (size_t d = 0; d < n; ++d) sum_k[d] = kWk[7] * fx[d], sum_g[d] = kWg[3] * fx[d];
-    for (int j = 0; j < 7; ++j) {
-      double x = h * kXk[j];
-      f(c - x, left.data());
-      f(c + x, fx.data());
-      for (size_t d = 0; d < n; ++d) {
-        double s = left[d] + fx[d];
-        sum_k[d] += kWk[j] * s;
-        if (j % 2 == 1) sum_g[d] += kWg[j / 2] * s;
-      }
-    }
+    x[0] = c;
+    for (int j = 0; j < 7; ++j) x[1 + 2 * j] = c - h * kXk[j], x[2 + 2 * j] = c + h * kXk[j];
+    f(x, 15, fx.data());
     Piece p{lo, hi, 0.0, std::vector<double>(n)};
-    for (size_t d = 0; d < n; ++d) p.value[d] = sum_k[d] * h;
-    for (size_t d = 0; d < n; ++d) p.error = std::max(p.error, std::abs((sum_k[d] - sum_g[d]) * h));
+    for (size_t d = 0; d < n; ++d) {
+      double kronrod = kWk[7] * fx[d], gauss = kWg[3] * fx[d];
+      for (size_t j = 0; j < 7; ++j) {
+        double sum = fx[(1 + 2 * j) * n + d] + fx[(2 + 2 * j) * n + d];
+        kronrod += kWk[j] * sum;
+        if (j % 2 == 1) gauss += kWg[j / 2] * sum;
+      }
+      p.value[d] = kronrod * h;
+      p.error = std::max(p.error, std::abs((kronrod - gauss) * h));
+    }
     return p;
   };
   std::priority_queue<Piece> work;

@@ -184,6 +184,29 @@ TEST(Airlight, LegendreTablesFollowGWithinTheTruncationBound) {
   }
 }
 
+// Dynamic g for the surface airlight: the per-order J tables summed for g reproduce the J tables
+// built from HG(g)'s own airlight table (both Lambert and Phong), to the truncation bound plus
+// the tables' interpolation error.
+TEST(Airlight, LegendreSurfaceTablesMatchDirectTables) {
+  const double g = 0.3;
+  LegendreAirlightTables legendre(24, 128, 256);
+  ASSERT_LT(LegendreAirlightTables::truncation_bound(g, 24), 1e-9);
+  AirlightTable direct(PhaseFunction::henyey_greenstein(g), 128, 256);
+  for (double exponent : {0.0, 20.0}) {
+    auto summed = LegendreSurfaceTables(legendre, exponent, 24, 24).combine_hg(g, 24).values();
+    auto exact = SurfaceAirlightTable(direct, exponent, 24, 24).values();
+    ASSERT_EQ(summed.size(), exact.size());
+    double worst = 0.0, largest = 0.0;
+    for (size_t i = 0; i < exact.size(); ++i) {
+      worst = std::max(worst, std::abs(static_cast<double>(summed[i] - exact[i])));
+      largest = std::max(largest, std::abs(static_cast<double>(exact[i])));
+    }
+    EXPECT_LT(worst, 2e-3 * largest) << "exponent " << exponent;
+    std::printf("J (exponent %g) from 24 Legendre orders vs from HG(%.1f): worst difference %.1e of the largest value\n",
+                exponent, g, worst / largest);
+  }
+}
+
 // Tables cached as EXR: the second request reads what the first wrote, bit for bit; a file
 // written for other parameters is not taken for this one.
 TEST(Airlight, TablesRoundTripThroughTheCache) {

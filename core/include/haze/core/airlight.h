@@ -150,6 +150,7 @@ class LegendreAirlightTables {
       : terms_(terms), na_(a_samples), neta_(eta_samples), tables_(std::move(tables)) {}
   int terms_, na_, neta_;
   std::vector<std::vector<float>> tables_;  // per order: K_k (1 + w0) (1 + a) / 2, a fastest
+  friend class LegendreSurfaceTables;
 };
 
 // Batches of view segments for fast airlight evaluation (structure of arrays, float32): start

@@ -22,4 +22,9 @@ IntegrationResult integrate_adaptive(const std::function<double(double)>& f, dou
 std::vector<double> integrate_adaptive_vector(const std::function<void(double, double*)>& f, int dims, double a, double b,
                                               double rel_tol = 1e-10, int max_intervals = 4096);
 
+// The same with the integrand called once per Gauss-Kronrod panel: f(x, count, out) writes
+// out[q * dims + d] for the `count` nodes x[q], so it can vectorize across nodes.
+std::vector<double> integrate_adaptive_nodes(const std::function<void(const double*, int, double*)>& f, int dims, double a,
+                                             double b, double rel_tol = 1e-10, int max_intervals = 4096);
+
 }  // namespace haze
