@@ -1,0 +1,42 @@
+// Optical depth from a light to every cell of an extinction volume (seed 003 sec. 4.3: the opacity
+// propagation volume), three ways. Values are density integrals, integral of rho ds from the cell
+// centre to the light in scene units; multiply by sigma_t per channel. The density is the grid's,
+// constant over each cell (zero outside the grid).
+#pragma once
+
+#include <haze/core/light.h>
+#include <haze/grids/grid.h>
+
+#include <string>
+
+namespace haze::grids {
+
+enum class DepthScheme {
+  exact,  // a DDA walk from each cell centre to the light: the ground truth, O(n^4)
+  paper,  // seed 003 eq. 6-7: 6-neighbour weighted gathering, iterated as a wavefront until converged
+  sweep,  // short characteristics: one ordered pass outward from the light (BEYOND.md)
+};
+DepthScheme depth_scheme_from_name(const std::string& name);  // "exact", "paper", "sweep"
+const char* name(DepthScheme scheme);
+
+struct DepthStats {
+  int iterations = 0;  // paper: wavefront iterations until converged; 1 otherwise
+};
+
+// One volume of the density's size per light: point and spot lights (the cone does not matter
+// here) inside or outside the grid, and directional lights. A light exactly at a cell centre is
+// fine (that cell's depth is 0). Throws haze::Error for a sky light or a non-finite position or
+// direction.
+// sweep_layers: how many cell layers each short characteristic walks exactly before it
+// interpolates; more layers mean fewer interpolations along a path (less blurring of shadows)
+// for more work per cell (docs/PROPAGATION.md measures the trade).
+DenseGrid optical_depth(const DenseGrid& density, const Light& light, DepthScheme scheme, DepthStats* stats = nullptr,
+                        int sweep_layers = 4);
+
+// integral of the grid's piecewise-constant density along the segment a -> b (DDA, exact).
+double density_integral_dda(const DenseGrid& density, const Vec3& a, const Vec3& b);
+
+// Trilinear sample of cell-centred values (clamped to the edge cells), and 0 outside the bounds.
+float sample_trilinear(const DenseGrid& grid, const Vec3& p);
+
+}  // namespace haze::grids
