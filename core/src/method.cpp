@@ -107,6 +107,16 @@ double Settings::number(const std::string& key, double fallback, double min, dou
   return it->get<double>();
 }
 
+std::string Settings::choice(const std::string& key, const std::string& fallback, const std::vector<std::string>& allowed) {
+  known_.push_back(key);
+  auto it = settings_.find(key);
+  if (it == settings_.end()) return fallback;
+  if (it->is_string() && std::find(allowed.begin(), allowed.end(), it->get<std::string>()) != allowed.end()) return it->get<std::string>();
+  std::string names;
+  for (const auto& a : allowed) names += (names.empty() ? "\"" : ", \"") + a + "\"";
+  throw Error("method." + key, it->dump(), "one of " + names);
+}
+
 void Settings::reject_unknown() const {
   for (const auto& [key, value] : settings_.items()) {
     if (key == "name" || std::find(known_.begin(), known_.end(), key) != known_.end()) continue;

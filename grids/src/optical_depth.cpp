@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <optional>
 
 namespace haze::grids {
 
@@ -88,9 +89,9 @@ double exact_depth(const DenseGrid& grid, const LightGeometry& g, const Vec3& x)
   return distance > 0.0 ? integrate_ray(grid, x, dir, distance) : 0.0;
 }
 
-void compute_exact(const DenseGrid& density, const LightGeometry& g, DenseGrid& out) {
+void compute_exact(const DenseGrid& density, const LightGeometry& g, DenseGrid& out, int threads) {
   const auto& n = density.resolution();
-  parallel_for(n[2], 0, 1, [&](long long k0, long long k1) {
+  parallel_for(n[2], threads, 1, [&](long long k0, long long k1) {
     for (auto k = static_cast<int>(k0); k < k1; ++k)
       for (int j = 0; j < n[1]; ++j)
         for (int i = 0; i < n[0]; ++i) out.at(i, j, k) = static_cast<float>(exact_depth(density, g, density.cell_center(i, j, k)));
@@ -102,7 +103,7 @@ void compute_exact(const DenseGrid& density, const LightGeometry& g, DenseGrid& 
 // K(X) is the cell's density times the W-weighted cell length (the paper's grid has unit cells).
 // Jacobi iterations from zero until nothing changes (the dependencies run upwind only, so that
 // happens after at most the longest upwind path) or nx + ny + nz + 1 iterations.
-int compute_paper(const DenseGrid& density, const LightGeometry& g, DenseGrid& out) {
+int compute_paper(const DenseGrid& density, const LightGeometry& g, DenseGrid& out, int threads) {
   const auto& n = density.resolution();
   const Vec3 h = density.cell_size(), lo = density.bounds().lo;
   // The light's own cell, when it is inside: the exact distance from its centre.
@@ -114,7 +115,7 @@ int compute_paper(const DenseGrid& density, const LightGeometry& g, DenseGrid& o
   const int max_iterations = n[0] + n[1] + n[2] + 1;
   for (bool changed = true; changed && iterations < max_iterations; ++iterations) {
     std::atomic<bool> any{false};
-    parallel_for(n[2], 0, 1, [&](long long k0, long long k1) {
+    parallel_for(n[2], threads, 1, [&](long long k0, long long k1) {
       bool local = false;
       for (auto k = static_cast<int>(k0); k < k1; ++k)
         for (int j = 0; j < n[1]; ++j)
@@ -239,7 +240,7 @@ struct Sweeper {
   }
 };
 
-void compute_sweep(const DenseGrid& density, const LightGeometry& g, DenseGrid& out, int layers) {
+void compute_sweep(const DenseGrid& density, const LightGeometry& g, DenseGrid& out, int layers, int threads) {
   Sweeper sweeper(density, g, out, layers);
   const auto& n = density.resolution();
   if (g.directional) {
@@ -250,7 +251,7 @@ void compute_sweep(const DenseGrid& density, const LightGeometry& g, DenseGrid& 
     const int na = n[static_cast<size_t>(a)];
     for (int layer = 0; layer < na; ++layer) {
       const int l = g.to_light[a] > 0.0 ? na - 1 - layer : layer;
-      parallel_for(n[static_cast<size_t>(c)], 0, 8, [&](long long c0, long long c1) {
+      parallel_for(n[static_cast<size_t>(c)], threads, 8, [&](long long c0, long long c1) {
         int idx[3];
         idx[a] = l;
         for (auto ic = static_cast<int>(c0); ic < c1; ++ic)
@@ -280,7 +281,7 @@ void compute_sweep(const DenseGrid& density, const LightGeometry& g, DenseGrid& 
     const int z0 = std::max(lc[2] - r, 0), z1 = std::min(lc[2] + r, n[2] - 1);
     const int y0 = std::max(lc[1] - r, 0), y1 = std::min(lc[1] + r, n[1] - 1);
     for (int pass = 1; pass <= 3; ++pass) {
-      parallel_for(z1 - z0 + 1, 0, 8, [&](long long k0, long long k1) {
+      parallel_for(z1 - z0 + 1, threads, 8, [&](long long k0, long long k1) {
         for (int k = z0 + static_cast<int>(k0); k < z0 + k1; ++k)
           for (int j = y0; j <= y1; ++j) {
             const bool on_z = std::abs(k - lc[2]) == r, on_y = std::abs(j - lc[1]) == r;
@@ -319,17 +320,34 @@ const char* name(DepthScheme scheme) {
   return "?";
 }
 
-DenseGrid optical_depth(const DenseGrid& density, const Light& light, DepthScheme scheme, DepthStats* stats, int sweep_layers) {
-  if (sweep_layers < 1 || sweep_layers > 64) throw Error("sweep_layers", to_text(sweep_layers), "an integer in [1, 64]");
+DenseGrid optical_depth(const DenseGrid& density, const Light& light, const DepthOptions& options, DepthStats* stats) {
+  if (options.sweep_layers < 1 || options.sweep_layers > 64)
+    throw Error("sweep_layers", to_text(options.sweep_layers), "an integer in [1, 64]");
   const LightGeometry g = geometry(light);
   DenseGrid out(density.resolution(), density.bounds());
   int iterations = 1;
-  switch (scheme) {
-    case DepthScheme::exact: compute_exact(density, g, out); break;
-    case DepthScheme::paper: iterations = compute_paper(density, g, out); break;
-    case DepthScheme::sweep: compute_sweep(density, g, out, sweep_layers); break;
+  switch (options.scheme) {
+    case DepthScheme::exact: compute_exact(density, g, out, options.threads); break;
+    case DepthScheme::paper: iterations = compute_paper(density, g, out, options.threads); break;
+    case DepthScheme::sweep: compute_sweep(density, g, out, options.sweep_layers, options.threads); break;
   }
-  if (stats) stats->iterations = iterations;
+  if (stats) stats->iterations = std::max(stats->iterations, iterations);
+  return out;
+}
+
+std::vector<DenseGrid> optical_depths(const DenseGrid& density, const std::vector<Light>& lights, const DepthOptions& options,
+                                      DepthStats* stats) {
+  for (const auto& light : lights) geometry(light);  // errors before any work
+  std::vector<std::optional<DenseGrid>> volumes(lights.size());
+  std::vector<DepthStats> per_light(lights.size());
+  parallel_for(static_cast<long long>(lights.size()), options.threads, 1, [&](long long l0, long long l1) {
+    for (auto l = static_cast<size_t>(l0); l < static_cast<size_t>(l1); ++l) volumes[l] = optical_depth(density, lights[l], options, &per_light[l]);
+  });
+  std::vector<DenseGrid> out;
+  for (size_t l = 0; l < lights.size(); ++l) {
+    out.push_back(std::move(*volumes[l]));
+    if (stats) stats->iterations = std::max(stats->iterations, per_light[l].iterations);
+  }
   return out;
 }
 

@@ -60,8 +60,8 @@ TEST(OpticalDepth, SweepAndExactAgreeInAHomogeneousGrid) {
   DenseGrid g = constant_grid(24, 0.5f);
   for (const Light& light : {Light{PointLight{Vec3(0.13, -0.21, 0.05)}}, Light{PointLight{Vec3(2.5, 1.2, -1.7)}},
                              Light{DirectionalLight{glm::normalize(Vec3(-0.3, -1.0, 0.45))}}}) {
-    DenseGrid exact = optical_depth(g, light, DepthScheme::exact);
-    DenseGrid sweep = optical_depth(g, light, DepthScheme::sweep);
+    DenseGrid exact = optical_depth(g, light, {DepthScheme::exact});
+    DenseGrid sweep = optical_depth(g, light, {DepthScheme::sweep});
     ErrorStats e = compare(sweep, exact, 1e-3);
     EXPECT_LT(e.max, 1e-4) << light.index();
   }
@@ -75,8 +75,8 @@ TEST(OpticalDepth, SweepIsWithinTwoPercentOfExactInAHeterogeneousMedium) {
   DenseGrid g = cloud(64);
   for (const Light& light : {Light{PointLight{Vec3(0.05, 0.1, -0.02)}}, Light{PointLight{Vec3(1.8, 1.1, 0.6)}},
                              Light{DirectionalLight{glm::normalize(Vec3(0.4, -1.0, 0.3))}}}) {
-    DenseGrid exact = optical_depth(g, light, DepthScheme::exact);
-    DenseGrid sweep = optical_depth(g, light, DepthScheme::sweep);
+    DenseGrid exact = optical_depth(g, light, {DepthScheme::exact});
+    DenseGrid sweep = optical_depth(g, light, {DepthScheme::sweep});
     ErrorStats e = compare(sweep, exact, 0.1);
     std::printf("sweep vs exact, light %zu: mean |error| / mean depth %.2e; where depth >= 0.1: mean %.2e, max %.2e\n",
                 light.index(), e.mean_abs_over_mean, e.mean, e.max);
@@ -92,8 +92,8 @@ TEST(OpticalDepth, PaperGatheringOverestimatesDiagonals) {
   DenseGrid g({n, n, n}, {Vec3(0), Vec3(n)});
   std::fill(g.values().begin(), g.values().end(), 1.0f);
   DepthStats stats;
-  DenseGrid paper = optical_depth(g, PointLight{Vec3(0.5)}, DepthScheme::paper, &stats);
-  DenseGrid exact = optical_depth(g, PointLight{Vec3(0.5)}, DepthScheme::exact);
+  DenseGrid paper = optical_depth(g, PointLight{Vec3(0.5)}, {DepthScheme::paper}, &stats);
+  DenseGrid exact = optical_depth(g, PointLight{Vec3(0.5)}, {DepthScheme::exact});
   EXPECT_GT(stats.iterations, 1);
   EXPECT_NEAR(paper.at(n - 1, 0, 0) / exact.at(n - 1, 0, 0), 1.0, 1e-4);
   EXPECT_NEAR(paper.at(n - 1, n - 1, 0) / exact.at(n - 1, n - 1, 0), std::sqrt(2.0), 0.02);
@@ -103,12 +103,12 @@ TEST(OpticalDepth, PaperGatheringOverestimatesDiagonals) {
 TEST(OpticalDepth, LightAtACellCentreAndBadLights) {
   DenseGrid g = constant_grid(8, 1.0f);
   for (auto scheme : {DepthScheme::exact, DepthScheme::paper, DepthScheme::sweep}) {
-    DenseGrid t = optical_depth(g, PointLight{g.cell_center(3, 4, 5)}, scheme);
+    DenseGrid t = optical_depth(g, PointLight{g.cell_center(3, 4, 5)}, {scheme});
     EXPECT_EQ(t.at(3, 4, 5), 0.0f) << name(scheme);
     for (float v : t.values()) EXPECT_TRUE(std::isfinite(v)) << name(scheme);
   }
-  EXPECT_THROW(optical_depth(g, SkyLight{}, DepthScheme::sweep), Error);
-  EXPECT_THROW(optical_depth(g, PointLight{Vec3(std::nan(""))}, DepthScheme::sweep), Error);
+  EXPECT_THROW(optical_depth(g, SkyLight{}), Error);
+  EXPECT_THROW(optical_depth(g, PointLight{Vec3(std::nan(""))}), Error);
   EXPECT_THROW(depth_scheme_from_name("fast"), Error);
 }
 

@@ -55,6 +55,8 @@ class Settings {
   Settings(const nlohmann::json& settings, std::string method);
   long long integer(const std::string& key, long long fallback, long long min, long long max);
   double number(const std::string& key, double fallback, double min, double max);
+  // A string that must be one of `allowed`.
+  std::string choice(const std::string& key, const std::string& fallback, const std::vector<std::string>& allowed);
   // Throws for any key not read by integer() or number().
   void reject_unknown() const;
 

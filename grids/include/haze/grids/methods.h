@@ -3,8 +3,8 @@
 
 namespace haze::grids {
 
-// Registers every grid-based method this build has; safe to call more than once. Today there is
-// none yet: heterogeneous single scattering (propagation) and discrete ordinates (dom) land here.
+// Registers every grid-based method this build has (today "propagation"; discrete ordinates will
+// land here too); safe to call more than once.
 void register_methods();
 
 }  // namespace haze::grids

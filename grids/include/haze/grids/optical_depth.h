@@ -8,6 +8,7 @@
 #include <haze/grids/grid.h>
 
 #include <string>
+#include <vector>
 
 namespace haze::grids {
 
@@ -19,6 +20,15 @@ enum class DepthScheme {
 DepthScheme depth_scheme_from_name(const std::string& name);  // "exact", "paper", "sweep"
 const char* name(DepthScheme scheme);
 
+struct DepthOptions {
+  DepthScheme scheme = DepthScheme::sweep;
+  // sweep: how many cell layers each short characteristic walks exactly before it interpolates;
+  // more layers mean fewer interpolations along a path (less blurring of shadows) for more work
+  // per cell (docs/PROPAGATION.md measures the trade).
+  int sweep_layers = 4;
+  int threads = 0;  // 0: every core oneTBB offers
+};
+
 struct DepthStats {
   int iterations = 0;  // paper: wavefront iterations until converged; 1 otherwise
 };
@@ -26,12 +36,13 @@ struct DepthStats {
 // One volume of the density's size per light: point and spot lights (the cone does not matter
 // here) inside or outside the grid, and directional lights. A light exactly at a cell centre is
 // fine (that cell's depth is 0). Throws haze::Error for a sky light or a non-finite position or
-// direction.
-// sweep_layers: how many cell layers each short characteristic walks exactly before it
-// interpolates; more layers mean fewer interpolations along a path (less blurring of shadows)
-// for more work per cell (docs/PROPAGATION.md measures the trade).
-DenseGrid optical_depth(const DenseGrid& density, const Light& light, DepthScheme scheme, DepthStats* stats = nullptr,
-                        int sweep_layers = 4);
+// direction. The result does not depend on the thread count.
+DenseGrid optical_depth(const DenseGrid& density, const Light& light, const DepthOptions& options = {}, DepthStats* stats = nullptr);
+
+// Every light's volume, the lights spread over threads (the paper packs four lights per texture
+// and pass; here each light is one pass over its own volume, lights in parallel).
+std::vector<DenseGrid> optical_depths(const DenseGrid& density, const std::vector<Light>& lights, const DepthOptions& options = {},
+                                      DepthStats* stats = nullptr);
 
 // integral of the grid's piecewise-constant density along the segment a -> b (DDA, exact).
 double density_integral_dda(const DenseGrid& density, const Vec3& a, const Vec3& b);

@@ -1,0 +1,50 @@
+// Heterogeneous single scattering on grids (seed 003), the pieces of method "propagation" for
+// callers who keep them between frames: the extinction volume (inject once, re-inject only what a
+// moved blob touches), one optical-depth volume per light (re-propagate when lights move), and the
+// ray marcher over both.
+#pragma once
+
+#include <haze/core/method.h>
+#include <haze/core/scene.h>
+#include <haze/grids/grid.h>
+
+#include <memory>
+#include <vector>
+
+namespace haze::grids {
+
+// The medium's density on a grid over its bounds, with the medium's coefficients.
+struct ExtinctionVolume {
+  DenseGrid density;
+  Rgb sigma_t_scale{1.0}, albedo{0.8};
+  PhaseFunction phase;
+};
+
+struct VolumeReport {
+  double truncation_bound = 0.0;  // RBF injection: see InjectionReport
+};
+
+// From the scene's medium: an RBF density is injected into `resolution` cells along the longest
+// axis of its bounds (the others in proportion; an unbounded RBF medium gets the box where every
+// blob has fallen below the injection cutoff), a grid density is taken as it is, a constant
+// density fills a grid over the medium's bounds (it must have bounds).
+// Throws haze::Error for a scene without a medium or with an unbounded constant one.
+ExtinctionVolume make_extinction_volume(const Scene& scene, int resolution = 64, double cutoff = 0.0, int threads = 0,
+                                        VolumeReport* report = nullptr);
+
+struct MarchSettings {
+  double step_cells = 0.5;  // ray-march step as a fraction of the smallest cell side
+};
+
+// Seed 003 eq. 8-10 in Haze's conventions: along each camera ray inside the volume, in steps,
+//   L += T_cam albedo (1 - e^(-sigma_t rho step)) sum_lights p(wi . wo) E_light e^(-sigma_t depth_light),
+// with density and depths trilinear at the step's midpoint and T_cam the transmittance so far
+// (the (1 - e^-tau) form keeps thick steps energy-conserving, where eq. 8's K_t step does not).
+// Surfaces (Lambert/Phong) are lit through the depth volume (or, outside it, a DDA walk through
+// the density) and seen through T_cam; no surface shadows. depths[i] belongs to scene.lights[i].
+Image march_image(const Scene& scene, const ExtinctionVolume& volume, const std::vector<DenseGrid>& depths,
+                  const MarchSettings& settings, const RenderOptions& options);
+
+std::unique_ptr<Method> make_propagation_method();
+
+}  // namespace haze::grids
