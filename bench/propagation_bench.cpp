@@ -1,0 +1,100 @@
+// Method "propagation" (seed 003), stage by stage, at the sizes on this machine and at the
+// seed's own table 2/3 settings (20^3 to 40^3 volumes, 1 to 8 lights, 800 x 600, up to 27000 RBFs).
+// Run: build/release/bench/haze_bench_propagation --benchmark_repetitions=3 --benchmark_report_aggregates_only=true
+#include <haze/core/rng.h>
+#include <haze/grids/optical_depth.h>
+#include <haze/grids/propagation.h>
+#include <haze/grids/rbf.h>
+
+#include <benchmark/benchmark.h>
+
+namespace {
+
+using namespace haze;
+using namespace haze::grids;
+
+const Aabb kBounds{Vec3(-1.0), Vec3(1.0)};
+
+// count blobs on a jittered lattice filling the box, each reaching about 0.1 at the 1e-4 cutoff.
+std::vector<RbfBlob> lattice_blobs(int count) {
+  const int side = std::max(1, static_cast<int>(std::lround(std::cbrt(count))));
+  Rng rng(11);
+  std::vector<RbfBlob> blobs;
+  for (int i = 0; i < count; ++i) {
+    Vec3 cell(i % side, (i / side) % side, i / (side * side));
+    Vec3 jitter(rng.uniform(), rng.uniform(), rng.uniform());
+    blobs.push_back({-0.8 + 1.6 * (cell + jitter) / static_cast<double>(side), 0.5 + rng.uniform(), 1.6 * side});
+  }
+  return blobs;
+}
+
+std::vector<Light> lights(int count) {
+  const std::vector<Light> all = {PointLight{Vec3(0.2, 0.3, -0.1)},  PointLight{Vec3(1.6, 1.2, 0.4)},
+                                  PointLight{Vec3(-0.5, -0.2, 0.6)}, PointLight{Vec3(-1.5, 0.8, -1.9)},
+                                  PointLight{Vec3(0.7, -0.6, 0.2)},  PointLight{Vec3(0.0, 2.0, 0.0)},
+                                  PointLight{Vec3(-0.3, 0.5, -0.5)}, PointLight{Vec3(1.1, -1.4, 1.3)}};
+  return {all.begin(), all.begin() + count};
+}
+
+DenseGrid cloud(int n, int blobs) {
+  DenseGrid grid({n, n, n}, kBounds);
+  inject_rbf(lattice_blobs(blobs), grid);
+  return grid;
+}
+
+// Args: blobs, cells per side.
+void BM_Inject(benchmark::State& state) {
+  const auto blobs = lattice_blobs(static_cast<int>(state.range(0)));
+  const int n = static_cast<int>(state.range(1));
+  DenseGrid grid({n, n, n}, kBounds);
+  size_t updates = 0;
+  for (auto _ : state) {
+    std::fill(grid.values().begin(), grid.values().end(), 0.0f);
+    updates = inject_rbf(blobs, grid, 0.0, 2).cell_updates;
+  }
+  state.counters["cell_updates"] = static_cast<double>(updates);
+  state.counters["updates_per_second"] = benchmark::Counter(static_cast<double>(updates), benchmark::Counter::kIsIterationInvariantRate);
+}
+BENCHMARK(BM_Inject)->Name("propagation/inject/blobs,cells")->Args({27000, 128})->Args({27000, 20})->Args({1000, 20})->Args({1, 20})
+    ->UseRealTime()->Unit(benchmark::kMillisecond);
+
+// Args: cells per side, lights, scheme (0 exact, 1 paper, 2 sweep), sweep layers.
+void BM_OpticalDepth(benchmark::State& state) {
+  const int n = static_cast<int>(state.range(0));
+  const DenseGrid grid = cloud(n, 1000);
+  const auto ls = lights(static_cast<int>(state.range(1)));
+  DepthOptions options;
+  options.scheme = static_cast<DepthScheme>(state.range(2));
+  options.sweep_layers = static_cast<int>(state.range(3));
+  options.threads = 2;
+  for (auto _ : state) benchmark::DoNotOptimize(optical_depths(grid, ls, options));
+  state.counters["cell_lights_per_second"] =
+      benchmark::Counter(static_cast<double>(grid.cell_count() * ls.size()), benchmark::Counter::kIsIterationInvariantRate);
+  state.SetLabel(name(options.scheme));
+}
+BENCHMARK(BM_OpticalDepth)->Name("propagation/optical_depth/cells,lights,scheme,layers")
+    ->Args({128, 4, 2, 4})->Args({128, 4, 2, 1})->Args({64, 4, 2, 4})->Args({64, 4, 0, 1})->Args({64, 4, 1, 1})
+    ->Args({20, 1, 1, 1})->Args({40, 4, 1, 1})->Args({20, 1, 2, 4})->Args({40, 8, 2, 4})
+    ->UseRealTime()->Unit(benchmark::kMillisecond);
+
+// Args: width, height, cells per side, lights. Ray marching only (volumes built beforehand).
+void BM_March(benchmark::State& state) {
+  const int n = static_cast<int>(state.range(2));
+  Scene scene;
+  scene.camera.position = Vec3(0.4, 0.5, 3.4);
+  scene.camera.look_at = Vec3(0.0);
+  scene.camera.width_px = static_cast<int>(state.range(0)), scene.camera.height_px = static_cast<int>(state.range(1));
+  scene.lights = lights(static_cast<int>(state.range(3)));
+  ExtinctionVolume volume{cloud(n, 1000), Rgb(2.0), Rgb(0.9), PhaseFunction::henyey_greenstein(0.4)};
+  const auto depths = optical_depths(volume.density, scene.lights);
+  RenderOptions options;
+  options.threads = 2;
+  for (auto _ : state) benchmark::DoNotOptimize(march_image(scene, volume, depths, {}, options).data().data());
+  state.counters["pixels_per_second"] =
+      benchmark::Counter(static_cast<double>(state.range(0) * state.range(1)), benchmark::Counter::kIsIterationInvariantRate);
+}
+BENCHMARK(BM_March)->Name("propagation/march/width,height,cells,lights")
+    ->Args({512, 512, 128, 4})->Args({512, 512, 64, 4})->Args({800, 600, 20, 1})->Args({800, 600, 40, 4})->Args({800, 600, 40, 8})
+    ->UseRealTime()->Unit(benchmark::kMillisecond);
+
+}  // namespace
