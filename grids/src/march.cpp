@@ -3,11 +3,39 @@
 #include <haze/grids/optical_depth.h>
 #include <haze/grids/propagation.h>
 
+#include <algorithm>
 #include <cmath>
 
 namespace haze::grids {
 
 namespace {
+
+// Trilinear weights of one point on the volume's cell-centred grid (clamped at the edge cells),
+// computed once per step and applied to the density and to every light's depth.
+struct Stencil {
+  size_t offset[8];
+  double weight[8];
+
+  Stencil(const DenseGrid& grid, const Vec3& p) {
+    const Vec3 u = (p - grid.bounds().lo) / grid.cell_size() - 0.5;
+    const auto& n = grid.resolution();
+    size_t i[2][3];
+    double f[3];
+    for (int a = 0; a < 3; ++a) {
+      const double fl = std::floor(u[a]);
+      f[a] = u[a] - fl;
+      const int last = n[static_cast<size_t>(a)] - 1;
+      i[0][a] = static_cast<size_t>(std::clamp(static_cast<int>(fl), 0, last));
+      i[1][a] = static_cast<size_t>(std::clamp(static_cast<int>(fl) + 1, 0, last));
+    }
+    const auto nx = static_cast<size_t>(n[0]), nxy = nx * static_cast<size_t>(n[1]);
+    for (int m = 0; m < 8; ++m) {
+      const int bi = m & 1, bj = (m >> 1) & 1, bk = (m >> 2) & 1;
+      offset[m] = i[bk][2] * nxy + i[bj][1] * nx + i[bi][0];
+      weight[m] = (bi ? f[0] : 1 - f[0]) * (bj ? f[1] : 1 - f[1]) * (bk ? f[2] : 1 - f[2]);
+    }
+  }
+};
 
 struct Marcher {
   const Scene& scene;
@@ -15,6 +43,16 @@ struct Marcher {
   const std::vector<DenseGrid>& depths;
   Rgb sigma_t;
   double step;
+  // The lights' depths interleaved (all lights of a cell together): one stencil reads 8 short runs.
+  std::vector<float> packed;
+
+  Marcher(const Scene& s, const ExtinctionVolume& v, const std::vector<DenseGrid>& d, double step_length)
+      : scene(s), volume(v), depths(d), sigma_t(v.sigma_t_scale), step(step_length) {
+    const size_t lights = depths.size(), cells = volume.density.cell_count();
+    packed.resize(cells * lights);
+    for (size_t c = 0; c < cells; ++c)
+      for (size_t l = 0; l < lights; ++l) packed[c * lights + l] = depths[l].values()[c];
+  }
 
   // Density integral from x to the light: the volume's value inside it, a DDA walk outside.
   double depth_to_light(size_t l, const Vec3& x, const LightArrival& a) const {
@@ -33,15 +71,23 @@ struct Marcher {
     if (volume.density.bounds().clip(ray, t0, t1) && t1 > t0) {
       const int steps = static_cast<int>(std::ceil((t1 - t0) / step));
       const double dt = (t1 - t0) / steps;
+      const size_t lights = scene.lights.size();
+      std::vector<double> depth(lights);
       for (int s = 0; s < steps; ++s) {
         const Vec3 x = ray.at(t0 + (s + 0.5) * dt);
-        const double rho = static_cast<double>(sample_trilinear(volume.density, x));
+        const Stencil stencil(volume.density, x);
+        double rho = 0.0;
+        for (int m = 0; m < 8; ++m) rho += stencil.weight[m] * static_cast<double>(volume.density.values()[stencil.offset[m]]);
         if (rho <= 0.0) continue;
+        std::fill(depth.begin(), depth.end(), 0.0);
+        for (int m = 0; m < 8; ++m) {
+          const float* run = packed.data() + stencil.offset[m] * lights;
+          for (size_t l = 0; l < lights; ++l) depth[l] += stencil.weight[m] * static_cast<double>(run[l]);
+        }
         Rgb in(0.0);
-        for (size_t l = 0; l < scene.lights.size(); ++l) {
+        for (size_t l = 0; l < lights; ++l) {
           if (!arrival(scene.lights[l], x, a) || a.irradiance == Rgb(0.0)) continue;
-          const double depth = static_cast<double>(sample_trilinear(depths[l], x));
-          in += volume.phase.eval(-a.to_light, -ray.direction) * a.irradiance * glm::exp(-sigma_t * depth);
+          in += volume.phase.eval(-a.to_light, -ray.direction) * a.irradiance * glm::exp(-sigma_t * depth[l]);
         }
         const Rgb tau = sigma_t * rho * dt;
         const Rgb absorbed = Rgb(1.0) - glm::exp(-tau);
@@ -71,7 +117,7 @@ Image march_image(const Scene& scene, const ExtinctionVolume& volume, const std:
     throw Error("depths", to_text(depths.size()) + " volumes", "one per light (" + to_text(scene.lights.size()) + ")");
   if (!(settings.step_cells > 0.0)) throw Error("step", to_text(settings.step_cells), "a step > 0 cells");
   const Vec3 h = volume.density.cell_size();
-  const Marcher marcher{scene, volume, depths, volume.sigma_t_scale, settings.step_cells * std::min({h.x, h.y, h.z})};
+  const Marcher marcher(scene, volume, depths, settings.step_cells * std::min({h.x, h.y, h.z}));
   const Camera& camera = scene.camera;
   Image image(camera.width_px, camera.height_px);
   ProgressTracker progress(options.progress, camera.height_px);
