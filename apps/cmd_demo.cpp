@@ -75,7 +75,7 @@ int run(const DemoArgs& a) {
   }
   std::printf("rel. error: RMSE over pixels and channels divided by the reference's RMS; the reference's row\n"
               "gives its own noise (RMS standard error over RMS radiance) on the same scale. The reference\n"
-              "solves the full transport: single-scattering methods (analytic, quadrature) also differ by the\n"
+              "solves the full transport: single-scattering methods (analytic, propagation, quadrature) also differ by the\n"
               "multiple scattering and shadows they leave out.\n");
   return rendered > 0 ? 0 : 1;
 }

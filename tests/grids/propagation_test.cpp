@@ -3,6 +3,8 @@
 #include <haze/core/error.h>
 #include <haze/core/method.h>
 #include <haze/grids/methods.h>
+#include <haze/grids/optical_depth.h>
+#include <haze/grids/propagation.h>
 
 #include <gtest/gtest.h>
 
@@ -79,6 +81,25 @@ TEST(Propagation, DoesNotDependOnTheThreadCount) {
     one.settings = two.settings = {{"optical_depth", scheme}, {"resolution", 24}};
     EXPECT_EQ(render(scene, "propagation", one).radiance.data(), render(scene, "propagation", two).radiance.data()) << scheme;
   }
+}
+
+// Seed 003 table 1: the stages kept apart. Moving a light re-propagates only its depth volume over
+// the same extinction volume; the image equals a full render of the moved scene. A grid-file
+// medium holding the injected values renders the same as the RBF medium.
+TEST(Propagation, StagesKeptApartGiveTheFullRendersResult) {
+  register_methods();
+  Scene scene = cloud_scene(20, 16);
+  RenderOptions options;
+  options.settings = {{"resolution", 32}};
+  const ExtinctionVolume volume = make_extinction_volume(scene, 32);
+  scene.lights[0] = PointLight{Vec3(-0.4, 0.8, 0.2), Rgb(2.0)};
+  std::vector<DenseGrid> depths = optical_depths(volume.density, scene.lights);
+  EXPECT_EQ(march_image(scene, volume, depths, {}, options).data(), render(scene, "propagation", options).radiance.data());
+
+  Scene from_file = scene;
+  from_file.medium->bounds = volume.density.bounds();
+  from_file.medium->density = GridDensity{volume.density.resolution(), volume.density.values()};
+  EXPECT_EQ(render(from_file, "propagation").radiance.data(), render(scene, "propagation", options).radiance.data());
 }
 
 TEST(Propagation, BadSettingsAndLightsAreRejected) {
