@@ -2,6 +2,8 @@
 #include <haze/core/progress.h>
 #include <haze/grids/optical_depth.h>
 
+#include "trilinear.h"
+
 #include <algorithm>
 #include <atomic>
 #include <cmath>
@@ -359,22 +361,9 @@ double density_integral_dda(const DenseGrid& density, const Vec3& a, const Vec3&
 
 float sample_trilinear(const DenseGrid& grid, const Vec3& p) {
   if (!grid.bounds().contains(p)) return 0.0f;
-  const Vec3 u = (p - grid.bounds().lo) / grid.cell_size() - 0.5;
-  const auto& n = grid.resolution();
-  int i0[3], i1[3];
-  double f[3];
-  for (int a = 0; a < 3; ++a) {
-    double fl = std::floor(u[a]);
-    f[a] = u[a] - fl;
-    const int last = n[static_cast<size_t>(a)] - 1;
-    i0[a] = std::clamp(static_cast<int>(fl), 0, last), i1[a] = std::clamp(static_cast<int>(fl) + 1, 0, last);
-  }
+  const TrilinearStencil stencil(grid, p);
   double v = 0.0;
-  for (int m = 0; m < 8; ++m) {
-    const int bi = m & 1, bj = (m >> 1) & 1, bk = (m >> 2) & 1;
-    const double w = (bi ? f[0] : 1 - f[0]) * (bj ? f[1] : 1 - f[1]) * (bk ? f[2] : 1 - f[2]);
-    v += w * static_cast<double>(grid.at(bi ? i1[0] : i0[0], bj ? i1[1] : i0[1], bk ? i1[2] : i0[2]));
-  }
+  for (int m = 0; m < 8; ++m) v += stencil.weight[m] * static_cast<double>(grid.values()[stencil.offset[m]]);
   return static_cast<float>(v);
 }
 
