@@ -554,12 +554,6 @@ std::string LegendreAirlightTables::key() const {
   return "legendre-tail v1; orders " + std::to_string(terms_) + "; " + std::to_string(na_) + "x" + std::to_string(neta_);
 }
 
-AirlightTable LegendreAirlightTables::order(int k) const {
-  if (k < 0 || k >= terms_) throw Error("order", to_text(k), "a Legendre order below " + to_text(terms_));
-  std::string origin = key() + "; order " + std::to_string(k);
-  return AirlightTable(PhaseFunction::isotropic(), na_, neta_, tables_[static_cast<size_t>(k)], origin);
-}
-
 LegendreSurfaceTables::LegendreSurfaceTables(const LegendreAirlightTables& legendre, double exponent, int t_samples,
                                              int angle_samples, int threads)
     : exponent_(exponent), nt_(t_samples), na_(angle_samples) {

@@ -32,8 +32,8 @@ struct Marcher {
   // Density integral from x to the light: the volume's value inside it, a DDA walk outside.
   double depth_to_light(size_t l, const Vec3& x, const LightArrival& a) const {
     if (volume.density.bounds().contains(x)) return static_cast<double>(sample_trilinear(depths[l], x));
-    const double reach = std::isfinite(a.distance) ? a.distance : 1e30;
-    return density_integral_dda(volume.density, x, x + a.to_light * std::min(reach, 1e30));
+    const double reach = std::isfinite(a.distance) ? a.distance : 1e30;  // directional: past any grid
+    return density_integral_dda(volume.density, x, x + a.to_light * reach);
   }
 
   Rgb pixel(const Ray& ray) const {
@@ -64,10 +64,9 @@ struct Marcher {
           if (!arrival(scene.lights[l], x, a) || a.irradiance == Rgb(0.0)) continue;
           in += volume.phase.eval(-a.to_light, -ray.direction) * a.irradiance * glm::exp(-sigma_t * depth[l]);
         }
-        const Rgb tau = sigma_t * rho * dt;
-        const Rgb absorbed = Rgb(1.0) - glm::exp(-tau);
-        radiance += transmittance * volume.albedo * absorbed * in;
-        transmittance *= Rgb(1.0) - absorbed;
+        const Rgb step_transmittance = glm::exp(-sigma_t * rho * dt);
+        radiance += transmittance * volume.albedo * (Rgb(1.0) - step_transmittance) * in;
+        transmittance *= step_transmittance;
       }
     }
     if (!hit) return radiance + transmittance * scene.background;

@@ -88,8 +88,11 @@ double exact_depth(const DenseGrid& grid, const LightGeometry& g, const Vec3& x)
   Vec3 dir;
   double distance;
   toward(g, x, dir, distance);
-  return distance > 0.0 ? integrate_ray(grid, x, dir, distance) : 0.0;
+  return integrate_ray(grid, x, dir, distance);
 }
+
+// The axis along which a direction, in cell units q = |dir| / h, crosses cell layers fastest.
+int dominant_axis(const Vec3& q) { return q.x >= q.y ? (q.x >= q.z ? 0 : 2) : (q.y >= q.z ? 1 : 2); }
 
 void compute_exact(const DenseGrid& density, const LightGeometry& g, DenseGrid& out, int threads) {
   const auto& n = density.resolution();
@@ -154,14 +157,14 @@ int compute_paper(const DenseGrid& density, const LightGeometry& g, DenseGrid& o
   return iterations;
 }
 
-// Short characteristics (BEYOND.md): from the cell centre toward the light to the plane of the
-// next cell layer along the dominant axis, the optical depth there interpolated from that layer's
-// four nearest cells, plus the trapezoid of the density over the step. What is interpolated is
-// the mean density along each cell's path to the light (its depth over the length of that path
-// inside the grid), then multiplied by the landing point's own path length: depth itself curves
-// near the light and kinks where the exit face changes, the mean density does neither in a
-// homogeneous medium, where the sweep is then exact. Cells whose step would leave the grid or pass
-// the light take the exact DDA (a segment of at most two cells).
+// Short characteristics (BEYOND.md): from the cell centre toward the light to the plane `layers`
+// cell layers away along the dominant axis, walked exactly (DDA); beyond it, the depth is
+// interpolated from that layer's four nearest cells. What is interpolated is the mean density
+// along each cell's path to the light (its depth over the length of that path inside the grid),
+// then multiplied by the landing point's own path length: depth itself curves near the light and
+// kinks where the exit face changes, the mean density does neither in a homogeneous medium, where
+// the sweep is then exact. Cells whose step would leave the grid or pass the light take the exact
+// DDA all the way.
 struct Sweeper {
   const DenseGrid& density;
   const LightGeometry& g;
@@ -192,15 +195,11 @@ struct Sweeper {
     double distance;
     toward(g, x, dir, distance);
     const double length = inside_length(x, dir, distance);
-    if (near_light || distance == 0.0) {
-      store(i, j, k, distance > 0.0 ? integrate_ray(density, x, dir, distance) : 0.0, length);
-      return;
-    }
-    // Dominant axis in cell units, and the step to the plane `layers` cell layers toward the light.
+    // The step to the plane `layers` cell layers toward the light along the dominant axis.
     const Vec3 q = glm::abs(dir) / h;
-    const int a = q.x >= q.y ? (q.x >= q.z ? 0 : 2) : (q.y >= q.z ? 1 : 2);
+    const int a = dominant_axis(q);
     const double s = layers / q[a];
-    if (length <= s || distance <= s) {
+    if (near_light || length <= s || distance <= s) {
       store(i, j, k, integrate_ray(density, x, dir, distance), length);
       return;
     }
@@ -247,8 +246,7 @@ void compute_sweep(const DenseGrid& density, const LightGeometry& g, DenseGrid& 
   const auto& n = density.resolution();
   if (g.directional) {
     // Layers along the dominant axis from the face toward the light; each depends on the last.
-    const Vec3 q = glm::abs(g.to_light) / density.cell_size();
-    const int a = q.x >= q.y ? (q.x >= q.z ? 0 : 2) : (q.y >= q.z ? 1 : 2);
+    const int a = dominant_axis(glm::abs(g.to_light) / sweeper.h);
     const int b = (a + 1) % 3, c = (a + 2) % 3;
     const int na = n[static_cast<size_t>(a)];
     for (int layer = 0; layer < na; ++layer) {
@@ -270,9 +268,8 @@ void compute_sweep(const DenseGrid& density, const LightGeometry& g, DenseGrid& 
   // also on face cells, corners (three) also on edges: three passes per shell keep every
   // dependency computed first (with steps of several layers too). Shells up to the step (the
   // light's neighbourhood) are exact.
-  const Vec3 h = density.cell_size(), lo = density.bounds().lo;
   int lc[3];
-  for (int a = 0; a < 3; ++a) lc[a] = static_cast<int>(std::floor((g.position[a] - lo[a]) / h[a]));
+  for (int a = 0; a < 3; ++a) lc[a] = static_cast<int>(std::floor((g.position[a] - sweeper.lo[a]) / sweeper.h[a]));
   int r_min = 0, r_max = 0;
   for (int a = 0; a < 3; ++a) {
     const int last = n[static_cast<size_t>(a)] - 1;

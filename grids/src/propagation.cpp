@@ -33,13 +33,13 @@ class PropagationMethod final : public Method {
     const double cutoff = settings.number("cutoff", 0.0, 0.0, 1e30);
     settings.reject_unknown();
 
+    for (size_t i = 0; i < scene.lights.size(); ++i)
+      if (std::holds_alternative<SkyLight>(scene.lights[i]))
+        throw Error("lights[" + std::to_string(i) + "].type", "sky", "point, spot or directional lights for the propagation method");
     auto start = std::chrono::steady_clock::now();
     VolumeReport report;
     const ExtinctionVolume volume = make_extinction_volume(scene, resolution, cutoff, options.threads, &report);
     const double inject_seconds = seconds_since(start);
-    for (size_t i = 0; i < scene.lights.size(); ++i)
-      if (std::holds_alternative<SkyLight>(scene.lights[i]))
-        throw Error("lights[" + std::to_string(i) + "].type", "sky", "point, spot or directional lights for the propagation method");
     start = std::chrono::steady_clock::now();
     DepthStats depth_stats;
     const std::vector<DenseGrid> depths = optical_depths(volume.density, scene.lights, depth, &depth_stats);

@@ -21,14 +21,6 @@ void validate(const std::vector<RbfBlob>& blobs) {
   }
 }
 
-double default_cutoff(const std::vector<RbfBlob>& blobs, double cutoff) {
-  if (std::isnan(cutoff)) throw Error("cutoff", "NaN", "a density >= 0 (0: 1e-4 of the largest weight)");
-  if (cutoff > 0.0) return cutoff;
-  double largest = 0.0;
-  for (const auto& b : blobs) largest = std::max(largest, b.weight);
-  return largest > 0.0 ? 1e-4 * largest : 1.0;
-}
-
 double support_radius(const RbfBlob& b, double cutoff) {
   return b.weight > cutoff ? std::sqrt(std::log(b.weight / cutoff)) / b.sharpness : -1.0;
 }
@@ -87,6 +79,14 @@ size_t inject_parallel(const std::vector<RbfBlob>& blobs, DenseGrid& grid, doubl
 
 }  // namespace
 
+double injection_cutoff(const std::vector<RbfBlob>& blobs, double cutoff) {
+  if (std::isnan(cutoff)) throw Error("cutoff", "NaN", "a density >= 0 (0: 1e-4 of the largest weight)");
+  if (cutoff > 0.0) return cutoff;
+  double largest = 0.0;
+  for (const auto& b : blobs) largest = std::max(largest, b.weight);
+  return largest > 0.0 ? 1e-4 * largest : 1.0;
+}
+
 Aabb blob_support(const RbfBlob& blob, double cutoff) {
   double r = support_radius(blob, cutoff);
   if (r < 0.0) return {Vec3(kInfinity), Vec3(-kInfinity)};
@@ -96,7 +96,7 @@ Aabb blob_support(const RbfBlob& blob, double cutoff) {
 InjectionReport inject_rbf(const std::vector<RbfBlob>& blobs, DenseGrid& grid, double cutoff, int threads) {
   validate(blobs);
   InjectionReport report;
-  report.cutoff = default_cutoff(blobs, cutoff);
+  report.cutoff = injection_cutoff(blobs, cutoff);
   const auto& n = grid.resolution();
   report.cell_updates = inject_parallel(blobs, grid, report.cutoff, {0, 0, 0}, n, threads);
   // A blob contributes less than cutoff to each cell it skips: the bound counts every blob.
@@ -108,7 +108,7 @@ size_t reinject_region(const std::vector<RbfBlob>& blobs, DenseGrid& grid, const
                        int threads) {
   validate(blobs);
   if (brick_size < 1) throw Error("brick_size", to_text(brick_size), "an integer >= 1");
-  cutoff = default_cutoff(blobs, cutoff);
+  cutoff = injection_cutoff(blobs, cutoff);
   const Vec3 h = grid.cell_size(), origin = grid.bounds().lo;
   std::array<int, 3> lo{}, hi{};
   for (int a = 0; a < 3; ++a) {

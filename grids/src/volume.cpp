@@ -30,9 +30,7 @@ ExtinctionVolume make_extinction_volume(const Scene& scene, int resolution, doub
     if (!bounds.bounded()) {
       // Unbounded: the blobs' supports at the injection cutoff.
       bounds = {Vec3(kInfinity), Vec3(-kInfinity)};
-      double largest = 0.0;
-      for (const auto& b : rbf->blobs) largest = std::max(largest, b.weight);
-      const double c = cutoff > 0.0 ? cutoff : 1e-4 * largest;
+      const double c = injection_cutoff(rbf->blobs, cutoff);
       for (const auto& b : rbf->blobs) {
         Aabb support = blob_support(b, c);
         bounds.lo = glm::min(bounds.lo, support.lo), bounds.hi = glm::max(bounds.hi, support.hi);

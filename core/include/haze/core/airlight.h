@@ -137,8 +137,6 @@ class LegendreAirlightTables {
   AirlightTable combine_hg(double g, int terms = 0) const;
   int terms() const { return terms_; }
 
-  // The tail of order k alone, K_k, as a table (to build per-order surface tables).
-  AirlightTable order(int k) const;
   std::string key() const;
 
   // As AirlightTable::cached: all orders in one EXR, keyed by version, orders and sizes.

@@ -30,6 +30,10 @@ InjectionReport inject_rbf(const std::vector<RbfBlob>& blobs, DenseGrid& grid, d
 size_t reinject_region(const std::vector<RbfBlob>& blobs, DenseGrid& grid, const Aabb& region, double cutoff,
                        int brick_size = 8, int threads = 0);
 
+// The cutoff inject_rbf uses for `cutoff` <= 0: 1e-4 of the largest weight (1 when all are 0);
+// a positive cutoff is returned as it is.
+double injection_cutoff(const std::vector<RbfBlob>& blobs, double cutoff = 0.0);
+
 // A blob's support: the box around its centre beyond which it contributes less than cutoff.
 Aabb blob_support(const RbfBlob& blob, double cutoff);
 
