@@ -77,6 +77,23 @@ BENCHMARK(BM_OpticalDepth)->Name("propagation/optical_depth/cells,lights,scheme,
     ->Args({20, 1, 1, 1})->Args({40, 4, 1, 1})->Args({20, 1, 2, 4})->Args({40, 8, 2, 4})
     ->UseRealTime()->Unit(benchmark::kMillisecond);
 
+// The issue's sweep (128^3, 4 point lights) with the SIMD kernel against its scalar reference, on
+// 1 and 2 threads. Args: threads, scalar kernel (0 or 1).
+void BM_SweepKernel(benchmark::State& state) {
+  const DenseGrid grid = cloud(128, 1000);
+  const auto ls = lights(4);
+  DepthOptions options;
+  options.threads = static_cast<int>(state.range(0));
+  options.scalar_kernel = state.range(1) != 0;
+  for (auto _ : state) benchmark::DoNotOptimize(optical_depths(grid, ls, options));
+  const double cell_lights = static_cast<double>(grid.cell_count() * ls.size());
+  state.counters["cell_lights_per_second"] = benchmark::Counter(cell_lights, benchmark::Counter::kIsIterationInvariantRate);
+  state.counters["ns_per_cell_light"] = benchmark::Counter(1e-9 * cell_lights, benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+  state.SetLabel(options.scalar_kernel ? "scalar" : "simd");
+}
+BENCHMARK(BM_SweepKernel)->Name("propagation/sweep_128_4_lights/threads,scalar")->Args({1, 0})->Args({2, 0})->Args({1, 1})->Args({2, 1})
+    ->UseRealTime()->Unit(benchmark::kMillisecond);
+
 // Args: width, height, cells per side, lights. Ray marching only (volumes built beforehand).
 void BM_March(benchmark::State& state) {
   const int n = static_cast<int>(state.range(2));

@@ -31,6 +31,10 @@ void parallel_for(long long count, int threads, long long grain, const std::func
   if (count <= 0) return;
   grain = std::max(1LL, grain);
   long long chunks = (count + grain - 1) / grain;
+  if (chunks == 1 || threads == 1) {  // no arena to set up for work one thread does anyway
+    for (long long c = 0; c < chunks; ++c) body(c * grain, std::min(count, (c + 1) * grain));
+    return;
+  }
   tbb::task_arena arena(threads > 0 ? threads : tbb::task_arena::automatic);
   arena.execute([&] {
     tbb::parallel_for(tbb::blocked_range<long long>(0, chunks, 1), [&](const tbb::blocked_range<long long>& r) {

@@ -1,6 +1,7 @@
 #include <haze/core/error.h>
 #include <haze/core/progress.h>
 #include <haze/grids/optical_depth.h>
+#include <haze/simd/sweep_cells.h>
 
 #include "trilinear.h"
 
@@ -8,6 +9,7 @@
 #include <atomic>
 #include <cmath>
 #include <optional>
+#include <thread>
 
 namespace haze::grids {
 
@@ -157,146 +159,139 @@ int compute_paper(const DenseGrid& density, const LightGeometry& g, DenseGrid& o
   return iterations;
 }
 
-// Short characteristics (BEYOND.md): from the cell centre toward the light to the plane `layers`
-// cell layers away along the dominant axis, walked exactly (DDA); beyond it, the depth is
-// interpolated from that layer's four nearest cells. What is interpolated is the mean density
-// along each cell's path to the light (its depth over the length of that path inside the grid),
-// then multiplied by the landing point's own path length: depth itself curves near the light and
-// kinks where the exit face changes, the mean density does neither in a homogeneous medium, where
-// the sweep is then exact. Cells whose step would leave the grid or pass the light take the exact
-// DDA all the way.
-struct Sweeper {
-  const DenseGrid& density;
-  const LightGeometry& g;
-  DenseGrid& out;
-  DenseGrid mean;  // depth / path length inside the grid
-  int layers;
-  Vec3 h, lo;
-  std::array<int, 3> n;
-
-  Sweeper(const DenseGrid& d, const LightGeometry& geo, DenseGrid& o, int step_layers)
-      : density(d), g(geo), out(o), mean(d.resolution(), d.bounds()), layers(step_layers), h(d.cell_size()), lo(d.bounds().lo),
-        n(d.resolution()) {}
-
-  // Length of the path from x toward the light inside the grid.
-  double inside_length(const Vec3& x, const Vec3& dir, double distance) const {
-    double t0 = 0.0, t1 = distance;
-    return density.bounds().clip(Ray{x, dir}, t0, t1) && t1 > t0 ? t1 - t0 : 0.0;
+// Short characteristics (BEYOND.md), the formulas of haze/simd/sweep_cells.h: from each cell
+// centre toward the light to the cell-centre plane `layers` layers away along the dominant axis,
+// one density sample per layer; beyond it, the mean density along the landing point's own path
+// (bilinear in that plane) times that path's length. Interpolating the mean density rather than
+// the depth, which curves near the light and kinks where the exit face changes, makes the sweep
+// exact in a homogeneous medium; walking several layers between interpolations keeps the sideways
+// blur of shadows small (docs/PROPAGATION.md). Cells within `layers` shells of a point light walk
+// their whole path. Cells go to the kernel in runs along x (or y), in
+// an order that computes every cell a landing point reads first.
+class Sweeper {
+ public:
+  Sweeper(const DenseGrid& density, const LightGeometry& g, DenseGrid& out, int layers, bool scalar, int exact_radius,
+          const int light_cell[3])
+      : out_(out), mean_(density.resolution(), density.bounds()),
+        kernel_(scalar ? &simd::sweep_cells_reference : &simd::sweep_cells) {
+    const Vec3 h = density.cell_size();
+    for (int e = 0; e < 3; ++e) {
+      volume_.n[e] = density.resolution()[static_cast<size_t>(e)];
+      volume_.lo[e] = static_cast<float>(density.bounds().lo[e]);
+      volume_.h[e] = static_cast<float>(h[e]);
+      volume_.light[e] = static_cast<float>(g.directional ? g.to_light[e] : g.position[e]);
+      volume_.light_cell[e] = light_cell[e];
+    }
+    volume_.density = density.values().data();
+    volume_.mean = mean_.values().data();
+    volume_.directional = g.directional;
+    volume_.layers = layers;
+    volume_.exact_radius = exact_radius;
   }
 
-  void store(int i, int j, int k, double depth, double length) {
-    out.at(i, j, k) = static_cast<float>(depth);
-    mean.at(i, j, k) = static_cast<float>(length > 0.0 ? depth / length : static_cast<double>(density.at(i, j, k)));
+  struct Run {
+    int i, j, k, axis, count;
+  };
+
+  // The runs in parallel (each reads only cells of earlier calls).
+  void sweep(const std::vector<Run>& runs, int threads) {
+    long long cells = 0;
+    for (const Run& r : runs) cells += r.count;
+    const int workers = cells < 4096 ? 1 : threads;  // a thread hand-off costs more than small passes
+    parallel_for(static_cast<long long>(runs.size()), workers, 4, [&](long long r0, long long r1) {
+      std::vector<float> depth, mean;
+      for (auto r = static_cast<size_t>(r0); r < static_cast<size_t>(r1); ++r) {
+        const Run& run = runs[r];
+        depth.resize(static_cast<size_t>(run.count)), mean.resize(static_cast<size_t>(run.count));
+        const size_t first = out_.index(run.i, run.j, run.k);
+        if (run.axis == 0) {  // contiguous: straight into the volumes
+          kernel_(volume_, run.i, run.j, run.k, 0, run.count, &out_.values()[first], &mean_.values()[first]);
+          continue;
+        }
+        depth.resize(static_cast<size_t>(run.count)), mean.resize(static_cast<size_t>(run.count));
+        kernel_(volume_, run.i, run.j, run.k, run.axis, run.count, depth.data(), mean.data());
+        const auto stride = static_cast<size_t>(volume_.n[0]);
+        for (size_t m = 0; m < depth.size(); ++m) {
+          out_.values()[first + m * stride] = depth[m];
+          mean_.values()[first + m * stride] = mean[m];
+        }
+      }
+    });
   }
 
-  void cell(int i, int j, int k, bool near_light) {
-    const Vec3 x = density.cell_center(i, j, k);
-    Vec3 dir;
-    double distance;
-    toward(g, x, dir, distance);
-    const double length = inside_length(x, dir, distance);
-    // The step to the plane `layers` cell layers toward the light along the dominant axis.
-    const Vec3 q = glm::abs(dir) / h;
-    const int a = dominant_axis(q);
-    const double s = layers / q[a];
-    if (near_light || length <= s || distance <= s) {
-      store(i, j, k, integrate_ray(density, x, dir, distance), length);
-      return;
-    }
-    const Vec3 p = x + s * dir;
-    int base[3] = {i, j, k};
-    base[a] += dir[a] > 0.0 ? layers : -layers;
-    const int b = (a + 1) % 3, c = (a + 2) % 3;
-    // Where the landing point lies past the outermost cell centres the ray is on its way out of
-    // the grid sideways: no neighbours to interpolate between, so take the exact (short) walk.
-    bool outside = false;
-    auto split = [&](int axis, int& i0, int& i1, double& f) {
-      double u = (p[axis] - lo[axis]) / h[axis] - 0.5;
-      const int last = n[static_cast<size_t>(axis)] - 1;
-      outside |= u < 0.0 || u > last;
-      double fl = std::floor(u);
-      f = u - fl;
-      i0 = std::clamp(static_cast<int>(fl), 0, last), i1 = std::clamp(static_cast<int>(fl) + 1, 0, last);
-    };
-    int b0, b1, c0, c1;
-    double fb, fc;
-    split(b, b0, b1, fb);
-    split(c, c0, c1, fc);
-    if (outside) {
-      store(i, j, k, integrate_ray(density, x, dir, distance), length);
-      return;
-    }
-    double mean_land = 0.0;
-    const double w[4] = {(1 - fb) * (1 - fc), fb * (1 - fc), (1 - fb) * fc, fb * fc};
-    const int ib[4] = {b0, b1, b0, b1}, ic[4] = {c0, c0, c1, c1};
-    for (int m = 0; m < 4; ++m) {
-      if (w[m] == 0.0) continue;
-      int idx[3];
-      idx[a] = base[a], idx[b] = ib[m], idx[c] = ic[m];
-      mean_land += w[m] * static_cast<double>(mean.at(idx[0], idx[1], idx[2]));
-    }
-    // The step itself is walked exactly (DDA); only the depth beyond it is interpolated.
-    const double depth = (length - s) * mean_land + integrate_ray(density, x, dir, s);
-    store(i, j, k, depth, length);
-  }
+ private:
+  DenseGrid& out_;
+  DenseGrid mean_;  // depth / path length inside the grid, read by later landings
+  simd::SweepVolume volume_;
+  void (*kernel_)(const simd::SweepVolume&, int, int, int, int, int, float*, float*);
 };
 
-void compute_sweep(const DenseGrid& density, const LightGeometry& g, DenseGrid& out, int layers, int threads) {
-  Sweeper sweeper(density, g, out, layers);
+void compute_sweep(const DenseGrid& density, const LightGeometry& g, DenseGrid& out, int layers, bool scalar, int threads) {
   const auto& n = density.resolution();
+  const Vec3 h = density.cell_size(), lo = density.bounds().lo;
+  int lc[3];  // the point light's cell (perhaps outside the grid)
+  for (int a = 0; a < 3; ++a) lc[a] = g.directional ? 0 : static_cast<int>(std::floor((g.position[a] - lo[a]) / h[a]));
+  Sweeper sweeper(density, g, out, layers, scalar, g.directional ? -1 : layers, lc);
+  std::vector<Sweeper::Run> runs;
   if (g.directional) {
-    // Layers along the dominant axis from the face toward the light; each depends on the last.
-    const int a = dominant_axis(glm::abs(g.to_light) / sweeper.h);
-    const int b = (a + 1) % 3, c = (a + 2) % 3;
+    // Layers along the dominant axis from the face toward the light; each depends on earlier ones.
+    const int a = dominant_axis(glm::abs(g.to_light) / h);
     const int na = n[static_cast<size_t>(a)];
     for (int layer = 0; layer < na; ++layer) {
       const int l = g.to_light[a] > 0.0 ? na - 1 - layer : layer;
-      parallel_for(n[static_cast<size_t>(c)], threads, 8, [&](long long c0, long long c1) {
-        int idx[3];
-        idx[a] = l;
-        for (auto ic = static_cast<int>(c0); ic < c1; ++ic)
-          for (int ib = 0; ib < n[static_cast<size_t>(b)]; ++ib) {
-            idx[b] = ib, idx[c] = ic;
-            sweeper.cell(idx[0], idx[1], idx[2], false);
-          }
-      });
+      runs.clear();
+      if (a == 0) {
+        for (int k = 0; k < n[2]; ++k) runs.push_back({l, 0, k, 1, n[1]});
+      } else {
+        for (int c = 0; c < n[static_cast<size_t>(3 - a)]; ++c) runs.push_back(a == 1 ? Sweeper::Run{0, l, c, 0, n[0]} : Sweeper::Run{0, c, l, 0, n[0]});
+      }
+      sweeper.sweep(runs, threads);
     }
     return;
   }
   // Point lights: shells of cells at Chebyshev distance r from the light's cell, outward. In a
   // shell, face cells (one coordinate at distance r) depend only on inner shells, edge cells (two)
   // also on face cells, corners (three) also on edges: three passes per shell keep every
-  // dependency computed first (with steps of several layers too). Shells up to the step (the
-  // light's neighbourhood) are exact.
-  int lc[3];
-  for (int a = 0; a < 3; ++a) lc[a] = static_cast<int>(std::floor((g.position[a] - sweeper.lo[a]) / sweeper.h[a]));
+  // dependency computed first. Runs go along x, except on the x faces (along y).
   int r_min = 0, r_max = 0;
   for (int a = 0; a < 3; ++a) {
     const int last = n[static_cast<size_t>(a)] - 1;
     r_min = std::max({r_min, -lc[a], lc[a] - last});
     r_max = std::max({r_max, std::abs(lc[a]), std::abs(lc[a] - last)});
   }
+  // [c - r + 1, c + r - 1] (the shell's inside along an axis) and the shell's two sides, in the grid.
+  auto inside = [&](int a, int r, int& first, int& last) {
+    first = std::max(lc[a] - r + 1, 0), last = std::min(lc[a] + r - 1, n[static_cast<size_t>(a)] - 1);
+  };
+  auto sides = [&](int a, int r) {
+    std::vector<int> s;
+    for (int v : {lc[a] - r, lc[a] + r})
+      if (v >= 0 && v < n[static_cast<size_t>(a)] && (s.empty() || s.back() != v)) s.push_back(v);
+    return s;
+  };
   for (int r = r_min; r <= r_max; ++r) {
-    const int z0 = std::max(lc[2] - r, 0), z1 = std::min(lc[2] + r, n[2] - 1);
-    const int y0 = std::max(lc[1] - r, 0), y1 = std::min(lc[1] + r, n[1] - 1);
+    int x0, x1, y0, y1, z0, z1;
+    inside(0, r, x0, x1), inside(1, r, y0, y1), inside(2, r, z0, z1);
+    const auto xs = sides(0, r), ys = sides(1, r), zs = sides(2, r);
     for (int pass = 1; pass <= 3; ++pass) {
-      parallel_for(z1 - z0 + 1, threads, 8, [&](long long k0, long long k1) {
-        for (int k = z0 + static_cast<int>(k0); k < z0 + k1; ++k)
-          for (int j = y0; j <= y1; ++j) {
-            const bool on_z = std::abs(k - lc[2]) == r, on_y = std::abs(j - lc[1]) == r;
-            auto visit = [&](int i) {
-              if (i < 0 || i >= n[0]) return;
-              const int at_r = (std::abs(i - lc[0]) == r) + on_y + on_z;
-              if (at_r == pass) sweeper.cell(i, j, k, r <= layers);
-            };
-            if (on_z || on_y) {
-              for (int i = std::max(lc[0] - r, 0); i <= std::min(lc[0] + r, n[0] - 1); ++i) visit(i);
-            } else {
-              visit(lc[0] - r);
-              if (r > 0) visit(lc[0] + r);
-            }
-          }
-      });
+      runs.clear();
+      // A run along x at (j, k) where `at_r` coordinates (of y, z) sit on the shell: the inside
+      // cells have at_r of them, the two ends at_r + 1.
+      auto row = [&](int j, int k, int at_r) {
+        if (at_r == pass && x1 >= x0) runs.push_back({x0, j, k, 0, x1 - x0 + 1});
+        if (at_r + 1 == pass)
+          for (int i : xs) runs.push_back({i, j, k, 0, 1});
+      };
+      for (int k : zs) {
+        for (int j = y0; j <= y1; ++j) row(j, k, 1);
+        for (int j : ys) row(j, k, 2);
+      }
+      for (int j : ys)
+        for (int k = z0; k <= z1; ++k) row(j, k, 1);
+      if (pass == 1 && y1 >= y0)
+        for (int i : xs)
+          for (int k = z0; k <= z1; ++k) runs.push_back({i, y0, k, 1, y1 - y0 + 1});
+      sweeper.sweep(runs, threads);
     }
   }
 }
@@ -328,7 +323,7 @@ DenseGrid optical_depth(const DenseGrid& density, const Light& light, const Dept
   switch (options.scheme) {
     case DepthScheme::exact: compute_exact(density, g, out, options.threads); break;
     case DepthScheme::paper: iterations = compute_paper(density, g, out, options.threads); break;
-    case DepthScheme::sweep: compute_sweep(density, g, out, options.sweep_layers, options.threads); break;
+    case DepthScheme::sweep: compute_sweep(density, g, out, options.sweep_layers, options.scalar_kernel, options.threads); break;
   }
   if (stats) stats->iterations = std::max(stats->iterations, iterations);
   return out;
@@ -339,8 +334,13 @@ std::vector<DenseGrid> optical_depths(const DenseGrid& density, const std::vecto
   for (const auto& light : lights) geometry(light);  // errors before any work
   std::vector<std::optional<DenseGrid>> volumes(lights.size());
   std::vector<DepthStats> per_light(lights.size());
+  // As many lights as threads: one thread per light, none handed work inside a light.
+  const auto workers = options.threads > 0 ? static_cast<unsigned>(options.threads) : std::thread::hardware_concurrency();
+  DepthOptions per_light_options = options;
+  if (lights.size() >= workers) per_light_options.threads = 1;
   parallel_for(static_cast<long long>(lights.size()), options.threads, 1, [&](long long l0, long long l1) {
-    for (auto l = static_cast<size_t>(l0); l < static_cast<size_t>(l1); ++l) volumes[l] = optical_depth(density, lights[l], options, &per_light[l]);
+    for (auto l = static_cast<size_t>(l0); l < static_cast<size_t>(l1); ++l)
+      volumes[l] = optical_depth(density, lights[l], per_light_options, &per_light[l]);
   });
   std::vector<DenseGrid> out;
   for (size_t l = 0; l < lights.size(); ++l) {

@@ -6,6 +6,7 @@
 #include <haze/grids/rbf.h>
 
 #include <gtest/gtest.h>
+#include <hwy/tests/hwy_gtest.h>
 
 namespace haze::grids {
 namespace {
@@ -87,6 +88,31 @@ TEST(OpticalDepth, SweepIsWithinTwoPercentOfExactInAHeterogeneousMedium) {
 
 // Seed 003's gathering follows grid paths: along an axis it is exact, along the body diagonal it
 // adds a cell per step of each axis, sqrt(3) times the straight length.
+// The sweep's SIMD kernel on every compiled Highway target against its scalar reference (the same
+// float32 formulas; FMA contraction differs between them), on lights inside, outside, at a cell
+// centre and directional, with 1 and 4 layers, on a grid of uneven sides so runs end mid-vector.
+class SweepTargets : public hwy::TestWithParamTarget {};
+HWY_TARGET_INSTANTIATE_TEST_SUITE_P(SweepTargets);
+
+TEST_P(SweepTargets, MatchesTheScalarKernel) {
+  DenseGrid g({37, 29, 23}, {Vec3(-1), Vec3(1)});
+  inject_rbf({{Vec3(0.2, -0.1, 0.3), 1.5, 3.0}, {Vec3(-0.4, 0.3, -0.2), 2.0, 4.0}}, g);
+  const Vec3 centre = g.cell_center(11, 7, 5);
+  for (const Light& light : {Light{PointLight{Vec3(0.13, -0.21, 0.05)}}, Light{PointLight{Vec3(2.5, 1.2, -1.7)}}, Light{PointLight{centre}},
+                             Light{DirectionalLight{glm::normalize(Vec3(-0.3, -1.0, 0.45))}}}) {
+    for (int layers : {1, 4}) {
+      DepthOptions options;
+      options.sweep_layers = layers;
+      DenseGrid simd = optical_depth(g, light, options);
+      options.scalar_kernel = true;
+      DenseGrid scalar = optical_depth(g, light, options);
+      for (size_t c = 0; c < g.cell_count(); ++c)
+        ASSERT_NEAR(simd.values()[c], scalar.values()[c], 1e-5f * (1.0f + scalar.values()[c]))
+            << "cell " << c << " light " << light.index() << " layers " << layers << " target " << hwy::TargetName(GetParam());
+    }
+  }
+}
+
 TEST(OpticalDepth, PaperGatheringOverestimatesDiagonals) {
   const int n = 32;
   DenseGrid g({n, n, n}, {Vec3(0), Vec3(n)});

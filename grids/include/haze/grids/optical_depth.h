@@ -26,6 +26,7 @@ struct DepthOptions {
   // more layers mean fewer interpolations along a path (less blurring of shadows) for more work
   // per cell (docs/PROPAGATION.md measures the trade).
   int sweep_layers = 4;
+  bool scalar_kernel = false;  // sweep: the scalar reference kernel instead of the SIMD one (tests, benchmarks)
   int threads = 0;  // 0: every core oneTBB offers
 };
 
