@@ -1,7 +1,9 @@
-// The ray marcher of method "propagation" (seed 003 sec. 4.4, eq. 8-10).
+// The ray marcher of method "propagation" (seed 003 sec. 4.4, eq. 8-10): the float64 reference
+// one pixel at a time, and the SIMD kernel (haze/simd/march_rays.h) over each image row.
 #include <haze/core/error.h>
 #include <haze/grids/optical_depth.h>
 #include <haze/grids/propagation.h>
+#include <haze/simd/march_rays.h>
 
 #include "trilinear.h"
 
@@ -11,6 +13,18 @@
 namespace haze::grids {
 
 namespace {
+
+struct Hit {
+  const Surface* surface = nullptr;
+  double t = kInfinity;
+  Vec3 normal{0.0};
+};
+
+// The steps of one ray inside the volume, before its hit.
+struct Steps {
+  double t0 = 0.0, dt = 0.0;
+  int count = 0;
+};
 
 struct Marcher {
   const Scene& scene;
@@ -29,6 +43,21 @@ struct Marcher {
       for (size_t l = 0; l < lights; ++l) packed[c * lights + l] = depths[l].values()[c];
   }
 
+  Hit hit(const Ray& ray) const {
+    Hit h;
+    h.surface = nearest_surface(scene.surfaces, ray, kInfinity, h.t, h.normal);
+    return h;
+  }
+
+  Steps steps(const Ray& ray, double t_hit) const {
+    Steps s;
+    double t1 = t_hit;
+    if (!volume.density.bounds().clip(ray, s.t0, t1) || !(t1 > s.t0)) return s;
+    s.count = static_cast<int>(std::ceil((t1 - s.t0) / step));
+    s.dt = (t1 - s.t0) / s.count;
+    return s;
+  }
+
   // Density integral from x to the light: the volume's value inside it, a DDA walk outside.
   double depth_to_light(size_t l, const Vec3& x, const LightArrival& a) const {
     if (volume.density.bounds().contains(x)) return static_cast<double>(sample_trilinear(depths[l], x));
@@ -36,52 +65,131 @@ struct Marcher {
     return density_integral_dda(volume.density, x, x + a.to_light * reach);
   }
 
-  Rgb pixel(const Ray& ray) const {
-    double t_hit = kInfinity;
-    Vec3 normal(0.0);
-    const Surface* hit = nearest_surface(scene.surfaces, ray, kInfinity, t_hit, normal);
-    Rgb radiance(0.0), transmittance(1.0);
-    double t0 = 0.0, t1 = t_hit;
+  // The medium along the ray's steps (the float64 reference of the SIMD kernel).
+  void march(const Ray& ray, const Steps& s, Rgb& radiance, Rgb& transmittance) const {
+    radiance = Rgb(0.0), transmittance = Rgb(1.0);
+    const size_t lights = scene.lights.size();
+    std::vector<double> depth(lights);
     LightArrival a;
-    if (volume.density.bounds().clip(ray, t0, t1) && t1 > t0) {
-      const int steps = static_cast<int>(std::ceil((t1 - t0) / step));
-      const double dt = (t1 - t0) / steps;
-      const size_t lights = scene.lights.size();
-      std::vector<double> depth(lights);
-      for (int s = 0; s < steps; ++s) {
-        const Vec3 x = ray.at(t0 + (s + 0.5) * dt);
-        const TrilinearStencil stencil(volume.density, x);
-        double rho = 0.0;
-        for (int m = 0; m < 8; ++m) rho += stencil.weight[m] * static_cast<double>(volume.density.values()[stencil.offset[m]]);
-        if (rho <= 0.0) continue;
-        std::fill(depth.begin(), depth.end(), 0.0);
-        for (int m = 0; m < 8; ++m) {
-          const float* run = packed.data() + stencil.offset[m] * lights;
-          for (size_t l = 0; l < lights; ++l) depth[l] += stencil.weight[m] * static_cast<double>(run[l]);
-        }
-        Rgb in(0.0);
-        for (size_t l = 0; l < lights; ++l) {
-          if (!arrival(scene.lights[l], x, a) || a.irradiance == Rgb(0.0)) continue;
-          in += volume.phase.eval(-a.to_light, -ray.direction) * a.irradiance * glm::exp(-sigma_t * depth[l]);
-        }
-        const Rgb step_transmittance = glm::exp(-sigma_t * rho * dt);
-        radiance += transmittance * volume.albedo * (Rgb(1.0) - step_transmittance) * in;
-        transmittance *= step_transmittance;
+    for (int i = 0; i < s.count; ++i) {
+      const Vec3 x = ray.at(s.t0 + (i + 0.5) * s.dt);
+      const TrilinearStencil stencil(volume.density, x);
+      double rho = 0.0;
+      for (int m = 0; m < 8; ++m) rho += stencil.weight[m] * static_cast<double>(volume.density.values()[stencil.offset[m]]);
+      if (rho <= 0.0) continue;
+      std::fill(depth.begin(), depth.end(), 0.0);
+      for (int m = 0; m < 8; ++m) {
+        const float* run = packed.data() + stencil.offset[m] * lights;
+        for (size_t l = 0; l < lights; ++l) depth[l] += stencil.weight[m] * static_cast<double>(run[l]);
       }
+      Rgb in(0.0);
+      for (size_t l = 0; l < lights; ++l) {
+        if (!arrival(scene.lights[l], x, a) || a.irradiance == Rgb(0.0)) continue;
+        in += volume.phase.eval(-a.to_light, -ray.direction) * a.irradiance * glm::exp(-sigma_t * depth[l]);
+      }
+      const Rgb step_transmittance = glm::exp(-sigma_t * rho * s.dt);
+      radiance += transmittance * volume.albedo * (Rgb(1.0) - step_transmittance) * in;
+      transmittance *= step_transmittance;
     }
-    if (!hit) return radiance + transmittance * scene.background;
-    // Eq. 10: the surface's shading, each light attenuated by its depth to the surface point.
-    const Vec3 p = ray.at(t_hit);
+  }
+
+  // What reaches the eye: the medium's radiance, then the background or (eq. 10) the surface's
+  // shading, each light attenuated by its depth to the surface point, seen through the medium.
+  Rgb finish(const Ray& ray, const Hit& h, const Rgb& radiance, const Rgb& transmittance) const {
+    if (!h.surface) return radiance + transmittance * scene.background;
+    const Vec3 p = ray.at(h.t);
     Rgb surface(0.0);
+    LightArrival a;
     for (size_t l = 0; l < scene.lights.size(); ++l) {
       if (!arrival(scene.lights[l], p, a)) continue;
-      const double cos_i = glm::dot(normal, a.to_light);
+      const double cos_i = glm::dot(h.normal, a.to_light);
       if (cos_i <= 0.0) continue;
-      surface += hit->brdf(a.to_light, -ray.direction, normal) * a.irradiance * cos_i * glm::exp(-sigma_t * depth_to_light(l, p, a));
+      surface += h.surface->brdf(a.to_light, -ray.direction, h.normal) * a.irradiance * cos_i * glm::exp(-sigma_t * depth_to_light(l, p, a));
     }
     return radiance + transmittance * surface;
   }
+
+  Rgb pixel(const Ray& ray) const {
+    const Hit h = hit(ray);
+    Rgb radiance, transmittance;
+    march(ray, steps(ray, h.t), radiance, transmittance);
+    return finish(ray, h, radiance, transmittance);
+  }
 };
+
+bool grey(const Rgb& c) { return c.r == c.g && c.g == c.b; }
+
+// The kernel's view of the volume and lights; false where it cannot take them (a tabulated phase
+// function, a sky light).
+bool simd_volume(const Marcher& m, std::vector<simd::MarchLight>& lights, simd::MarchVolume& v) {
+  if (!simd::march_supported(m.volume.phase)) return false;
+  const DenseGrid& density = m.volume.density;
+  const Vec3 h = density.cell_size();
+  for (int e = 0; e < 3; ++e) {
+    v.n[e] = density.resolution()[static_cast<size_t>(e)];
+    v.lo[e] = static_cast<float>(density.bounds().lo[e]), v.h[e] = static_cast<float>(h[e]);
+    v.sigma_t[e] = static_cast<float>(m.sigma_t[e]), v.albedo[e] = static_cast<float>(m.volume.albedo[e]);
+  }
+  bool all_grey = grey(m.sigma_t) && grey(m.volume.albedo);
+  auto set = [&](const Vec3& from, float* to) {
+    for (int e = 0; e < 3; ++e) to[e] = static_cast<float>(from[e]);
+  };
+  for (const Light& light : m.scene.lights) {
+    simd::MarchLight l;
+    Rgb intensity;
+    if (const auto* p = std::get_if<PointLight>(&light)) {
+      set(p->position, l.position), intensity = p->intensity;
+    } else if (const auto* s = std::get_if<SpotLight>(&light)) {
+      l.type = simd::MarchLight::spot;
+      set(s->position, l.position), set(s->direction, l.axis), intensity = s->intensity;
+      l.cos_cone = static_cast<float>(std::cos(s->cone_deg * kPi / 180.0)), l.exponent = static_cast<float>(s->exponent);
+    } else if (const auto* d = std::get_if<DirectionalLight>(&light)) {
+      l.type = simd::MarchLight::directional;
+      set(-d->direction, l.to_light), intensity = d->irradiance;
+    } else {
+      return false;
+    }
+    set(intensity, l.intensity);
+    all_grey = all_grey && grey(intensity);
+    lights.push_back(l);
+  }
+  v.density = density.values().data();
+  v.depths = m.packed.data();
+  v.lights = lights.data();
+  v.light_count = static_cast<int>(lights.size());
+  v.channels = all_grey ? 1 : 3;
+  return true;
+}
+
+// One image row through the SIMD kernel; surfaces and the background per pixel after it.
+void march_row(const Marcher& m, const simd::MarchVolume& v, int y, Image& image) {
+  const Camera& camera = m.scene.camera;
+  const auto width = static_cast<size_t>(camera.width_px);
+  std::vector<float> in(9 * width), out(6 * width, 0.0f);
+  std::vector<Ray> rays(width);
+  std::vector<Hit> hits(width);
+  for (size_t x = 0; x < width; ++x) {
+    rays[x] = camera.pixel_ray(static_cast<int>(x), y);
+    hits[x] = m.hit(rays[x]);
+    const Steps s = m.steps(rays[x], hits[x].t);
+    const double values[9] = {rays[x].origin.x, rays[x].origin.y, rays[x].origin.z, rays[x].direction.x, rays[x].direction.y,
+                              rays[x].direction.z, s.t0, s.dt, static_cast<double>(s.count)};
+    for (size_t a = 0; a < 9; ++a) in[a * width + x] = static_cast<float>(values[a]);
+  }
+  auto row = [&](std::vector<float>& buffer, size_t a) { return buffer.data() + a * width; };
+  simd::RayPacket packet{row(in, 0), row(in, 1), row(in, 2), row(in, 3), row(in, 4), row(in, 5), row(in, 6), row(in, 7), row(in, 8), width,
+                         {row(out, 0), row(out, 1), row(out, 2)}, {row(out, 3), row(out, 4), row(out, 5)}};
+  simd::march_rays(v, m.volume.phase, packet);
+  for (size_t x = 0; x < width; ++x) {
+    Rgb radiance, transmittance;
+    for (int c = 0; c < 3; ++c) {
+      const size_t channel = v.channels == 1 ? 0 : static_cast<size_t>(c);
+      radiance[c] = static_cast<double>(row(out, channel)[x]);
+      transmittance[c] = static_cast<double>(row(out, 3 + channel)[x]);
+    }
+    image.set(static_cast<int>(x), y, m.finish(rays[x], hits[x], radiance, transmittance));
+  }
+}
 
 }  // namespace
 
@@ -92,12 +200,19 @@ Image march_image(const Scene& scene, const ExtinctionVolume& volume, const std:
   if (!(settings.step_cells > 0.0)) throw Error("step", to_text(settings.step_cells), "a step > 0 cells");
   const Vec3 h = volume.density.cell_size();
   const Marcher marcher(scene, volume, depths, settings.step_cells * std::min({h.x, h.y, h.z}));
+  std::vector<simd::MarchLight> lights;
+  simd::MarchVolume simd_view;
+  const bool use_simd = !settings.scalar && simd_volume(marcher, lights, simd_view);
   const Camera& camera = scene.camera;
   Image image(camera.width_px, camera.height_px);
   ProgressTracker progress(options.progress, camera.height_px);
   parallel_for(camera.height_px, options.threads, 4, [&](long long y0, long long y1) {
     for (auto y = static_cast<int>(y0); y < y1 && !progress.cancelled(); ++y) {
-      for (int x = 0; x < camera.width_px; ++x) image.set(x, y, marcher.pixel(camera.pixel_ray(x, y)));
+      if (use_simd) {
+        march_row(marcher, simd_view, y, image);
+      } else {
+        for (int x = 0; x < camera.width_px; ++x) image.set(x, y, marcher.pixel(camera.pixel_ray(x, y)));
+      }
       progress.advance();
     }
   });

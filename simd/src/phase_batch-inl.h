@@ -29,7 +29,8 @@ HWY_INLINE V EvalPhase(D d, const internal::PhaseParams& p, V mu) {
   return hn::Mul(poly, sum);
 }
 
-HWY_NOINLINE void EvalPhaseBatch(const internal::PhaseParams& p, const float* HWY_RESTRICT mu, float* HWY_RESTRICT out,
+// inline: march_rays-inl.h includes this header too.
+inline HWY_NOINLINE void EvalPhaseBatch(const internal::PhaseParams& p, const float* HWY_RESTRICT mu, float* HWY_RESTRICT out,
                                  size_t count) {
   const hn::ScalableTag<float> d;
   const size_t lanes = hn::Lanes(d);

@@ -24,8 +24,9 @@ void set_lobe(internal::PhaseParams& p, int l, double g, double weight) {
   p.s[l] = g < 0.0 ? -1.0f : 1.0f;
 }
 
-// Float constants for an analytic phase function; false for a tabulated one.
-bool params_for(const PhaseFunction& phase, internal::PhaseParams& p) {
+}  // namespace
+
+bool internal::params_for(const PhaseFunction& phase, internal::PhaseParams& p) {
   switch (phase.type()) {
     case PhaseType::isotropic:
       p.c0 = static_cast<float>(kInv4Pi);
@@ -58,15 +59,13 @@ bool params_for(const PhaseFunction& phase, internal::PhaseParams& p) {
   return false;
 }
 
-}  // namespace
-
 void eval_phase_reference(const PhaseFunction& phase, const float* cos_theta, float* out, size_t count) {
   for (size_t i = 0; i < count; ++i) out[i] = static_cast<float>(phase.eval(static_cast<double>(cos_theta[i])));
 }
 
 void eval_phase(const PhaseFunction& phase, const float* cos_theta, float* out, size_t count) {
   internal::PhaseParams p;
-  if (!params_for(phase, p)) return eval_phase_reference(phase, cos_theta, out, count);
+  if (!internal::params_for(phase, p)) return eval_phase_reference(phase, cos_theta, out, count);
   HWY_DYNAMIC_DISPATCH(EvalPhaseBatch)(p, cos_theta, out, count);
 }
 

@@ -1,6 +1,8 @@
 // Float constants of an analytic phase function, shared by every SIMD target (internal).
 #pragma once
 
+#include <haze/core/phase.h>
+
 namespace haze::simd::internal {
 
 // Every analytic phase function is written as
@@ -16,5 +18,8 @@ struct PhaseParams {
   float b[2] = {0, 0};    // 2 |g|
   float s[2] = {1, 1};    // sign(g)
 };
+
+// Float constants for an analytic phase function; false for a tabulated one (phase_batch.cc).
+bool params_for(const PhaseFunction& phase, PhaseParams& p);
 
 }  // namespace haze::simd::internal

@@ -34,6 +34,9 @@ ExtinctionVolume make_extinction_volume(const Scene& scene, int resolution = 64,
 
 struct MarchSettings {
   double step_cells = 0.5;  // ray-march step as a fraction of the smallest cell side
+  // The float64 reference, one pixel at a time, instead of the float32 SIMD kernel over each row
+  // (which a tabulated phase function also falls back to).
+  bool scalar = false;
 };
 
 // Seed 003 eq. 8-10 in Haze's conventions: along each camera ray inside the volume, in steps,

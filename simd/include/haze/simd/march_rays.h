@@ -1,0 +1,49 @@
+// The ray marcher of method `propagation` (grids/propagation.h, seed 003 eq. 8-10) over packets of
+// camera rays in float32 lanes, Highway runtime dispatch. ISA-free header: per-target code in
+// src/march_rays-inl.h. Its reference is the float64 marcher in grids (MarchSettings::scalar).
+//
+// Per ray, steps s < steps of length dt from t0, at the midpoints x:
+//   rho   = trilinear density, depth_l = trilinear optical depth to light l (cell-centred, clamped),
+//   L_in  = sum_l p(to_light_l . dir) E_l(x) e^(-sigma_t depth_l),
+//   L    += T albedo (1 - e^(-sigma_t rho dt)) L_in,   T *= e^(-sigma_t rho dt)   (per channel).
+#pragma once
+
+#include <haze/core/phase.h>
+
+#include <cstddef>
+
+namespace haze::simd {
+
+struct MarchLight {
+  enum Type { point, spot, directional } type = point;
+  float position[3] = {0, 0, 0};  // point, spot
+  float to_light[3] = {0, 0, 1};  // directional: unit vector toward the light
+  float axis[3] = {0, 0, -1};     // spot: unit direction it shines along
+  float intensity[3] = {1, 1, 1};  // I (point), I0 (spot), irradiance (directional)
+  float cos_cone = 0.0f, exponent = 1.0f;  // spot: I0 cos^exponent(theta) where cos(theta) >= cos_cone
+};
+
+struct MarchVolume {
+  int n[3] = {1, 1, 1};
+  float lo[3] = {0, 0, 0}, h[3] = {1, 1, 1};
+  const float* density = nullptr;  // x fastest
+  const float* depths = nullptr;   // depths[cell * light_count + l]
+  const MarchLight* lights = nullptr;
+  int light_count = 0;
+  float sigma_t[3] = {1, 1, 1}, albedo[3] = {1, 1, 1};
+  int channels = 3;  // 1 where sigma_t, albedo and every light are grey: channel 0 only
+};
+
+struct RayPacket {
+  const float *ox, *oy, *oz, *dx, *dy, *dz;  // origin, unit direction
+  const float *t0, *dt, *steps;              // first step's start, step length, step count (whole)
+  size_t count;
+  float* radiance[3];       // out, per channel (channels of the volume)
+  float* transmittance[3];  // out, per channel
+};
+
+// False for phase functions the kernel cannot evaluate (tabulated): use the float64 marcher.
+bool march_supported(const PhaseFunction& phase);
+void march_rays(const MarchVolume& volume, const PhaseFunction& phase, const RayPacket& rays);
+
+}  // namespace haze::simd

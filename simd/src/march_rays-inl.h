@@ -1,0 +1,143 @@
+// Per-target ray-march kernel (Highway: included once per target by foreach_target.h).
+#include "phase_params.h"
+
+#if defined(HAZE_SIMD_MARCH_RAYS_INL_H_) == defined(HWY_TARGET_TOGGLE)
+#ifdef HAZE_SIMD_MARCH_RAYS_INL_H_
+#undef HAZE_SIMD_MARCH_RAYS_INL_H_
+#else
+#define HAZE_SIMD_MARCH_RAYS_INL_H_
+#endif
+
+#include <haze/simd/march_rays.h>
+
+#include <hwy/contrib/math/math-inl.h>
+#include <hwy/highway.h>
+
+#include <algorithm>
+
+#include "phase_batch-inl.h"
+
+HWY_BEFORE_NAMESPACE();
+namespace haze::simd::HWY_NAMESPACE {
+namespace hn = hwy::HWY_NAMESPACE;
+
+// One vector of rays starting at ray `first` (lanes past the end repeat the last ray), `C` channels.
+template <int C, class D>
+HWY_INLINE void MarchVector(D d, const MarchVolume& v, const internal::PhaseParams& phase, const RayPacket& rays, size_t first,
+                            size_t last, float* HWY_RESTRICT radiance_out, float* HWY_RESTRICT transmittance_out) {
+  using V = hn::Vec<D>;
+  const hn::RebindToSigned<D> di;
+  using VI = hn::Vec<decltype(di)>;
+  const size_t lanes = hn::Lanes(d);
+  HWY_ALIGN float buffer[9][hn::MaxLanes(d)];
+  const float* inputs[9] = {rays.ox, rays.oy, rays.oz, rays.dx, rays.dy, rays.dz, rays.t0, rays.dt, rays.steps};
+  for (int a = 0; a < 9; ++a)
+    for (size_t m = 0; m < lanes; ++m) buffer[a][m] = inputs[a][std::min(first + m, last)];
+  V o[3], dir[3];
+  for (int e = 0; e < 3; ++e) o[e] = hn::Load(d, buffer[e]), dir[e] = hn::Load(d, buffer[3 + e]);
+  const V t0 = hn::Load(d, buffer[6]), dt = hn::Load(d, buffer[7]), steps = hn::Load(d, buffer[8]);
+  const V zero = hn::Zero(d), one = hn::Set(d, 1.0f), half = hn::Set(d, 0.5f);
+  V radiance[C], transmittance[C];
+  for (int c = 0; c < C; ++c) radiance[c] = zero, transmittance[c] = one;
+  const int stride[3] = {1, v.n[0], v.n[0] * v.n[1]};
+  float max_steps = 0.0f;
+  for (size_t m = 0; m < lanes; ++m) max_steps = std::max(max_steps, buffer[8][m]);
+  for (int s = 0; s < static_cast<int>(max_steps); ++s) {
+    auto active = hn::Lt(hn::Set(d, static_cast<float>(s)), steps);
+    const V t = hn::MulAdd(hn::Add(hn::Set(d, static_cast<float>(s)), half), dt, t0);
+    // Trilinear stencil on the cell-centred grid, clamped to the edge cells.
+    V x[3], frac[3];
+    VI lo[3], hi[3];
+    for (int e = 0; e < 3; ++e) {
+      x[e] = hn::MulAdd(t, dir[e], o[e]);
+      const V u = hn::Sub(hn::Mul(hn::Sub(x[e], hn::Set(d, v.lo[e])), hn::Set(d, 1.0f / v.h[e])), half);
+      const V fl = hn::Floor(u);
+      frac[e] = hn::Sub(u, fl);
+      const VI c = hn::ConvertTo(di, fl), last_cell = hn::Set(di, v.n[e] - 1);
+      lo[e] = hn::Mul(hn::Min(hn::Max(c, hn::Zero(di)), last_cell), hn::Set(di, stride[e]));
+      hi[e] = hn::Mul(hn::Min(hn::Max(hn::Add(c, hn::Set(di, 1)), hn::Zero(di)), last_cell), hn::Set(di, stride[e]));
+    }
+    VI offset[8];
+    V weight[8];
+    for (int m = 0; m < 8; ++m) {
+      const bool bx = m & 1, by = (m >> 1) & 1, bz = (m >> 2) & 1;
+      offset[m] = hn::Add(bx ? hi[0] : lo[0], hn::Add(by ? hi[1] : lo[1], bz ? hi[2] : lo[2]));
+      weight[m] = hn::Mul(bx ? frac[0] : hn::Sub(one, frac[0]),
+                          hn::Mul(by ? frac[1] : hn::Sub(one, frac[1]), bz ? frac[2] : hn::Sub(one, frac[2])));
+    }
+    V rho = zero;
+    for (int m = 0; m < 8; ++m) rho = hn::MulAdd(weight[m], hn::GatherIndex(d, v.density, offset[m]), rho);
+    active = hn::And(active, hn::Gt(rho, zero));
+    if (hn::AllFalse(d, active)) continue;
+    V in[C];
+    for (int c = 0; c < C; ++c) in[c] = zero;
+    const VI lights = hn::Set(di, v.light_count);
+    for (int l = 0; l < v.light_count; ++l) {
+      const MarchLight& light = v.lights[l];
+      V depth = zero;
+      for (int m = 0; m < 8; ++m)
+        depth = hn::MulAdd(weight[m], hn::GatherIndex(d, v.depths + l, hn::Mul(offset[m], lights)), depth);
+      V to[3], falloff;
+      if (light.type == MarchLight::directional) {
+        for (int e = 0; e < 3; ++e) to[e] = hn::Set(d, light.to_light[e]);
+        falloff = one;
+      } else {
+        V w[3];
+        for (int e = 0; e < 3; ++e) w[e] = hn::Sub(hn::Set(d, light.position[e]), x[e]);
+        const V r2 = hn::MulAdd(w[0], w[0], hn::MulAdd(w[1], w[1], hn::Mul(w[2], w[2])));
+        const V inv_r = hn::Div(one, hn::Sqrt(r2));
+        for (int e = 0; e < 3; ++e) to[e] = hn::Mul(w[e], inv_r);
+        falloff = hn::Mul(inv_r, inv_r);
+        if (light.type == MarchLight::spot) {
+          const V cos_theta = hn::Neg(hn::MulAdd(to[0], hn::Set(d, light.axis[0]),
+                                                 hn::MulAdd(to[1], hn::Set(d, light.axis[1]), hn::Mul(to[2], hn::Set(d, light.axis[2])))));
+          const auto inside = hn::And(hn::Ge(cos_theta, hn::Set(d, light.cos_cone)), hn::Gt(cos_theta, zero));
+          const V cone = hn::Exp(d, hn::Mul(hn::Set(d, light.exponent), hn::Log(d, hn::IfThenElse(inside, cos_theta, one))));
+          falloff = hn::IfThenElseZero(inside, hn::Mul(falloff, cone));
+        }
+      }
+      const V mu = hn::MulAdd(to[0], dir[0], hn::MulAdd(to[1], dir[1], hn::Mul(to[2], dir[2])));
+      const V weight_l = hn::Mul(EvalPhase(d, phase, mu), falloff);
+      for (int c = 0; c < C; ++c)
+        in[c] = hn::MulAdd(hn::Mul(weight_l, hn::Set(d, light.intensity[c])), hn::Exp(d, hn::Mul(hn::Set(d, -v.sigma_t[c]), depth)), in[c]);
+    }
+    for (int c = 0; c < C; ++c) {
+      const V step_transmittance = hn::Exp(d, hn::Mul(hn::Set(d, -v.sigma_t[c]), hn::Mul(rho, dt)));
+      const V scattered = hn::Mul(hn::Mul(transmittance[c], hn::Set(d, v.albedo[c])), hn::Mul(hn::Sub(one, step_transmittance), in[c]));
+      radiance[c] = hn::Add(radiance[c], hn::IfThenElseZero(active, scattered));
+      transmittance[c] = hn::IfThenElse(active, hn::Mul(transmittance[c], step_transmittance), transmittance[c]);
+    }
+  }
+  for (int c = 0; c < C; ++c) {
+    hn::Store(radiance[c], d, radiance_out + c * lanes);
+    hn::Store(transmittance[c], d, transmittance_out + c * lanes);
+  }
+}
+
+template <int C>
+HWY_INLINE void MarchAll(const MarchVolume& v, const internal::PhaseParams& phase, const RayPacket& rays) {
+  const hn::ScalableTag<float> d;
+  const size_t lanes = hn::Lanes(d);
+  HWY_ALIGN float radiance[3 * hn::MaxLanes(d)], transmittance[3 * hn::MaxLanes(d)];
+  for (size_t first = 0; first < rays.count; first += lanes) {
+    MarchVector<C>(d, v, phase, rays, first, rays.count - 1, radiance, transmittance);
+    const size_t n = std::min(lanes, rays.count - first);
+    for (int c = 0; c < C; ++c) {
+      std::copy(radiance + c * lanes, radiance + c * lanes + n, rays.radiance[c] + first);
+      std::copy(transmittance + c * lanes, transmittance + c * lanes + n, rays.transmittance[c] + first);
+    }
+  }
+}
+
+HWY_NOINLINE void MarchRays(const MarchVolume& v, const internal::PhaseParams& phase, const RayPacket& rays) {
+  if (v.channels == 1) {
+    MarchAll<1>(v, phase, rays);
+  } else {
+    MarchAll<3>(v, phase, rays);
+  }
+}
+
+}  // namespace haze::simd::HWY_NAMESPACE
+HWY_AFTER_NAMESPACE();
+
+#endif  // HAZE_SIMD_MARCH_RAYS_INL_H_
