@@ -94,7 +94,8 @@ void BM_SweepKernel(benchmark::State& state) {
 BENCHMARK(BM_SweepKernel)->Name("propagation/sweep_128_4_lights/threads,scalar")->Args({1, 0})->Args({2, 0})->Args({1, 1})->Args({2, 1})
     ->UseRealTime()->Unit(benchmark::kMillisecond);
 
-// Args: width, height, cells per side, lights. Ray marching only (volumes built beforehand).
+// Args: width, height, cells per side, lights, float64 reference marcher (0 or 1). Ray marching
+// only (volumes built beforehand). Counters: march steps (samples) and the time per sample and light.
 void BM_March(benchmark::State& state) {
   const int n = static_cast<int>(state.range(2));
   Scene scene;
@@ -104,14 +105,27 @@ void BM_March(benchmark::State& state) {
   scene.lights = lights(static_cast<int>(state.range(3)));
   ExtinctionVolume volume{cloud(n, 1000), Rgb(2.0), Rgb(0.9), PhaseFunction::henyey_greenstein(0.4)};
   const auto depths = optical_depths(volume.density, scene.lights);
+  MarchSettings settings;
+  settings.scalar = state.range(4) != 0;
   RenderOptions options;
   options.threads = 2;
-  for (auto _ : state) benchmark::DoNotOptimize(march_image(scene, volume, depths, {}, options).data().data());
-  state.counters["pixels_per_second"] =
-      benchmark::Counter(static_cast<double>(state.range(0) * state.range(1)), benchmark::Counter::kIsIterationInvariantRate);
+  for (auto _ : state) benchmark::DoNotOptimize(march_image(scene, volume, depths, settings, options).data().data());
+  // The marcher's steps: ceil(length inside the volume / step) per pixel.
+  const double step = settings.step_cells * volume.density.cell_size().x;
+  double samples = 0.0;
+  for (int y = 0; y < scene.camera.height_px; ++y)
+    for (int x = 0; x < scene.camera.width_px; ++x) {
+      double t0 = 0.0, t1 = kInfinity;
+      if (volume.density.bounds().clip(scene.camera.pixel_ray(x, y), t0, t1)) samples += std::ceil((t1 - t0) / step);
+    }
+  state.counters["samples"] = samples;
+  state.counters["ns_per_sample_light"] = benchmark::Counter(1e-9 * samples * static_cast<double>(scene.lights.size()),
+                                                             benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+  state.SetLabel(settings.scalar ? "float64" : "simd");
 }
-BENCHMARK(BM_March)->Name("propagation/march/width,height,cells,lights")
-    ->Args({512, 512, 128, 4})->Args({512, 512, 64, 4})->Args({800, 600, 20, 1})->Args({800, 600, 40, 4})->Args({800, 600, 40, 8})
+BENCHMARK(BM_March)->Name("propagation/march/width,height,cells,lights,float64")
+    ->Args({512, 512, 64, 4, 0})->Args({512, 512, 64, 4, 1})->Args({512, 512, 128, 4, 0})
+    ->Args({800, 600, 20, 1, 0})->Args({800, 600, 40, 4, 0})->Args({800, 600, 40, 8, 0})
     ->UseRealTime()->Unit(benchmark::kMillisecond);
 
 }  // namespace
