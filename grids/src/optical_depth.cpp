@@ -161,13 +161,13 @@ int compute_paper(const DenseGrid& density, const LightGeometry& g, DenseGrid& o
 
 // Short characteristics (BEYOND.md), the formulas of haze/simd/sweep_cells.h: from each cell
 // centre toward the light to the cell-centre plane `layers` layers away along the dominant axis,
-// one density sample per layer; beyond it, the mean density along the landing point's own path
-// (bilinear in that plane) times that path's length. Interpolating the mean density rather than
-// the depth, which curves near the light and kinks where the exit face changes, makes the sweep
-// exact in a homogeneous medium; walking several layers between interpolations keeps the sideways
-// blur of shadows small (docs/PROPAGATION.md). Cells within `layers` shells of a point light walk
-// their whole path. Cells go to the kernel in runs along x (or y), in
-// an order that computes every cell a landing point reads first.
+// walked cell by cell; beyond it, the mean density along the landing point's own path (bilinear
+// in that plane) times that path's length. Interpolating the mean density rather than the depth,
+// which curves near the light and kinks where the exit face changes, makes the sweep exact in a
+// homogeneous medium; walking several layers between interpolations keeps the sideways blur of
+// shadows small (docs/PROPAGATION.md). Cells within `layers` shells of a point light walk their
+// whole path. Cells go to the kernel in runs along x (or y), in an order that computes every cell
+// a landing point reads first.
 class Sweeper {
  public:
   Sweeper(const DenseGrid& density, const LightGeometry& g, DenseGrid& out, int layers, bool scalar, int exact_radius,
@@ -202,7 +202,6 @@ class Sweeper {
       std::vector<float> depth, mean;
       for (auto r = static_cast<size_t>(r0); r < static_cast<size_t>(r1); ++r) {
         const Run& run = runs[r];
-        depth.resize(static_cast<size_t>(run.count)), mean.resize(static_cast<size_t>(run.count));
         const size_t first = out_.index(run.i, run.j, run.k);
         if (run.axis == 0) {  // contiguous: straight into the volumes
           kernel_(volume_, run.i, run.j, run.k, 0, run.count, &out_.values()[first], &mean_.values()[first]);
