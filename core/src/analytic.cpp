@@ -120,7 +120,7 @@ class AnalyticMethod final : public Method {
     const Rgb sigma_t = desc.sigma_t * constant->value;
     const Rgb sigma_s = desc.albedo * sigma_t;
     // A grey medium (the same coefficients in every channel) needs one airlight evaluation per light.
-    const bool grey = sigma_t.r == sigma_t.g && sigma_t.g == sigma_t.b && sigma_s.r == sigma_s.g && sigma_s.g == sigma_s.b;
+    const bool grey = is_grey(sigma_t) && is_grey(sigma_s);
     // Tables come from this object's memory when an earlier render made them, else from
     // options.cache_dir when it is set and holds them, else they are built.
     const bool use_cache = !options.cache_dir.empty();

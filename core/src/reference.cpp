@@ -31,7 +31,7 @@ Vec3 sample_cosine(const Vec3& n, Rng& rng) {
 
 // exp(-sigma * length) per channel, one exp when the channels agree (grey media).
 Rgb beer(const Rgb& sigma, double length) {
-  if (sigma.r == sigma.g && sigma.g == sigma.b) return Rgb(std::exp(-sigma.r * length));
+  if (is_grey(sigma)) return Rgb(std::exp(-sigma.r * length));
   return glm::exp(-sigma * length);
 }
 

@@ -117,8 +117,6 @@ struct Marcher {
   }
 };
 
-bool grey(const Rgb& c) { return c.r == c.g && c.g == c.b; }
-
 // The kernel's view of the volume and lights; false where it cannot take them (a tabulated phase
 // function, a sky light).
 bool simd_volume(const Marcher& m, std::vector<simd::MarchLight>& lights, simd::MarchVolume& v) {
@@ -130,7 +128,7 @@ bool simd_volume(const Marcher& m, std::vector<simd::MarchLight>& lights, simd::
     v.lo[e] = static_cast<float>(density.bounds().lo[e]), v.h[e] = static_cast<float>(h[e]);
     v.sigma_t[e] = static_cast<float>(m.sigma_t[e]), v.albedo[e] = static_cast<float>(m.volume.albedo[e]);
   }
-  bool all_grey = grey(m.sigma_t) && grey(m.volume.albedo);
+  bool all_grey = is_grey(m.sigma_t) && is_grey(m.volume.albedo);
   auto set = [&](const Vec3& from, float* to) {
     for (int e = 0; e < 3; ++e) to[e] = static_cast<float>(from[e]);
   };
@@ -150,7 +148,7 @@ bool simd_volume(const Marcher& m, std::vector<simd::MarchLight>& lights, simd::
       return false;
     }
     set(intensity, l.intensity);
-    all_grey = all_grey && grey(intensity);
+    all_grey = all_grey && is_grey(intensity);
     lights.push_back(l);
   }
   v.density = density.values().data();

@@ -131,9 +131,11 @@ HWY_INLINE void SweepVector(D d, const SweepVolume& v, int i, int j, int k, int 
     result = hn::IfThenElse(lands, hn::MulAdd(landing, hn::Sub(len, s), result), result);
   }
   hn::StoreU(result, d, depth);
-  const V own_density = hn::GatherIndex(d, v.density, own);
-  hn::StoreU(hn::IfThenElse(hn::Gt(len, zero), hn::Div(result, hn::IfThenElse(hn::Gt(len, zero), len, hn::Set(d, 1.0f))), own_density), d,
-             mean);
+  // mean = depth / len; a cell at the light (len 0) keeps its own density.
+  const auto has_path = hn::Gt(len, zero);
+  V mean_density = hn::Div(result, hn::IfThenElse(has_path, len, hn::Set(d, 1.0f)));
+  if (!hn::AllTrue(d, has_path)) mean_density = hn::IfThenElse(has_path, mean_density, hn::GatherIndex(d, v.density, own));
+  hn::StoreU(mean_density, d, mean);
 }
 
 HWY_NOINLINE void SweepCells(const SweepVolume& v, int i, int j, int k, int axis, int count, float* HWY_RESTRICT depth,

@@ -52,5 +52,7 @@ struct Frame {
 Vec3 direction_around(const Vec3& axis, double cos_theta, double phi);
 
 inline double luminance(const Rgb& c) { return 0.2126 * c.r + 0.7152 * c.g + 0.0722 * c.b; }
+// The same value in every channel: a grey coefficient or light, which one channel can carry.
+inline bool is_grey(const Rgb& c) { return c.r == c.g && c.g == c.b; }
 
 }  // namespace haze
