@@ -30,6 +30,7 @@ PhaseMatrix::PhaseMatrix(const PhaseFunction& phase, const DirectionSet& directi
     s = (s.array() / ks.array()).sqrt();
   }
   matrix_ = s.asDiagonal() * k * s.asDiagonal();
+  scaling_ = s;
 }
 
 SeparablePhase::SeparablePhase(const PhaseMatrix& matrix, int terms) {

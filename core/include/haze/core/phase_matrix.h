@@ -22,12 +22,15 @@ class PhaseMatrix {
   const Eigen::VectorXd& raw_row_sums() const { return raw_row_sums_; }
   // New row sum over old row sum, 1 / raw_row_sums(): the accuracy diagnostic DESIGN.md asks for.
   Eigen::VectorXd renormalization_factors() const { return raw_row_sums_.cwiseInverse(); }
+  // The symmetric scaling: P_ij = s_i p(w_i . w_j) w_j s_j. A direction w outside the set gets the
+  // row s(w) p(w . w_j) w_j s_j with s(w) = 1 / sum_j p(w . w_j) w_j s_j (the same rule at w_i).
+  const Eigen::VectorXd& scaling() const { return scaling_; }
   // out_i = sum_j P_ij in_j: the direct O(D^2) in-scattering sum (seed 000 eq. 6).
   Eigen::VectorXd apply(const Eigen::VectorXd& in) const { return matrix_ * in; }
 
  private:
   Eigen::MatrixXd matrix_;
-  Eigen::VectorXd raw_row_sums_;
+  Eigen::VectorXd raw_row_sums_, scaling_;
 };
 
 // P ~ Q_N diag(lambda_N) Q_N^T, keeping the N eigenpairs of largest |lambda| of the symmetric P

@@ -1,0 +1,90 @@
+// Multiple scattering on grids by discrete ordinates (seed 000, Gong et al.): diffuse radiance over
+// D directions in every cell, iterated to convergence, the in-scattering integral taken through the
+// N-term separable factorization of the phase matrix (core's SeparablePhase; N = D is the full
+// matrix). Lights enter as a first-collision source from the exact optical depth to each light, so
+// point lights show no ray effects; the solver carries only light scattered at least once.
+#pragma once
+
+#include <haze/core/light.h>
+#include <haze/core/method.h>
+#include <haze/core/phase_matrix.h>
+#include <haze/core/progress.h>
+#include <haze/grids/propagation.h>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace haze::grids {
+
+enum class DomScheme {
+  // Seed 000 eq. 7/9: every cell updates from its upwind neighbours' previous values (Jacobi), so
+  // radiance moves one cell per iteration. The cell's own attenuation is implicit, as in `sweep`,
+  // so both schemes converge to the same discrete solution and the paper's one is stable at any
+  // optical thickness per cell.
+  paper,
+  // Source iteration: per iteration one upwind transport sweep per direction (Gauss-Seidel in
+  // space), so light crosses the whole grid in one iteration; only the N moments of the previous
+  // iteration are kept (flux-moment form of SN codes).
+  sweep,
+};
+DomScheme dom_scheme_from_name(const std::string& name);  // "paper", "sweep"
+const char* name(DomScheme scheme);
+
+enum class DomAccelerator {
+  none,
+  gmres,  // restarted GMRES on the moments (a Krylov method on the source-iteration operator)
+};
+DomAccelerator dom_accelerator_from_name(const std::string& name);  // "none", "gmres"
+const char* name(DomAccelerator accelerator);
+
+struct DomSettings {
+  int directions = 128;  // D, spherical Fibonacci
+  int terms = 24;        // N separable terms of the phase matrix; D (or 0) keeps the full matrix
+  DomScheme scheme = DomScheme::sweep;
+  DomAccelerator accelerator = DomAccelerator::gmres;
+  int max_iterations = 500;
+  // Stop when max over cells |change of the scalar flux| / max scalar flux falls below this.
+  double tolerance = 1e-3;
+  int threads = 0;  // 0: every core oneTBB offers
+  ProgressCallback progress;  // once per iteration, with the fraction of max_iterations done
+};
+
+// The converged diffuse radiance in moment form: per solved channel (1 when medium and lights are
+// grey, else 3) and cell, the N moments m_k = sum_d Q[d][k] L_d (seed 000 eq. 10). The in-scattered
+// radiance toward any direction w follows from them (inscatter_weights).
+struct DomSolution {
+  std::shared_ptr<const DirectionSet> directions;
+  std::shared_ptr<const PhaseMatrix> matrix;
+  std::shared_ptr<const SeparablePhase> separable;
+  std::array<int, 3> resolution{0, 0, 0};
+  int channels = 0;
+  std::vector<std::vector<float>> moments;  // [channel][cell * N + k], cells in public x-fastest order
+
+  int iterations = 0;              // transport sweeps, the first-collision sweep included
+  bool converged = false;
+  std::vector<double> changes;     // the relative change after each iteration
+  size_t bytes = 0;                // peak memory the solver held for its fields
+
+  int terms() const { return separable ? separable->terms() : 0; }
+};
+
+// Checks sizes and memory (a solve that would not fit in the memory available throws haze::Error
+// before allocating). `depths[i]` is the density integral from every cell to lights[i] (exact or
+// propagated, optical_depth.h); sky lights enter through the boundary and need no volume (pass an
+// empty grid). `warm`, when given and of the same shape, starts the iteration from its moments (the
+// paper's one-iteration-per-frame mode when density or lights change a little).
+DomSolution solve_dom(const ExtinctionVolume& volume, const std::vector<Light>& lights, const std::vector<DenseGrid>& depths,
+                      const DomSettings& settings, const DomSolution* warm = nullptr);
+
+// For a direction w (propagation direction of the scattered light): c_k with
+// sum_j P(w, w_j) L_j ~ sum_k c_k m_k, the row of P at w extended off the direction set
+// (PhaseMatrix::scaling) and projected on the kept eigenvectors.
+Eigen::VectorXd inscatter_weights(const DomSolution& solution, const PhaseFunction& phase, const Vec3& w);
+
+// The memory a solve with these settings needs, in bytes (what solve_dom checks).
+size_t dom_memory_bytes(const std::array<int, 3>& resolution, int channels, const DomSettings& settings);
+
+std::unique_ptr<Method> make_dom_method();
+
+}  // namespace haze::grids

@@ -1,0 +1,60 @@
+// Internal: the transport operator of the discrete-ordinate solver (dom_transport.cpp), shared by
+// the iteration drivers in dom_solver.cpp.
+#pragma once
+
+#include <haze/grids/dom.h>
+
+#include <array>
+#include <vector>
+
+namespace haze::grids::dom {
+
+// One channel of the medium: sigma_t = sigma_t_scale * density, sigma_s = albedo * sigma_t.
+struct Channel {
+  int index = 0;  // 0, 1, 2: which RGB channel
+  float sigma_t_scale = 1.0f, albedo = 0.0f;
+  float sky = 0.0f;  // radiance entering through the boundary
+  const float* density = nullptr;
+};
+Channel make_channel(const ExtinctionVolume& volume, const std::vector<Light>& lights, int channel);
+
+// The directions regrouped by octant (signs of x, y, z), so that each octant's directions share
+// one upwind order through the grid, with their separable-phase rows and face coefficients.
+class Transport {
+ public:
+  Transport(const DenseGrid& density, const DirectionSet& directions, const PhaseMatrix& matrix, const SeparablePhase& separable);
+
+  // One upwind sweep of every direction with the step scheme (a face carries its upwind cell's
+  // value):  L_d = (sigma_s S_d + sum_e a_e L_up,e) / (sigma_t + sum_e a_e),  a_e = |w_e| / h_e,
+  //   S_d = first[cell * D + d] + sum_k lambda_k Q[d][k] m_in[cell * N + k]   (seed 000 eq. 9),
+  // radiance `boundary` entering through every face, and the moments of the result
+  //   m_out[cell * N + k] = sum_d Q[d][k] L_d   (eq. 10).
+  // first (regrouped order, from first_collision) and m_in may be null. Directions going up and
+  // going down run on two threads into separate buffers, summed in a fixed order.
+  void sweep(const Channel& channel, const float* first, const float* m_in, float boundary, float* m_out, int threads) const;
+
+  // The first-collision source per cell and direction (regrouped order), before the factor sigma_s:
+  //   sum_lights p(w_light . w_d) E_light e^(-sigma_t depth) / sum_j p(w_light . w_j) w_j,
+  // normalized so its quadrature over directions is exactly E e^(-sigma_t depth).
+  std::vector<float> first_collision(const ExtinctionVolume& volume, const std::vector<Light>& lights,
+                                     const std::vector<DenseGrid>& depths, int channel, int threads) const;
+
+  // The paper's scheme: full radiance per cell and direction, every cell updated from its upwind
+  // neighbours' previous values (Jacobi). Returns the moments; appends one change per iteration.
+  std::vector<float> paper(const Channel& channel, const std::vector<float>& first, const std::vector<float>* warm,
+                           const DomSettings& settings, int& iterations, std::vector<double>& changes) const;
+
+ private:
+  std::array<int, 3> n_;
+  size_t cells_;
+  int d_, n_terms_;
+  bool full_;                       // N = D: the paper scheme multiplies by the matrix itself
+  std::vector<float> matrix_;       // [i * D + j]: P[order_[i]][order_[j]], when full_
+  mutable std::vector<float> scratch_;  // the second half's sweep output
+  std::vector<int> order_;          // order_[i]: the DirectionSet index of regrouped direction i
+  std::array<int, 9> start_{};      // octant o holds regrouped directions [start_[o], start_[o + 1])
+  std::vector<float> a_;            // [i * 3 + e]: |w_e| / h_e
+  std::vector<float> q_, lq_;       // [i * N + k]: Q[order_[i]][k] and lambda_k Q[order_[i]][k]
+};
+
+}  // namespace haze::grids::dom

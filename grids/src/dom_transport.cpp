@@ -1,0 +1,232 @@
+// The transport operator of the discrete-ordinate solver: the upwind sweep, the first-collision
+// source, and the paper's Jacobi scheme (dom_internal.h).
+#include "dom_internal.h"
+
+#include <haze/core/error.h>
+#include <haze/simd/phase_batch.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace haze::grids::dom {
+
+namespace {
+
+int octant(const Vec3& w) { return (w.x < 0.0 ? 1 : 0) | (w.y < 0.0 ? 2 : 0) | (w.z < 0.0 ? 4 : 0); }
+
+}  // namespace
+
+Channel make_channel(const ExtinctionVolume& volume, const std::vector<Light>& lights, int channel) {
+  Channel c;
+  c.index = channel;
+  c.sigma_t_scale = static_cast<float>(volume.sigma_t_scale[channel]);
+  c.albedo = static_cast<float>(volume.albedo[channel]);
+  for (const Light& l : lights)
+    if (const auto* sky = std::get_if<SkyLight>(&l)) c.sky += static_cast<float>(sky->radiance[channel]);
+  c.density = volume.density.values().data();
+  return c;
+}
+
+Transport::Transport(const DenseGrid& density, const DirectionSet& directions, const PhaseMatrix& matrix, const SeparablePhase& separable)
+    : n_(density.resolution()), cells_(density.cell_count()), d_(directions.size()), n_terms_(separable.terms()),
+      full_(separable.terms() == directions.size()) {
+  order_.resize(static_cast<size_t>(d_));
+  for (int i = 0; i < d_; ++i) order_[static_cast<size_t>(i)] = i;
+  std::stable_sort(order_.begin(), order_.end(), [&](int a, int b) { return octant(directions[a]) < octant(directions[b]); });
+  for (int o = 0, i = 0; o <= 8; ++o) {
+    while (i < d_ && octant(directions[order_[static_cast<size_t>(i)]]) < o) ++i;
+    start_[static_cast<size_t>(o)] = i;
+  }
+  const Vec3 h = density.cell_size();
+  const auto d = static_cast<size_t>(d_), n = static_cast<size_t>(n_terms_);
+  a_.resize(3 * d), q_.resize(d * n), lq_.resize(d * n);
+  for (size_t i = 0; i < d; ++i) {
+    const int dir = order_[i];
+    for (int e = 0; e < 3; ++e) a_[i * 3 + static_cast<size_t>(e)] = static_cast<float>(std::abs(directions[dir][e]) / h[e]);
+    for (size_t k = 0; k < n; ++k) {
+      q_[i * n + k] = static_cast<float>(separable.basis()(dir, static_cast<int>(k)));
+      lq_[i * n + k] = static_cast<float>(separable.eigenvalues()(static_cast<int>(k)) * separable.basis()(dir, static_cast<int>(k)));
+    }
+  }
+  if (full_) {
+    matrix_.resize(d * d);
+    for (size_t i = 0; i < d; ++i)
+      for (size_t j = 0; j < d; ++j) matrix_[i * d + j] = static_cast<float>(matrix(order_[i], order_[j]));
+  }
+}
+
+void Transport::sweep(const Channel& ch, const float* first, const float* m_in, float boundary, float* m_out, int threads) const {
+  const auto nx = n_[0], ny = n_[1], nz = n_[2];
+  const auto n = static_cast<size_t>(n_terms_), d_all = static_cast<size_t>(d_);
+  const size_t size = cells_ * n;
+  scratch_.resize(size);
+  parallel_for(2, threads, 1, [&](long long h0, long long h1) {
+    for (long long half = h0; half < h1; ++half) {
+      float* out = half == 0 ? m_out : scratch_.data();
+      std::fill(out, out + size, 0.0f);
+      for (int o = 4 * static_cast<int>(half); o < 4 * static_cast<int>(half) + 4; ++o) {
+        const int i0 = start_[static_cast<size_t>(o)], dq = start_[static_cast<size_t>(o) + 1] - i0;
+        if (dq == 0) continue;
+        const auto q = static_cast<size_t>(dq);
+        const float* a = a_.data() + 3 * static_cast<size_t>(i0);
+        const float* lq = lq_.data() + static_cast<size_t>(i0) * n;
+        const float* qd = q_.data() + static_cast<size_t>(i0) * n;
+        std::vector<float> zplane(static_cast<size_t>(nx) * static_cast<size_t>(ny) * q, boundary), yrow(static_cast<size_t>(nx) * q);
+        std::vector<float> xrun(q), src(q), asum(q);
+        for (size_t i = 0; i < q; ++i) asum[i] = a[3 * i] + a[3 * i + 1] + a[3 * i + 2];
+        for (int kk = 0; kk < nz; ++kk) {
+          const int k = o & 4 ? nz - 1 - kk : kk;
+          std::fill(yrow.begin(), yrow.end(), boundary);
+          for (int jj = 0; jj < ny; ++jj) {
+            const int j = o & 2 ? ny - 1 - jj : jj;
+            std::fill(xrun.begin(), xrun.end(), boundary);
+            for (int ii = 0; ii < nx; ++ii) {
+              const int i = o & 1 ? nx - 1 - ii : ii;
+              const size_t c = (static_cast<size_t>(k) * static_cast<size_t>(ny) + static_cast<size_t>(j)) * static_cast<size_t>(nx) +
+                               static_cast<size_t>(i);
+              const float sigma_t = ch.sigma_t_scale * ch.density[c], sigma_s = ch.albedo * sigma_t;
+              float* yp = yrow.data() + static_cast<size_t>(i) * q;
+              float* zp = zplane.data() + (static_cast<size_t>(j) * static_cast<size_t>(nx) + static_cast<size_t>(i)) * q;
+              std::fill(src.begin(), src.end(), 0.0f);
+              if (m_in) {
+                const float* m = m_in + c * n;
+                for (size_t e = 0; e < q; ++e) {
+                  float s = 0.0f;
+                  for (size_t t = 0; t < n; ++t) s += lq[e * n + t] * m[t];
+                  src[e] = s;
+                }
+              }
+              if (first) {
+                const float* f = first + c * d_all + static_cast<size_t>(i0);
+                for (size_t e = 0; e < q; ++e) src[e] += f[e];
+              }
+              float* mo = out + c * n;
+              for (size_t e = 0; e < q; ++e) {
+                const float l = (sigma_s * src[e] + a[3 * e] * xrun[e] + a[3 * e + 1] * yp[e] + a[3 * e + 2] * zp[e]) / (sigma_t + asum[e]);
+                xrun[e] = yp[e] = zp[e] = l;
+                for (size_t t = 0; t < n; ++t) mo[t] += qd[e * n + t] * l;
+              }
+            }
+          }
+        }
+      }
+    }
+  });
+  for (size_t i = 0; i < size; ++i) m_out[i] += scratch_[i];
+}
+
+std::vector<float> Transport::first_collision(const ExtinctionVolume& volume, const std::vector<Light>& lights,
+                                              const std::vector<DenseGrid>& depths, int channel, int threads) const {
+  const DenseGrid& grid = volume.density;
+  const auto d = static_cast<size_t>(d_);
+  const DirectionSet directions = DirectionSet::fibonacci(d_);
+  const Vec3 h = grid.cell_size();
+  // A point light inside a cell delivers the irradiance at half a cell's distance, no more: the
+  // cell's source stays finite (and isotropic when the light sits at its centre).
+  const double nearest = 0.5 * std::min({h.x, h.y, h.z});
+  const double sigma_t = volume.sigma_t_scale[channel], weight = 4.0 * kPi / d_;
+  std::vector<float> first(cells_ * d, 0.0f);
+  const auto nx = n_[0], ny = n_[1];
+  parallel_for(n_[2], threads, 1, [&](long long k0, long long k1) {
+    std::vector<float> cosines(d), phase(d);
+    for (auto k = static_cast<int>(k0); k < k1; ++k)
+      for (int j = 0; j < ny; ++j)
+        for (int i = 0; i < nx; ++i) {
+          const size_t c = grid.index(i, j, k);
+          const Vec3 x = grid.cell_center(i, j, k);
+          float* f = first.data() + c * d;
+          for (size_t l = 0; l < lights.size(); ++l) {
+            LightArrival a;
+            if (!arrival(lights[l], x, a)) continue;  // the sky enters through the boundary
+            double e = a.irradiance[channel];
+            if (std::isfinite(a.distance) && a.distance < nearest) e *= (a.distance / nearest) * (a.distance / nearest);
+            if (!(a.distance > 0.0)) {
+              const auto* p = std::get_if<PointLight>(&lights[l]);
+              e = p ? p->intensity[channel] / (nearest * nearest) : 0.0;
+              a.to_light = Vec3(0.0);  // every cosine 0: an isotropic source
+            }
+            e *= std::exp(-sigma_t * static_cast<double>(depths[l].values()[c]));
+            if (!(e > 0.0)) continue;
+            for (size_t t = 0; t < d; ++t) cosines[t] = static_cast<float>(-glm::dot(a.to_light, directions[order_[t]]));
+            simd::eval_phase(volume.phase, cosines.data(), phase.data(), d);
+            double sum = 0.0;
+            for (size_t t = 0; t < d; ++t) sum += static_cast<double>(phase[t]);
+            const auto scale = static_cast<float>(e / (sum * weight));
+            for (size_t t = 0; t < d; ++t) f[t] += scale * phase[t];
+          }
+        }
+  });
+  return first;
+}
+
+std::vector<float> Transport::paper(const Channel& ch, const std::vector<float>& first, const std::vector<float>* warm,
+                                    const DomSettings& settings, int& iterations, std::vector<double>& changes) const {
+  const auto d = static_cast<long>(d_), n = static_cast<long>(n_terms_);
+  const auto nx = n_[0], ny = n_[1], nz = n_[2];
+  using Matrix = Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic>;
+  const Eigen::Map<const Matrix> qt(q_.data(), n, d), lqt(lq_.data(), n, d);  // Q^T and (Q Lambda)^T, regrouped
+  std::vector<float> radiance(cells_ * static_cast<size_t>(d), 0.0f), next(radiance.size()), inscatter(radiance.size());
+  std::vector<float> moments(cells_ * static_cast<size_t>(n), 0.0f), previous;
+  auto project = [&](const std::vector<float>& from, std::vector<float>& to) {  // moments of every cell
+    parallel_for(static_cast<long long>(cells_), settings.threads, 4096, [&](long long c0, long long c1) {
+      Eigen::Map<Matrix>(to.data() + c0 * n, n, c1 - c0).noalias() = qt * Eigen::Map<const Matrix>(from.data() + c0 * d, d, c1 - c0);
+    });
+  };
+  if (warm) {  // radiance from the warm moments: L = Q m (exact for the full matrix)
+    moments = *warm;
+    parallel_for(static_cast<long long>(cells_), settings.threads, 4096, [&](long long c0, long long c1) {
+      Eigen::Map<Matrix>(radiance.data() + c0 * d, d, c1 - c0).noalias() =
+          qt.transpose() * Eigen::Map<const Matrix>(moments.data() + c0 * n, n, c1 - c0);
+    });
+  }
+  const size_t sx = 1, sy = static_cast<size_t>(nx), sz = static_cast<size_t>(nx) * static_cast<size_t>(ny);
+  for (int it = 0; it < settings.max_iterations; ++it) {
+    // In-scattering, seed 000 eq. 6 (full matrix) or eq. 9 (separable), as two products per block.
+    parallel_for(static_cast<long long>(cells_), settings.threads, 4096, [&](long long c0, long long c1) {
+      const Eigen::Map<const Matrix> l(radiance.data() + c0 * d, d, c1 - c0);
+      Eigen::Map<Matrix> s(inscatter.data() + c0 * d, d, c1 - c0);
+      if (full_) s.noalias() = Eigen::Map<const Matrix>(matrix_.data(), d, d) * l;  // P symmetric
+      else s.noalias() = lqt.transpose() * (qt * l);
+    });
+    // Every cell from its upwind neighbours' previous radiance (eq. 7): one cell per iteration.
+    parallel_for(nz, settings.threads, 1, [&](long long k0, long long k1) {
+      for (auto k = static_cast<int>(k0); k < k1; ++k)
+        for (int j = 0; j < ny; ++j)
+          for (int i = 0; i < nx; ++i) {
+            const size_t c = static_cast<size_t>(k) * sz + static_cast<size_t>(j) * sy + static_cast<size_t>(i) * sx;
+            const float sigma_t = ch.sigma_t_scale * ch.density[c], sigma_s = ch.albedo * sigma_t;
+            for (int o = 0; o < 8; ++o) {
+              const int ui = o & 1 ? i + 1 : i - 1, uj = o & 2 ? j + 1 : j - 1, uk = o & 4 ? k + 1 : k - 1;
+              const float* ux = ui >= 0 && ui < nx ? radiance.data() + (c + (o & 1 ? sx : -sx)) * static_cast<size_t>(d) : nullptr;
+              const float* uy = uj >= 0 && uj < ny ? radiance.data() + (c + (o & 2 ? sy : -sy)) * static_cast<size_t>(d) : nullptr;
+              const float* uz = uk >= 0 && uk < nz ? radiance.data() + (c + (o & 4 ? sz : -sz)) * static_cast<size_t>(d) : nullptr;
+              for (int e = start_[static_cast<size_t>(o)]; e < start_[static_cast<size_t>(o) + 1]; ++e) {
+                const auto t = static_cast<size_t>(e);
+                const float* a = a_.data() + 3 * t;
+                const size_t cd = c * static_cast<size_t>(d) + t;
+                const float in = a[0] * (ux ? ux[t] : ch.sky) + a[1] * (uy ? uy[t] : ch.sky) + a[2] * (uz ? uz[t] : ch.sky);
+                next[cd] = (sigma_s * (first[cd] + inscatter[cd]) + in) / (sigma_t + a[0] + a[1] + a[2]);
+              }
+            }
+          }
+    });
+    radiance.swap(next);
+    ++iterations;
+    previous.swap(moments);
+    moments.resize(previous.size());
+    project(radiance, moments);
+    changes.push_back(it == 0 && !warm ? 1.0 : [&] {
+      double diff = 0.0, ref = 0.0;
+      for (size_t i = 0; i < moments.size(); ++i) {
+        const double m = moments[i], dm = m - static_cast<double>(previous[i]);
+        diff += dm * dm, ref += m * m;
+      }
+      return ref > 0.0 ? std::sqrt(diff / ref) : 0.0;
+    }());
+    if (settings.progress && !settings.progress(std::min(1.0, (it + 1.0) / settings.max_iterations))) throw Cancelled();
+    if (changes.back() < settings.tolerance) break;
+  }
+  return moments;
+}
+
+}  // namespace haze::grids::dom
