@@ -83,7 +83,7 @@ class DomMethod final : public Method {
     const int resolution = static_cast<int>(settings.integer("resolution", 64, 2, 1024));
     DomSettings dom;
     dom.directions = static_cast<int>(settings.integer("directions", dom.directions, 8, 4096));
-    dom.terms = static_cast<int>(settings.integer("terms", dom.terms, 0, 4096));
+    dom.terms = static_cast<int>(settings.integer("terms", std::min(dom.terms, dom.directions), 0, dom.directions));
     dom.scheme = dom_scheme_from_name(settings.choice("scheme", "sweep", {"paper", "sweep"}));
     dom.accelerator = dom_accelerator_from_name(settings.choice("accelerator", "gmres", {"none", "gmres"}));
     dom.max_iterations = static_cast<int>(settings.integer("iterations", dom.max_iterations, 1, 100000));

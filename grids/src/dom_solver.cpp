@@ -41,7 +41,7 @@ size_t available_memory() {
   return pages > 0 && page > 0 ? static_cast<size_t>(pages) * static_cast<size_t>(page) : SIZE_MAX;
 }
 
-int kept_terms(const DomSettings& s) { return s.terms <= 0 || s.terms >= s.directions ? s.directions : s.terms; }
+int kept_terms(const DomSettings& s) { return s.terms == 0 ? s.directions : s.terms; }
 constexpr int kGmresRestart = 12;
 
 double dot(const std::vector<float>& a, const std::vector<float>& b) {
@@ -159,7 +159,9 @@ DomSolution solve_dom(const ExtinctionVolume& volume, const std::vector<Light>& 
                       const DomSettings& settings, const DomSolution* warm) {
   if (settings.directions < 8 || settings.directions > 4096)
     throw Error("directions", to_text(settings.directions), "a direction count in [8, 4096]");
-  if (settings.terms < 0) throw Error("terms", to_text(settings.terms), "a term count >= 1 (or 0 for the full matrix)");
+  if (settings.terms < 0 || settings.terms > settings.directions)
+    throw Error("terms", to_text(settings.terms),
+                "a term count in [1, " + to_text(settings.directions) + "] (the direction count), or 0 for the full matrix");
   if (settings.max_iterations < 1) throw Error("iterations", to_text(settings.max_iterations), "at least 1");
   if (!(settings.tolerance > 0.0)) throw Error("tolerance", to_text(settings.tolerance), "a relative change > 0");
   if (depths.size() != lights.size())

@@ -40,7 +40,7 @@ const char* name(DomAccelerator accelerator);
 
 struct DomSettings {
   int directions = 128;  // D, spherical Fibonacci
-  int terms = 24;        // N separable terms of the phase matrix; D (or 0) keeps the full matrix
+  int terms = 24;        // N separable terms of the phase matrix, at most D; 0 (or D) keeps the full matrix
   DomScheme scheme = DomScheme::sweep;
   DomAccelerator accelerator = DomAccelerator::gmres;
   int max_iterations = 500;
