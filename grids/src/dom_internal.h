@@ -3,6 +3,7 @@
 #pragma once
 
 #include <haze/grids/dom.h>
+#include <haze/simd/dom_sweep.h>
 
 #include <array>
 #include <vector>
@@ -22,18 +23,20 @@ Channel make_channel(const ExtinctionVolume& volume, const std::vector<Light>& l
 // one upwind order through the grid, with their separable-phase rows and face coefficients.
 class Transport {
  public:
-  Transport(const DenseGrid& density, const DirectionSet& directions, const PhaseMatrix& matrix, const SeparablePhase& separable);
+  Transport(const DenseGrid& density, const DirectionSet& directions, const PhaseMatrix& matrix, const SeparablePhase& separable,
+            bool scalar_kernel);
 
   // One upwind sweep of every direction with the step scheme (a face carries its upwind cell's
   // value):  L_d = (sigma_s S_d + sum_e a_e L_up,e) / (sigma_t + sum_e a_e),  a_e = |w_e| / h_e,
   //   S_d = first[cell * D + d] + sum_k lambda_k Q[d][k] m_in[cell * N + k]   (seed 000 eq. 9),
   // radiance `boundary` entering through every face, and the moments of the result
   //   m_out[cell * N + k] = sum_d Q[d][k] L_d   (eq. 10).
-  // first (regrouped order, from first_collision) and m_in may be null. Directions going up and
+  // first (from first_collision) and m_in may be null. Rows run through simd::dom_sweep_row. Directions going up and
   // going down run on two threads into separate buffers, summed in a fixed order.
   void sweep(const Channel& channel, const float* first, const float* m_in, float boundary, float* m_out, int threads) const;
 
-  // The first-collision source per cell and direction (regrouped order), before the factor sigma_s:
+  // The first-collision source per cell and direction (regrouped and padded: [cell * padded + i]
+  // for octant o's directions from padded_start(o)), before the factor sigma_s:
   //   sum_lights p(w_light . w_d) E_light e^(-sigma_t depth) / sum_j p(w_light . w_j) w_j,
   // normalized so its quadrature over directions is exactly E e^(-sigma_t depth).
   std::vector<float> first_collision(const ExtinctionVolume& volume, const std::vector<Light>& lights,
@@ -44,17 +47,31 @@ class Transport {
   std::vector<float> paper(const Channel& channel, const std::vector<float>& first, const std::vector<float>* warm,
                            const DomSettings& settings, int& iterations, std::vector<double>& changes) const;
 
+  // Wall time spent in sweep() and paper() so far.
+  double seconds() const { return seconds_; }
+
  private:
   std::array<int, 3> n_;
   size_t cells_;
   int d_, n_terms_;
   bool full_;                       // N = D: the paper scheme multiplies by the matrix itself
-  std::vector<float> matrix_;       // [i * D + j]: P[order_[i]][order_[j]], when full_
+  std::vector<float> matrix_;       // [i * D + j]: P between regrouped directions i and j, when full_
   mutable std::vector<float> scratch_;  // the second half's sweep output
-  std::vector<int> order_;          // order_[i]: the DirectionSet index of regrouped direction i
+  mutable double seconds_ = 0.0;
+  bool scalar_kernel_;
+  std::vector<Vec3> directions_;    // regrouped
   std::array<int, 9> start_{};      // octant o holds regrouped directions [start_[o], start_[o + 1])
   std::vector<float> a_;            // [i * 3 + e]: |w_e| / h_e
-  std::vector<float> q_, lq_;       // [i * N + k]: Q[order_[i]][k] and lambda_k Q[order_[i]][k]
+  std::vector<float> q_, lq_;       // [i * N + k]: Q[order[i]][k] and lambda_k Q[order[i]][k]
+  // The kernel's view: per octant, its directions padded to a multiple of 8.
+  struct Octant {
+    std::vector<float> a, lq, q;
+    simd::DomOctant view;
+    size_t offset = 0;              // of its first direction in a cell's padded run
+  };
+  std::array<Octant, 8> octants_;
+  size_t padded_ = 0;               // directions per cell in the padded layout
+  std::vector<size_t> padded_index_;  // regrouped direction i -> its place in the padded layout
 };
 
 }  // namespace haze::grids::dom

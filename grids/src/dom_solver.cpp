@@ -9,6 +9,7 @@
 #include "dom_internal.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <fstream>
 #include <unistd.h>
@@ -44,17 +45,38 @@ size_t available_memory() {
 int kept_terms(const DomSettings& s) { return s.terms == 0 ? s.directions : s.terms; }
 constexpr int kGmresRestart = 12;
 
+// Vector operations of the iteration, threaded in fixed chunks (partial sums added in chunk order,
+// so results do not depend on the thread count).
+constexpr long long kChunk = 1 << 16;
+int vector_threads = 0;
+
 double dot(const std::vector<float>& a, const std::vector<float>& b) {
-  double sum = 0.0;
-  for (size_t i = 0; i < a.size(); ++i) sum += static_cast<double>(a[i]) * static_cast<double>(b[i]);
-  return sum;
+  const auto size = static_cast<long long>(a.size());
+  std::vector<double> partial(static_cast<size_t>((size + kChunk - 1) / kChunk), 0.0);
+  parallel_for(size, vector_threads, kChunk, [&](long long i0, long long i1) {
+    float sum[8] = {};
+    long long i = i0;
+    for (; i + 8 <= i1; i += 8)
+      for (long long e = 0; e < 8; ++e) sum[e] += a[static_cast<size_t>(i + e)] * b[static_cast<size_t>(i + e)];
+    double total = 0.0;
+    for (float e : sum) total += static_cast<double>(e);
+    for (; i < i1; ++i) total += static_cast<double>(a[static_cast<size_t>(i)] * b[static_cast<size_t>(i)]);
+    partial[static_cast<size_t>(i0 / kChunk)] = total;
+  });
+  double total = 0.0;
+  for (double p : partial) total += p;
+  return total;
 }
 double norm(const std::vector<float>& a) { return std::sqrt(dot(a, a)); }
-// a += s * b
-void axpy(std::vector<float>& a, double s, const std::vector<float>& b) {
-  const auto f = static_cast<float>(s);
-  for (size_t i = 0; i < a.size(); ++i) a[i] += f * b[i];
+// a = alpha a + beta b
+void combine(std::vector<float>& a, double alpha, double beta, const std::vector<float>& b) {
+  const auto fa = static_cast<float>(alpha), fb = static_cast<float>(beta);
+  parallel_for(static_cast<long long>(a.size()), vector_threads, kChunk, [&](long long i0, long long i1) {
+    for (auto i = static_cast<size_t>(i0); i < static_cast<size_t>(i1); ++i) a[i] = fa * a[i] + fb * b[i];
+  });
 }
+void axpy(std::vector<float>& a, double s, const std::vector<float>& b) { combine(a, 1.0, s, b); }
+
 // Calls the progress callback once per iteration; throws haze::Cancelled when it says stop.
 struct IterationProgress {
   const DomSettings& settings;
@@ -69,10 +91,13 @@ void solve_moments(const dom::Transport& t, const dom::Channel& channel, const s
                    const DomSettings& settings, DomSolution& out) {
   const IterationProgress progress{settings};
   std::vector<float> kx(x.size());
+  vector_threads = settings.threads;
   auto residual = [&](std::vector<float>& r) {  // r = b + K x - x, one sweep
     t.sweep(channel, nullptr, x.data(), 0.0f, kx.data(), settings.threads);
     ++out.iterations;
-    for (size_t i = 0; i < r.size(); ++i) r[i] = b[i] + kx[i] - x[i];
+    r = kx;
+    axpy(r, 1.0, b);
+    axpy(r, -1.0, x);
   };
   if (settings.accelerator == DomAccelerator::none) {
     std::vector<float> r(x.size());
@@ -99,21 +124,24 @@ void solve_moments(const dom::Transport& t, const dom::Channel& channel, const s
     out.changes.push_back(beta / x_norm);
     progress(out.iterations);
     if (beta / x_norm < settings.tolerance || beta == 0.0) return;
-    for (auto& e : v[0]) e = static_cast<float>(static_cast<double>(e) / beta);
+    combine(v[0], 1.0 / beta, 0.0, v[0]);
     g.setZero();
     g(0) = beta;
     int j = 0;
     for (; j < m && out.iterations < settings.max_iterations; ++j) {
       t.sweep(channel, nullptr, v[static_cast<size_t>(j)].data(), 0.0f, kx.data(), settings.threads);  // w = (I - K) v_j
       ++out.iterations;
-      for (size_t i = 0; i < w.size(); ++i) w[i] = v[static_cast<size_t>(j)][i] - kx[i];
+      w = v[static_cast<size_t>(j)];
+      axpy(w, -1.0, kx);
       for (int i = 0; i <= j; ++i) {
         h(i, j) = dot(w, v[static_cast<size_t>(i)]);
         axpy(w, -h(i, j), v[static_cast<size_t>(i)]);
       }
       h(j + 1, j) = norm(w);
-      if (h(j + 1, j) > 0.0)
-        for (size_t i = 0; i < w.size(); ++i) v[static_cast<size_t>(j + 1)][i] = static_cast<float>(static_cast<double>(w[i]) / h(j + 1, j));
+      if (h(j + 1, j) > 0.0) {
+        v[static_cast<size_t>(j + 1)] = w;
+        combine(v[static_cast<size_t>(j + 1)], 1.0 / h(j + 1, j), 0.0, w);
+      }
       for (int i = 0; i < j; ++i) {
         const double a = cs(i) * h(i, j) + sn(i) * h(i + 1, j);
         h(i + 1, j) = -sn(i) * h(i, j) + cs(i) * h(i + 1, j);
@@ -179,6 +207,7 @@ DomSolution solve_dom(const ExtinctionVolume& volume, const std::vector<Light>& 
       else grey = grey && is_grey(light.intensity);
     }, l);
   }
+  const auto start = std::chrono::steady_clock::now();
   DomSolution out;
   out.channels = grey ? 1 : 3;
   out.resolution = volume.density.resolution();
@@ -191,7 +220,7 @@ DomSolution solve_dom(const ExtinctionVolume& volume, const std::vector<Light>& 
   out.directions = std::make_shared<DirectionSet>(DirectionSet::fibonacci(settings.directions));
   out.matrix = std::make_shared<PhaseMatrix>(volume.phase, *out.directions);
   out.separable = std::make_shared<SeparablePhase>(*out.matrix, kept_terms(settings));
-  const dom::Transport transport(volume.density, *out.directions, *out.matrix, *out.separable);
+  const dom::Transport transport(volume.density, *out.directions, *out.matrix, *out.separable, settings.scalar_kernel);
   const size_t size = volume.density.cell_count() * static_cast<size_t>(out.terms());
   const bool warm_fits = warm && warm->channels == out.channels && warm->resolution == out.resolution &&
                          warm->terms() == out.terms() && warm->directions && warm->directions->size() == settings.directions;
@@ -214,6 +243,8 @@ DomSolution solve_dom(const ExtinctionVolume& volume, const std::vector<Light>& 
     solve_moments(transport, channel, b, x, settings, out);
   }
   out.converged = !out.changes.empty() && out.changes.back() < settings.tolerance;
+  out.sweep_seconds = transport.seconds();
+  out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return out;
 }
 

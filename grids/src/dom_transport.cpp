@@ -6,6 +6,7 @@
 #include <haze/simd/phase_batch.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 
 namespace haze::grids::dom {
@@ -27,21 +28,23 @@ Channel make_channel(const ExtinctionVolume& volume, const std::vector<Light>& l
   return c;
 }
 
-Transport::Transport(const DenseGrid& density, const DirectionSet& directions, const PhaseMatrix& matrix, const SeparablePhase& separable)
+Transport::Transport(const DenseGrid& density, const DirectionSet& directions, const PhaseMatrix& matrix, const SeparablePhase& separable,
+                     bool scalar_kernel)
     : n_(density.resolution()), cells_(density.cell_count()), d_(directions.size()), n_terms_(separable.terms()),
-      full_(separable.terms() == directions.size()) {
-  order_.resize(static_cast<size_t>(d_));
-  for (int i = 0; i < d_; ++i) order_[static_cast<size_t>(i)] = i;
-  std::stable_sort(order_.begin(), order_.end(), [&](int a, int b) { return octant(directions[a]) < octant(directions[b]); });
+      full_(separable.terms() == directions.size()), scalar_kernel_(scalar_kernel) {
+  std::vector<int> order(static_cast<size_t>(d_));
+  for (int i = 0; i < d_; ++i) order[static_cast<size_t>(i)] = i;
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return octant(directions[a]) < octant(directions[b]); });
   for (int o = 0, i = 0; o <= 8; ++o) {
-    while (i < d_ && octant(directions[order_[static_cast<size_t>(i)]]) < o) ++i;
+    while (i < d_ && octant(directions[order[static_cast<size_t>(i)]]) < o) ++i;
     start_[static_cast<size_t>(o)] = i;
   }
   const Vec3 h = density.cell_size();
   const auto d = static_cast<size_t>(d_), n = static_cast<size_t>(n_terms_);
   a_.resize(3 * d), q_.resize(d * n), lq_.resize(d * n);
   for (size_t i = 0; i < d; ++i) {
-    const int dir = order_[i];
+    const int dir = order[i];
+    directions_.push_back(directions[dir]);
     for (int e = 0; e < 3; ++e) a_[i * 3 + static_cast<size_t>(e)] = static_cast<float>(std::abs(directions[dir][e]) / h[e]);
     for (size_t k = 0; k < n; ++k) {
       q_[i * n + k] = static_cast<float>(separable.basis()(dir, static_cast<int>(k)));
@@ -51,81 +54,85 @@ Transport::Transport(const DenseGrid& density, const DirectionSet& directions, c
   if (full_) {
     matrix_.resize(d * d);
     for (size_t i = 0; i < d; ++i)
-      for (size_t j = 0; j < d; ++j) matrix_[i * d + j] = static_cast<float>(matrix(order_[i], order_[j]));
+      for (size_t j = 0; j < d; ++j) matrix_[i * d + j] = static_cast<float>(matrix(order[i], order[j]));
+  }
+  const size_t np = (n + 7) / 8 * 8;
+  padded_index_.resize(d);
+  for (size_t o = 0; o < 8; ++o) {
+    Octant& oc = octants_[o];
+    const auto i0 = static_cast<size_t>(start_[o]), count = static_cast<size_t>(start_[o + 1]) - i0, p = (count + 7) / 8 * 8;
+    oc.offset = padded_;
+    padded_ += p;
+    oc.a.assign(4 * p, 0.0f), oc.lq.assign(n * p, 0.0f), oc.q.assign(p * np, 0.0f);
+    for (size_t e = 0; e < p; ++e) oc.a[3 * p + e] = 1.0f;  // padding: L = 0 / (sigma_t + 1)
+    for (size_t e = 0; e < count; ++e) {
+      const size_t i = i0 + e;
+      padded_index_[i] = oc.offset + e;
+      oc.a[3 * p + e] = 0.0f;
+      for (size_t axis = 0; axis < 3; ++axis) {
+        oc.a[axis * p + e] = a_[i * 3 + axis];
+        oc.a[3 * p + e] += a_[i * 3 + axis];
+      }
+      for (size_t k = 0; k < n; ++k) oc.lq[k * p + e] = lq_[i * n + k], oc.q[e * np + k] = q_[i * n + k];
+    }
+    oc.view = {static_cast<int>(p), n_terms_, static_cast<int>(np), oc.a.data(), oc.lq.data(), oc.q.data()};
   }
 }
 
 void Transport::sweep(const Channel& ch, const float* first, const float* m_in, float boundary, float* m_out, int threads) const {
   const auto nx = n_[0], ny = n_[1], nz = n_[2];
-  const auto n = static_cast<size_t>(n_terms_), d_all = static_cast<size_t>(d_);
-  const size_t size = cells_ * n;
+  const auto start = std::chrono::steady_clock::now();
+  const size_t size = cells_ * static_cast<size_t>(n_terms_);
   scratch_.resize(size);
+  const auto row_kernel = scalar_kernel_ ? simd::dom_sweep_row_reference : simd::dom_sweep_row;
   parallel_for(2, threads, 1, [&](long long h0, long long h1) {
     for (long long half = h0; half < h1; ++half) {
       float* out = half == 0 ? m_out : scratch_.data();
       std::fill(out, out + size, 0.0f);
-      for (int o = 4 * static_cast<int>(half); o < 4 * static_cast<int>(half) + 4; ++o) {
-        const int i0 = start_[static_cast<size_t>(o)], dq = start_[static_cast<size_t>(o) + 1] - i0;
-        if (dq == 0) continue;
-        const auto q = static_cast<size_t>(dq);
-        const float* a = a_.data() + 3 * static_cast<size_t>(i0);
-        const float* lq = lq_.data() + static_cast<size_t>(i0) * n;
-        const float* qd = q_.data() + static_cast<size_t>(i0) * n;
-        std::vector<float> zplane(static_cast<size_t>(nx) * static_cast<size_t>(ny) * q, boundary), yrow(static_cast<size_t>(nx) * q);
-        std::vector<float> xrun(q), src(q), asum(q);
-        for (size_t i = 0; i < q; ++i) asum[i] = a[3 * i] + a[3 * i + 1] + a[3 * i + 2];
+      for (size_t o = 4 * static_cast<size_t>(half); o < 4 * static_cast<size_t>(half) + 4; ++o) {
+        const Octant& oc = octants_[o];
+        const auto p = static_cast<size_t>(oc.view.directions);
+        if (p == 0) continue;
+        std::vector<float> z_plane(static_cast<size_t>(nx) * static_cast<size_t>(ny) * p, boundary), y_row(static_cast<size_t>(nx) * p),
+            x_run(p), scratch(p + static_cast<size_t>(oc.view.terms_padded));
+        simd::DomRow row;
+        row.count = nx;
+        row.step = o & 1 ? -1 : 1;
+        row.x0 = o & 1 ? nx - 1 : 0;
+        row.density = ch.density, row.sigma_t_scale = ch.sigma_t_scale, row.albedo = ch.albedo;
+        row.first = first ? first + oc.offset : nullptr;
+        row.first_stride = padded_;
+        row.m_in = m_in, row.m_out = out;
+        row.x_run = x_run.data(), row.y_row = y_row.data(), row.scratch = scratch.data();
         for (int kk = 0; kk < nz; ++kk) {
           const int k = o & 4 ? nz - 1 - kk : kk;
-          std::fill(yrow.begin(), yrow.end(), boundary);
+          std::fill(y_row.begin(), y_row.end(), boundary);
           for (int jj = 0; jj < ny; ++jj) {
             const int j = o & 2 ? ny - 1 - jj : jj;
-            std::fill(xrun.begin(), xrun.end(), boundary);
-            for (int ii = 0; ii < nx; ++ii) {
-              const int i = o & 1 ? nx - 1 - ii : ii;
-              const size_t c = (static_cast<size_t>(k) * static_cast<size_t>(ny) + static_cast<size_t>(j)) * static_cast<size_t>(nx) +
-                               static_cast<size_t>(i);
-              const float sigma_t = ch.sigma_t_scale * ch.density[c], sigma_s = ch.albedo * sigma_t;
-              float* yp = yrow.data() + static_cast<size_t>(i) * q;
-              float* zp = zplane.data() + (static_cast<size_t>(j) * static_cast<size_t>(nx) + static_cast<size_t>(i)) * q;
-              std::fill(src.begin(), src.end(), 0.0f);
-              if (m_in) {
-                const float* m = m_in + c * n;
-                for (size_t e = 0; e < q; ++e) {
-                  float s = 0.0f;
-                  for (size_t t = 0; t < n; ++t) s += lq[e * n + t] * m[t];
-                  src[e] = s;
-                }
-              }
-              if (first) {
-                const float* f = first + c * d_all + static_cast<size_t>(i0);
-                for (size_t e = 0; e < q; ++e) src[e] += f[e];
-              }
-              float* mo = out + c * n;
-              for (size_t e = 0; e < q; ++e) {
-                const float l = (sigma_s * src[e] + a[3 * e] * xrun[e] + a[3 * e + 1] * yp[e] + a[3 * e + 2] * zp[e]) / (sigma_t + asum[e]);
-                xrun[e] = yp[e] = zp[e] = l;
-                for (size_t t = 0; t < n; ++t) mo[t] += qd[e * n + t] * l;
-              }
-            }
+            std::fill(x_run.begin(), x_run.end(), boundary);
+            row.cell0 = (static_cast<size_t>(k) * static_cast<size_t>(ny) + static_cast<size_t>(j)) * static_cast<size_t>(nx) +
+                        static_cast<size_t>(row.x0);
+            row.z_row = z_plane.data() + static_cast<size_t>(j) * static_cast<size_t>(nx) * p;
+            row_kernel(oc.view, row);
           }
         }
       }
     }
   });
   for (size_t i = 0; i < size; ++i) m_out[i] += scratch_[i];
+  seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
 std::vector<float> Transport::first_collision(const ExtinctionVolume& volume, const std::vector<Light>& lights,
                                               const std::vector<DenseGrid>& depths, int channel, int threads) const {
   const DenseGrid& grid = volume.density;
   const auto d = static_cast<size_t>(d_);
-  const DirectionSet directions = DirectionSet::fibonacci(d_);
   const Vec3 h = grid.cell_size();
   // A point light inside a cell delivers the irradiance at half a cell's distance, no more: the
   // cell's source stays finite (and isotropic when the light sits at its centre).
   const double nearest = 0.5 * std::min({h.x, h.y, h.z});
   const double sigma_t = volume.sigma_t_scale[channel], weight = 4.0 * kPi / d_;
-  std::vector<float> first(cells_ * d, 0.0f);
+  std::vector<float> first(cells_ * padded_, 0.0f);
   const auto nx = n_[0], ny = n_[1];
   parallel_for(n_[2], threads, 1, [&](long long k0, long long k1) {
     std::vector<float> cosines(d), phase(d);
@@ -134,7 +141,7 @@ std::vector<float> Transport::first_collision(const ExtinctionVolume& volume, co
         for (int i = 0; i < nx; ++i) {
           const size_t c = grid.index(i, j, k);
           const Vec3 x = grid.cell_center(i, j, k);
-          float* f = first.data() + c * d;
+          float* f = first.data() + c * padded_;
           for (size_t l = 0; l < lights.size(); ++l) {
             LightArrival a;
             if (!arrival(lights[l], x, a)) continue;  // the sky enters through the boundary
@@ -147,12 +154,12 @@ std::vector<float> Transport::first_collision(const ExtinctionVolume& volume, co
             }
             e *= std::exp(-sigma_t * static_cast<double>(depths[l].values()[c]));
             if (!(e > 0.0)) continue;
-            for (size_t t = 0; t < d; ++t) cosines[t] = static_cast<float>(-glm::dot(a.to_light, directions[order_[t]]));
+            for (size_t t = 0; t < d; ++t) cosines[t] = static_cast<float>(-glm::dot(a.to_light, directions_[t]));
             simd::eval_phase(volume.phase, cosines.data(), phase.data(), d);
             double sum = 0.0;
             for (size_t t = 0; t < d; ++t) sum += static_cast<double>(phase[t]);
             const auto scale = static_cast<float>(e / (sum * weight));
-            for (size_t t = 0; t < d; ++t) f[t] += scale * phase[t];
+            for (size_t t = 0; t < d; ++t) f[padded_index_[t]] += scale * phase[t];
           }
         }
   });
@@ -180,6 +187,7 @@ std::vector<float> Transport::paper(const Channel& ch, const std::vector<float>&
     });
   }
   const size_t sx = 1, sy = static_cast<size_t>(nx), sz = static_cast<size_t>(nx) * static_cast<size_t>(ny);
+  const auto start = std::chrono::steady_clock::now();
   for (int it = 0; it < settings.max_iterations; ++it) {
     // In-scattering, seed 000 eq. 6 (full matrix) or eq. 9 (separable), as two products per block.
     parallel_for(static_cast<long long>(cells_), settings.threads, 4096, [&](long long c0, long long c1) {
@@ -205,7 +213,8 @@ std::vector<float> Transport::paper(const Channel& ch, const std::vector<float>&
                 const float* a = a_.data() + 3 * t;
                 const size_t cd = c * static_cast<size_t>(d) + t;
                 const float in = a[0] * (ux ? ux[t] : ch.sky) + a[1] * (uy ? uy[t] : ch.sky) + a[2] * (uz ? uz[t] : ch.sky);
-                next[cd] = (sigma_s * (first[cd] + inscatter[cd]) + in) / (sigma_t + a[0] + a[1] + a[2]);
+                const float source = first[c * padded_ + padded_index_[t]] + inscatter[cd];
+                next[cd] = (sigma_s * source + in) / (sigma_t + a[0] + a[1] + a[2]);
               }
             }
           }
@@ -226,6 +235,7 @@ std::vector<float> Transport::paper(const Channel& ch, const std::vector<float>&
     if (settings.progress && !settings.progress(std::min(1.0, (it + 1.0) / settings.max_iterations))) throw Cancelled();
     if (changes.back() < settings.tolerance) break;
   }
+  seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return moments;
 }
 

@@ -47,6 +47,7 @@ struct DomSettings {
   // Stop when max over cells |change of the scalar flux| / max scalar flux falls below this.
   double tolerance = 1e-3;
   int threads = 0;  // 0: every core oneTBB offers
+  bool scalar_kernel = false;  // sweep: the scalar reference kernel instead of the SIMD one (tests, benchmarks)
   ProgressCallback progress;  // once per iteration, with the fraction of max_iterations done
 };
 
@@ -65,6 +66,8 @@ struct DomSolution {
   bool converged = false;
   std::vector<double> changes;     // the relative change after each iteration
   size_t bytes = 0;                // peak memory the solver held for its fields
+  double sweep_seconds = 0.0;      // wall time in transport sweeps (paper: in its iterations)
+  double seconds = 0.0;            // wall time of the whole solve (phase matrix, first collision, sweeps)
 
   int terms() const { return separable ? separable->terms() : 0; }
 };

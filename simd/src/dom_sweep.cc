@@ -1,0 +1,43 @@
+// Dispatch and scalar reference for the discrete-ordinate row sweep (Highway skeleton layout).
+#undef HWY_TARGET_INCLUDE
+#define HWY_TARGET_INCLUDE "dom_sweep.cc"
+#include <hwy/foreach_target.h>  // IWYU pragma: keep
+
+#include "dom_sweep-inl.h"
+
+#include <hwy/highway.h>
+
+#if HWY_ONCE
+namespace haze::simd {
+
+HWY_EXPORT(DomSweepRow);
+
+void dom_sweep_row_reference(const DomOctant& o, const DomRow& r) {
+  const auto p = static_cast<size_t>(o.directions), n = static_cast<size_t>(o.terms), np = static_cast<size_t>(o.terms_padded);
+  float* light = r.scratch;
+  for (int m = 0; m < r.count; ++m) {
+    const size_t c = r.cell0 + static_cast<size_t>(static_cast<long>(m) * r.step);
+    const auto x = static_cast<size_t>(r.x0 + m * r.step);
+    const float sigma_t = r.sigma_t_scale * r.density[c], sigma_s = r.albedo * sigma_t;
+    float* y = r.y_row + x * p;
+    float* z = r.z_row + x * p;
+    for (size_t d = 0; d < p; ++d) {
+      float s = r.first ? r.first[c * r.first_stride + d] : 0.0f;
+      if (r.m_in)
+        for (size_t k = 0; k < n; ++k) s += o.lq[k * p + d] * r.m_in[c * n + k];
+      const float l = (sigma_s * s + o.a[d] * r.x_run[d] + o.a[p + d] * y[d] + o.a[2 * p + d] * z[d]) / (sigma_t + o.a[3 * p + d]);
+      r.x_run[d] = y[d] = z[d] = light[d] = l;
+    }
+    float* out = r.m_out + c * n;
+    for (size_t k = 0; k < n; ++k) {
+      float sum = 0.0f;
+      for (size_t d = 0; d < p; ++d) sum += o.q[d * np + k] * light[d];
+      out[k] += sum;
+    }
+  }
+}
+
+void dom_sweep_row(const DomOctant& octant, const DomRow& row) { HWY_DYNAMIC_DISPATCH(DomSweepRow)(octant, row); }
+
+}  // namespace haze::simd
+#endif  // HWY_ONCE
