@@ -10,14 +10,15 @@
 
 namespace haze::grids::dom {
 
-// One channel of the medium: sigma_t = sigma_t_scale * density, sigma_s = albedo * sigma_t.
+// One channel of the medium: sigma_t = sigma_t_scale * density, sigma_s = albedo * sigma_t; with
+// delta-M fraction f, the scaled sigma_t (1 - albedo f) and albedo (1 - f) / (1 - albedo f).
 struct Channel {
   int index = 0;  // 0, 1, 2: which RGB channel
   float sigma_t_scale = 1.0f, albedo = 0.0f;
   float sky = 0.0f;  // radiance entering through the boundary
   const float* density = nullptr;
 };
-Channel make_channel(const ExtinctionVolume& volume, const std::vector<Light>& lights, int channel);
+Channel make_channel(const ExtinctionVolume& volume, const std::vector<Light>& lights, int channel, double delta_m_fraction);
 
 // The directions regrouped by octant (signs of x, y, z), so that each octant's directions share
 // one upwind order through the grid, with their separable-phase rows and face coefficients.
@@ -38,9 +39,10 @@ class Transport {
   // The first-collision source per cell and direction (regrouped and padded: [cell * padded + i]
   // for octant o's directions from padded_start(o)), before the factor sigma_s:
   //   sum_lights p(w_light . w_d) E_light e^(-sigma_t depth) / sum_j p(w_light . w_j) w_j,
-  // normalized so its quadrature over directions is exactly E e^(-sigma_t depth).
+  // normalized so its quadrature over directions is exactly E e^(-sigma_t depth), times `scale`
+  // (1 / (1 - f) under delta-M scaling, so that the scaled sigma_s gives back the true one).
   std::vector<float> first_collision(const ExtinctionVolume& volume, const std::vector<Light>& lights,
-                                     const std::vector<DenseGrid>& depths, int channel, int threads) const;
+                                     const std::vector<DenseGrid>& depths, int channel, double scale, int threads) const;
 
   // The paper's scheme: full radiance per cell and direction, every cell updated from its upwind
   // neighbours' previous values (Jacobi). Returns the moments; appends one change per iteration.

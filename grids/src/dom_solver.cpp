@@ -218,7 +218,21 @@ DomSolution solve_dom(const ExtinctionVolume& volume, const std::vector<Light>& 
                 "a solve that fits in the " + to_text(free >> 20) + " MiB available (fewer cells, directions or terms)");
 
   out.directions = std::make_shared<DirectionSet>(DirectionSet::fibonacci(settings.directions));
-  out.matrix = std::make_shared<PhaseMatrix>(volume.phase, *out.directions);
+  out.phase = volume.phase;
+  if (settings.delta_m && kept_terms(settings) < settings.directions) {
+    const auto m = static_cast<int>(std::floor(std::sqrt(kept_terms(settings))));
+    const std::vector<double> b = volume.phase.legendre_moments(m + 1);
+    if (const double f = b[static_cast<size_t>(m)]; f > 1e-6 && f < 1.0) {
+      std::vector<double> remainder(static_cast<size_t>(m));
+      for (size_t k = 0; k < remainder.size(); ++k) remainder[k] = (b[k] - f) / (1.0 - f);
+      std::vector<double> table(2049);
+      for (size_t i = 0; i < table.size(); ++i)
+        table[i] = std::max(0.0, eval_legendre_series(remainder, -1.0 + 2.0 * static_cast<double>(i) / 2048.0));
+      out.phase = PhaseFunction::tabulated(std::move(table));
+      out.delta_m_fraction = f;
+    }
+  }
+  out.matrix = std::make_shared<PhaseMatrix>(out.phase, *out.directions);
   out.separable = std::make_shared<SeparablePhase>(*out.matrix, kept_terms(settings));
   const dom::Transport transport(volume.density, *out.directions, *out.matrix, *out.separable, settings.scalar_kernel);
   const size_t size = volume.density.cell_count() * static_cast<size_t>(out.terms());
@@ -227,8 +241,8 @@ DomSolution solve_dom(const ExtinctionVolume& volume, const std::vector<Light>& 
 
   out.moments.resize(static_cast<size_t>(out.channels));
   for (int c = 0; c < out.channels; ++c) {
-    const dom::Channel channel = dom::make_channel(volume, lights, c);
-    std::vector<float> first = transport.first_collision(volume, lights, depths, c, settings.threads);
+    const dom::Channel channel = dom::make_channel(volume, lights, c, out.delta_m_fraction);
+    std::vector<float> first = transport.first_collision(volume, lights, depths, c, 1.0 / (1.0 - out.delta_m_fraction), settings.threads);
     std::vector<float>& x = out.moments[static_cast<size_t>(c)];
     if (settings.scheme == DomScheme::paper) {
       x = transport.paper(channel, first, warm_fits ? &warm->moments[static_cast<size_t>(c)] : nullptr, settings, out.iterations,
@@ -248,7 +262,8 @@ DomSolution solve_dom(const ExtinctionVolume& volume, const std::vector<Light>& 
   return out;
 }
 
-Eigen::VectorXd inscatter_weights(const DomSolution& solution, const PhaseFunction& phase, const Vec3& w) {
+Eigen::VectorXd inscatter_weights(const DomSolution& solution, const Vec3& w) {
+  const PhaseFunction& phase = solution.phase;
   const DirectionSet& dirs = *solution.directions;
   const Eigen::VectorXd& s = solution.matrix->scaling();
   Eigen::VectorXd row(dirs.size());

@@ -17,11 +17,12 @@ int octant(const Vec3& w) { return (w.x < 0.0 ? 1 : 0) | (w.y < 0.0 ? 2 : 0) | (
 
 }  // namespace
 
-Channel make_channel(const ExtinctionVolume& volume, const std::vector<Light>& lights, int channel) {
+Channel make_channel(const ExtinctionVolume& volume, const std::vector<Light>& lights, int channel, double delta_m_fraction) {
   Channel c;
+  const double f = delta_m_fraction, albedo = volume.albedo[channel];
   c.index = channel;
-  c.sigma_t_scale = static_cast<float>(volume.sigma_t_scale[channel]);
-  c.albedo = static_cast<float>(volume.albedo[channel]);
+  c.sigma_t_scale = static_cast<float>(volume.sigma_t_scale[channel] * (1.0 - albedo * f));
+  c.albedo = static_cast<float>(albedo * (1.0 - f) / (1.0 - albedo * f));
   for (const Light& l : lights)
     if (const auto* sky = std::get_if<SkyLight>(&l)) c.sky += static_cast<float>(sky->radiance[channel]);
   c.density = volume.density.values().data();
@@ -124,7 +125,7 @@ void Transport::sweep(const Channel& ch, const float* first, const float* m_in, 
 }
 
 std::vector<float> Transport::first_collision(const ExtinctionVolume& volume, const std::vector<Light>& lights,
-                                              const std::vector<DenseGrid>& depths, int channel, int threads) const {
+                                              const std::vector<DenseGrid>& depths, int channel, double scale_all, int threads) const {
   const DenseGrid& grid = volume.density;
   const auto d = static_cast<size_t>(d_);
   const Vec3 h = grid.cell_size();
@@ -158,7 +159,7 @@ std::vector<float> Transport::first_collision(const ExtinctionVolume& volume, co
             simd::eval_phase(volume.phase, cosines.data(), phase.data(), d);
             double sum = 0.0;
             for (size_t t = 0; t < d; ++t) sum += static_cast<double>(phase[t]);
-            const auto scale = static_cast<float>(e / (sum * weight));
+            const auto scale = static_cast<float>(scale_all * e / (sum * weight));
             for (size_t t = 0; t < d; ++t) f[padded_index_[t]] += scale * phase[t];
           }
         }

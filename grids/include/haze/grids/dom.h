@@ -47,6 +47,12 @@ struct DomSettings {
   // Stop when max over cells |change of the scalar flux| / max scalar flux falls below this.
   double tolerance = 1e-3;
   int threads = 0;  // 0: every core oneTBB offers
+  // Delta-M scaling (Wiscombe 1977) when N < D: with M = floor(sqrt(N)) Legendre orders the N
+  // terms can hold, the fraction f = b_M of the phase function is treated as unscattered
+  // (sigma_t' = sigma_t (1 - albedo f), albedo' = albedo (1 - f) / (1 - albedo f)) and the rest
+  // has moments (b_k - f) / (1 - f), k < M, which N terms represent well. The first-collision
+  // source keeps the exact phase function.
+  bool delta_m = true;
   bool scalar_kernel = false;  // sweep: the scalar reference kernel instead of the SIMD one (tests, benchmarks)
   ProgressCallback progress;  // once per iteration, with the fraction of max_iterations done
 };
@@ -58,6 +64,8 @@ struct DomSolution {
   std::shared_ptr<const DirectionSet> directions;
   std::shared_ptr<const PhaseMatrix> matrix;
   std::shared_ptr<const SeparablePhase> separable;
+  PhaseFunction phase;             // the one the matrix holds: the medium's, or its delta-M remainder
+  double delta_m_fraction = 0.0;   // f: 0 without delta-M scaling
   std::array<int, 3> resolution{0, 0, 0};
   int channels = 0;
   std::vector<std::vector<float>> moments;  // [channel][cell * N + k], cells in public x-fastest order
@@ -83,7 +91,16 @@ DomSolution solve_dom(const ExtinctionVolume& volume, const std::vector<Light>& 
 // For a direction w (propagation direction of the scattered light): c_k with
 // sum_j P(w, w_j) L_j ~ sum_k c_k m_k, the row of P at w extended off the direction set
 // (PhaseMatrix::scaling) and projected on the kept eigenvectors.
-Eigen::VectorXd inscatter_weights(const DomSolution& solution, const PhaseFunction& phase, const Vec3& w);
+Eigen::VectorXd inscatter_weights(const DomSolution& solution, const Vec3& w);
+
+// The image of a solved scene: unscattered light (surfaces lit through `delta_depths`, one per
+// point, spot or directional light of scene.lights in order; the background plus any sky) through
+// the medium, plus, along each camera ray, the single-scattered light and the in-scattered diffuse
+// radiance sum_k c_k m_k (c from inscatter_weights toward the eye), both carried by the delta-M
+// scaled extinction when the solve used it (the formal solution of the scaled equation; with f = 0
+// it is the propagation marcher's estimator plus the gather). One solution serves any camera.
+Image render_dom(const Scene& scene, const ExtinctionVolume& volume, const std::vector<DenseGrid>& delta_depths,
+                 const DomSolution& solution, double step_cells = 0.5, const RenderOptions& options = {});
 
 // The memory a solve with these settings needs, in bytes (what solve_dom checks).
 size_t dom_memory_bytes(const std::array<int, 3>& resolution, int channels, const DomSettings& settings);
