@@ -48,12 +48,11 @@ constexpr int kGmresRestart = 12;
 // Vector operations of the iteration, threaded in fixed chunks (partial sums added in chunk order,
 // so results do not depend on the thread count).
 constexpr long long kChunk = 1 << 16;
-int vector_threads = 0;
 
-double dot(const std::vector<float>& a, const std::vector<float>& b) {
+double dot(const std::vector<float>& a, const std::vector<float>& b, int threads) {
   const auto size = static_cast<long long>(a.size());
   std::vector<double> partial(static_cast<size_t>((size + kChunk - 1) / kChunk), 0.0);
-  parallel_for(size, vector_threads, kChunk, [&](long long i0, long long i1) {
+  parallel_for(size, threads, kChunk, [&](long long i0, long long i1) {
     float sum[8] = {};
     long long i = i0;
     for (; i + 8 <= i1; i += 8)
@@ -67,15 +66,15 @@ double dot(const std::vector<float>& a, const std::vector<float>& b) {
   for (double p : partial) total += p;
   return total;
 }
-double norm(const std::vector<float>& a) { return std::sqrt(dot(a, a)); }
+double norm(const std::vector<float>& a, int threads) { return std::sqrt(dot(a, a, threads)); }
 // a = alpha a + beta b
-void combine(std::vector<float>& a, double alpha, double beta, const std::vector<float>& b) {
+void combine(std::vector<float>& a, double alpha, double beta, const std::vector<float>& b, int threads) {
   const auto fa = static_cast<float>(alpha), fb = static_cast<float>(beta);
-  parallel_for(static_cast<long long>(a.size()), vector_threads, kChunk, [&](long long i0, long long i1) {
+  parallel_for(static_cast<long long>(a.size()), threads, kChunk, [&](long long i0, long long i1) {
     for (auto i = static_cast<size_t>(i0); i < static_cast<size_t>(i1); ++i) a[i] = fa * a[i] + fb * b[i];
   });
 }
-void axpy(std::vector<float>& a, double s, const std::vector<float>& b) { combine(a, 1.0, s, b); }
+void axpy(std::vector<float>& a, double s, const std::vector<float>& b, int threads) { combine(a, 1.0, s, b, threads); }
 
 // Calls the progress callback once per iteration; throws haze::Cancelled when it says stop.
 struct IterationProgress {
@@ -91,20 +90,20 @@ void solve_moments(const dom::Transport& t, const dom::Channel& channel, const s
                    const DomSettings& settings, DomSolution& out) {
   const IterationProgress progress{settings};
   std::vector<float> kx(x.size());
-  vector_threads = settings.threads;
+  const int th = settings.threads;
   auto residual = [&](std::vector<float>& r) {  // r = b + K x - x, one sweep
     t.sweep(channel, nullptr, x.data(), 0.0f, kx.data(), settings.threads);
     ++out.iterations;
     r = kx;
-    axpy(r, 1.0, b);
-    axpy(r, -1.0, x);
+    axpy(r, 1.0, b, th);
+    axpy(r, -1.0, x, th);
   };
   if (settings.accelerator == DomAccelerator::none) {
     std::vector<float> r(x.size());
     while (out.iterations < settings.max_iterations) {
       residual(r);
-      axpy(x, 1.0, r);
-      const double change = norm(r) / std::max(norm(x), 1e-300);
+      axpy(x, 1.0, r, th);
+      const double change = norm(r, th) / std::max(norm(x, th), 1e-300);
       out.changes.push_back(change);
       progress(out.iterations);
       if (change < settings.tolerance) return;
@@ -119,12 +118,12 @@ void solve_moments(const dom::Transport& t, const dom::Channel& channel, const s
   Eigen::VectorXd cs(m), sn(m), g(m + 1);
   while (out.iterations < settings.max_iterations) {
     residual(v[0]);
-    const double x_norm = std::max(norm(x), 1e-300);
-    double beta = norm(v[0]);
+    const double x_norm = std::max(norm(x, th), 1e-300);
+    double beta = norm(v[0], th);
     out.changes.push_back(beta / x_norm);
     progress(out.iterations);
     if (beta / x_norm < settings.tolerance || beta == 0.0) return;
-    combine(v[0], 1.0 / beta, 0.0, v[0]);
+    combine(v[0], 1.0 / beta, 0.0, v[0], th);
     g.setZero();
     g(0) = beta;
     int j = 0;
@@ -132,15 +131,15 @@ void solve_moments(const dom::Transport& t, const dom::Channel& channel, const s
       t.sweep(channel, nullptr, v[static_cast<size_t>(j)].data(), 0.0f, kx.data(), settings.threads);  // w = (I - K) v_j
       ++out.iterations;
       w = v[static_cast<size_t>(j)];
-      axpy(w, -1.0, kx);
+      axpy(w, -1.0, kx, th);
       for (int i = 0; i <= j; ++i) {
-        h(i, j) = dot(w, v[static_cast<size_t>(i)]);
-        axpy(w, -h(i, j), v[static_cast<size_t>(i)]);
+        h(i, j) = dot(w, v[static_cast<size_t>(i)], th);
+        axpy(w, -h(i, j), v[static_cast<size_t>(i)], th);
       }
-      h(j + 1, j) = norm(w);
+      h(j + 1, j) = norm(w, th);
       if (h(j + 1, j) > 0.0) {
         v[static_cast<size_t>(j + 1)] = w;
-        combine(v[static_cast<size_t>(j + 1)], 1.0 / h(j + 1, j), 0.0, w);
+        combine(v[static_cast<size_t>(j + 1)], 1.0 / h(j + 1, j), 0.0, w, th);
       }
       for (int i = 0; i < j; ++i) {
         const double a = cs(i) * h(i, j) + sn(i) * h(i + 1, j);
@@ -161,7 +160,7 @@ void solve_moments(const dom::Transport& t, const dom::Channel& channel, const s
     }
     // x += V_j y, with H_j y = g_j (upper triangular).
     Eigen::VectorXd y = h.topLeftCorner(j, j).triangularView<Eigen::Upper>().solve(g.head(j));
-    for (int i = 0; i < j; ++i) axpy(x, y(i), v[static_cast<size_t>(i)]);
+    for (int i = 0; i < j; ++i) axpy(x, y(i), v[static_cast<size_t>(i)], th);
   }
 }
 

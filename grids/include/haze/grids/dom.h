@@ -46,7 +46,8 @@ struct DomSettings {
   DomScheme scheme = DomScheme::sweep;
   DomAccelerator accelerator = DomAccelerator::gmres;
   int max_iterations = 500;
-  // Stop when max over cells |change of the scalar flux| / max scalar flux falls below this.
+  // Stop when a source iteration would change the moments by less than this, relative (L2 over
+  // every cell and term); the error to the converged answer can be larger by 1 / (1 - albedo).
   double tolerance = 1e-3;
   int threads = 0;  // 0: every core oneTBB offers
   // Delta-M scaling (Wiscombe 1977) when N < D: with M = floor(sqrt(N)) Legendre orders the N
