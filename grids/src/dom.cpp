@@ -1,12 +1,13 @@
 // Method "dom": multiple scattering on grids by discrete ordinates (seed 000). The extinction
 // volume and the exact optical depth to every light (propagation's volumes) feed the solver; the
-// image is the propagation marcher's (single scattering, surfaces, background) plus the in-scattered
-// diffuse radiance gathered along each camera ray from the solver's moments.
+// image is the propagation marcher's unscattered light (surfaces, background) plus, along each
+// camera ray, single scattering and the in-scattered diffuse radiance from the solver's moments.
 #include <haze/grids/dom.h>
 
 #include <haze/core/error.h>
 #include <haze/grids/optical_depth.h>
 
+#include "dom_internal.h"
 #include "trilinear.h"
 
 #include <chrono>
@@ -32,8 +33,8 @@ Image gather_scattered(const Scene& delta, const ExtinctionVolume& volume, const
   const double step = step_cells * std::min({h.x, h.y, h.z});
   const auto n = static_cast<size_t>(solution.terms());
   const double f = solution.delta_m_fraction;
-  const Rgb sigma_t = volume.sigma_t_scale * (Rgb(1.0) - volume.albedo * f);
-  const Rgb albedo = volume.albedo * (1.0 - f) / (Rgb(1.0) - volume.albedo * f);
+  const Rgb sigma_t = dom::delta_m_sigma_t(volume.sigma_t_scale, volume.albedo, f);
+  const Rgb albedo = dom::delta_m_albedo(volume.albedo, f);
   const Rgb single_albedo = volume.albedo / (Rgb(1.0) - volume.albedo * f);
   const Camera& camera = delta.camera;
   Image image(camera.width_px, camera.height_px);
@@ -107,7 +108,7 @@ Image render_dom(const Scene& scene, const ExtinctionVolume& volume, const std::
   // Unscattered light (surfaces, background): the marcher with albedo 0 and, under delta-M, the
   // scaled extinction, which counts the forward peak as unscattered (as DISORT does).
   ExtinctionVolume dark = volume;
-  dark.sigma_t_scale = volume.sigma_t_scale * (Rgb(1.0) - volume.albedo * solution.delta_m_fraction);
+  dark.sigma_t_scale = dom::delta_m_sigma_t(volume.sigma_t_scale, volume.albedo, solution.delta_m_fraction);
   dark.albedo = Rgb(0.0);
   const ProgressCallback& progress = options.progress;
   RenderOptions march_options = options;
@@ -146,21 +147,15 @@ class DomMethod final : public Method {
     const ExtinctionVolume volume = make_extinction_volume(scene, resolution, 0.0, options.threads);
     // Delta lights get depth volumes; the sky enters the solver through the boundary and reaches
     // the eye as background.
-    std::vector<DenseGrid> depths, delta_depths;
-    for (const Light& l : scene.lights) {
-      if (std::holds_alternative<SkyLight>(l)) {
-        depths.emplace_back(std::array<int, 3>{1, 1, 1}, volume.density.bounds());
-      } else {
-        depths.push_back(optical_depth(volume.density, l, depth));
-        delta_depths.push_back(depths.back());
-      }
-    }
+    std::vector<DenseGrid> delta_depths;
+    for (const Light& l : scene.lights)
+      if (!std::holds_alternative<SkyLight>(l)) delta_depths.push_back(optical_depth(volume.density, l, depth));
     const double depth_seconds = seconds_since(start);
 
     start = std::chrono::steady_clock::now();
     ProgressCallback progress = options.progress;
     dom.progress = progress ? [&](double f) { return progress(0.8 * f); } : ProgressCallback();
-    const DomSolution solution = solve_dom(volume, scene.lights, depths, dom);
+    const DomSolution solution = solve_dom(volume, scene.lights, delta_depths, dom);
     const double solve_seconds = seconds_since(start);
 
     start = std::chrono::steady_clock::now();

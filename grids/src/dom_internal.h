@@ -10,6 +10,11 @@
 
 namespace haze::grids::dom {
 
+// Delta-M's scaled coefficients (DomSettings::delta_m): sigma_t (1 - albedo f) and
+// albedo (1 - f) / (1 - albedo f); f = 0 leaves them as they are.
+inline Rgb delta_m_sigma_t(const Rgb& sigma_t, const Rgb& albedo, double f) { return sigma_t * (Rgb(1.0) - albedo * f); }
+inline Rgb delta_m_albedo(const Rgb& albedo, double f) { return albedo * (1.0 - f) / (Rgb(1.0) - albedo * f); }
+
 // One channel of the medium: sigma_t = sigma_t_scale * density, sigma_s = albedo * sigma_t; with
 // delta-M fraction f, the scaled sigma_t (1 - albedo f) and albedo (1 - f) / (1 - albedo f).
 struct Channel {
@@ -36,7 +41,8 @@ class Transport {
   // going down run on two threads into separate buffers, summed in a fixed order.
   void sweep(const Channel& channel, const float* first, const float* m_in, float boundary, float* m_out, int threads) const;
 
-  // The first-collision source per cell and direction (regrouped and padded: [cell * padded + i]
+  // The first-collision source from point, spot and directional lights, depths[i] to lights[i],
+  // per cell and direction (regrouped and padded: [cell * padded + i]
   // for octant o's directions from padded_start(o)), before the factor sigma_s:
   //   sum_lights p(w_light . w_d) E_light e^(-sigma_t depth) / sum_j p(w_light . w_j) w_j,
   // normalized so its quadrature over directions is exactly E e^(-sigma_t depth), times `scale`

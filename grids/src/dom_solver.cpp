@@ -12,6 +12,7 @@
 #include <chrono>
 #include <cmath>
 #include <fstream>
+#include <iterator>
 #include <unistd.h>
 
 namespace haze::grids {
@@ -92,7 +93,7 @@ void solve_moments(const dom::Transport& t, const dom::Channel& channel, const s
   std::vector<float> kx(x.size());
   const int th = settings.threads;
   auto residual = [&](std::vector<float>& r) {  // r = b + K x - x, one sweep
-    t.sweep(channel, nullptr, x.data(), 0.0f, kx.data(), settings.threads);
+    t.sweep(channel, nullptr, x.data(), 0.0f, kx.data(), th);
     ++out.iterations;
     r = kx;
     axpy(r, 1.0, b, th);
@@ -128,7 +129,7 @@ void solve_moments(const dom::Transport& t, const dom::Channel& channel, const s
     g(0) = beta;
     int j = 0;
     for (; j < m && out.iterations < settings.max_iterations; ++j) {
-      t.sweep(channel, nullptr, v[static_cast<size_t>(j)].data(), 0.0f, kx.data(), settings.threads);  // w = (I - K) v_j
+      t.sweep(channel, nullptr, v[static_cast<size_t>(j)].data(), 0.0f, kx.data(), th);  // w = (I - K) v_j
       ++out.iterations;
       w = v[static_cast<size_t>(j)];
       axpy(w, -1.0, kx, th);
@@ -137,10 +138,7 @@ void solve_moments(const dom::Transport& t, const dom::Channel& channel, const s
         axpy(w, -h(i, j), v[static_cast<size_t>(i)], th);
       }
       h(j + 1, j) = norm(w, th);
-      if (h(j + 1, j) > 0.0) {
-        v[static_cast<size_t>(j + 1)] = w;
-        combine(v[static_cast<size_t>(j + 1)], 1.0 / h(j + 1, j), 0.0, w, th);
-      }
+      if (h(j + 1, j) > 0.0) combine(v[static_cast<size_t>(j + 1)], 0.0, 1.0 / h(j + 1, j), w, th);
       for (int i = 0; i < j; ++i) {
         const double a = cs(i) * h(i, j) + sn(i) * h(i + 1, j);
         h(i + 1, j) = -sn(i) * h(i, j) + cs(i) * h(i + 1, j);
@@ -169,20 +167,21 @@ void solve_moments(const dom::Transport& t, const dom::Channel& channel, const s
 size_t dom_memory_bytes(const std::array<int, 3>& resolution, int channels, const DomSettings& settings) {
   const size_t cells = static_cast<size_t>(resolution[0]) * static_cast<size_t>(resolution[1]) * static_cast<size_t>(resolution[2]);
   const auto d = static_cast<size_t>(settings.directions), n = static_cast<size_t>(kept_terms(settings));
+  const size_t padded = d + 8 * 7;  // the first-collision source pads each octant to a multiple of 8
   const size_t result = static_cast<size_t>(channels) * cells * n;
   size_t work;
   if (settings.scheme == DomScheme::paper) {
-    work = 4 * cells * d + 2 * cells * n;  // first-collision source, radiance twice, in-scatter; moments twice
+    work = cells * padded + 3 * cells * d + 2 * cells * n;  // first-collision source; radiance twice, in-scatter; moments twice
   } else {
     // first-collision source (freed before iterating), b, K x and the second half's sweep output;
     // GMRES adds its Krylov basis.
     const size_t vectors = 3 + (settings.accelerator == DomAccelerator::gmres ? kGmresRestart + 2 : 1);
-    work = std::max(cells * d + 2 * cells * n, vectors * cells * n);
+    work = std::max(cells * padded + 2 * cells * n, vectors * cells * n);
   }
   return sizeof(float) * (result + work);
 }
 
-DomSolution solve_dom(const ExtinctionVolume& volume, const std::vector<Light>& lights, const std::vector<DenseGrid>& depths,
+DomSolution solve_dom(const ExtinctionVolume& volume, const std::vector<Light>& lights, const std::vector<DenseGrid>& delta_depths,
                       const DomSettings& settings, const DomSolution* warm) {
   if (settings.directions < 8 || settings.directions > 4096)
     throw Error("directions", to_text(settings.directions), "a direction count in [8, 4096]");
@@ -191,10 +190,13 @@ DomSolution solve_dom(const ExtinctionVolume& volume, const std::vector<Light>& 
                 "a term count in [1, " + to_text(settings.directions) + "] (the direction count), or 0 for the full matrix");
   if (settings.max_iterations < 1) throw Error("iterations", to_text(settings.max_iterations), "at least 1");
   if (!(settings.tolerance > 0.0)) throw Error("tolerance", to_text(settings.tolerance), "a relative change > 0");
-  if (depths.size() != lights.size())
-    throw Error("depths", to_text(depths.size()) + " volumes", "one per light (" + to_text(lights.size()) + ")");
-  for (size_t i = 0; i < lights.size(); ++i)
-    if (!std::holds_alternative<SkyLight>(lights[i]) && depths[i].resolution() != volume.density.resolution())
+  std::vector<Light> delta_lights;
+  std::copy_if(lights.begin(), lights.end(), std::back_inserter(delta_lights), [](const Light& l) { return !std::holds_alternative<SkyLight>(l); });
+  if (delta_depths.size() != delta_lights.size())
+    throw Error("depths", to_text(delta_depths.size()) + " volumes",
+                "one per light other than the sky (" + to_text(delta_lights.size()) + ")");
+  for (size_t i = 0; i < delta_depths.size(); ++i)
+    if (delta_depths[i].resolution() != volume.density.resolution())
       throw Error("depths[" + std::to_string(i) + "]", "a grid of another resolution", "the density's resolution");
 
   bool grey = is_grey(volume.sigma_t_scale) && is_grey(volume.albedo);
@@ -241,7 +243,7 @@ DomSolution solve_dom(const ExtinctionVolume& volume, const std::vector<Light>& 
   out.moments.resize(static_cast<size_t>(out.channels));
   for (int c = 0; c < out.channels; ++c) {
     const dom::Channel channel = dom::make_channel(volume, lights, c, out.delta_m_fraction);
-    std::vector<float> first = transport.first_collision(volume, lights, depths, c, 1.0 / (1.0 - out.delta_m_fraction), settings.threads);
+    std::vector<float> first = transport.first_collision(volume, delta_lights, delta_depths, c, 1.0 / (1.0 - out.delta_m_fraction), settings.threads);
     std::vector<float>& x = out.moments[static_cast<size_t>(c)];
     if (settings.scheme == DomScheme::paper) {
       x = transport.paper(channel, first, warm_fits ? &warm->moments[static_cast<size_t>(c)] : nullptr, settings, out.iterations,

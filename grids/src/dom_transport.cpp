@@ -19,10 +19,9 @@ int octant(const Vec3& w) { return (w.x < 0.0 ? 1 : 0) | (w.y < 0.0 ? 2 : 0) | (
 
 Channel make_channel(const ExtinctionVolume& volume, const std::vector<Light>& lights, int channel, double delta_m_fraction) {
   Channel c;
-  const double f = delta_m_fraction, albedo = volume.albedo[channel];
   c.index = channel;
-  c.sigma_t_scale = static_cast<float>(volume.sigma_t_scale[channel] * (1.0 - albedo * f));
-  c.albedo = static_cast<float>(albedo * (1.0 - f) / (1.0 - albedo * f));
+  c.sigma_t_scale = static_cast<float>(delta_m_sigma_t(volume.sigma_t_scale, volume.albedo, delta_m_fraction)[channel]);
+  c.albedo = static_cast<float>(delta_m_albedo(volume.albedo, delta_m_fraction)[channel]);
   for (const Light& l : lights)
     if (const auto* sky = std::get_if<SkyLight>(&l)) c.sky += static_cast<float>(sky->radiance[channel]);
   c.density = volume.density.values().data();
@@ -145,7 +144,7 @@ std::vector<float> Transport::first_collision(const ExtinctionVolume& volume, co
           float* f = first.data() + c * padded_;
           for (size_t l = 0; l < lights.size(); ++l) {
             LightArrival a;
-            if (!arrival(lights[l], x, a)) continue;  // the sky enters through the boundary
+            if (!arrival(lights[l], x, a)) continue;
             double e = a.irradiance[channel];
             if (std::isfinite(a.distance) && a.distance < nearest) e *= (a.distance / nearest) * (a.distance / nearest);
             if (!(a.distance > 0.0)) {

@@ -84,11 +84,11 @@ struct DomSolution {
 };
 
 // Checks sizes and memory (a solve that would not fit in the memory available throws haze::Error
-// before allocating). `depths[i]` is the density integral from every cell to lights[i] (exact or
-// propagated, optical_depth.h); sky lights enter through the boundary and need no volume (pass an
-// empty grid). `warm`, when given and of the same shape, starts the iteration from its moments (the
+// before allocating). `delta_depths` holds, for each point, spot or directional light of `lights`
+// in order, the density integral from every cell to it (exact or propagated, optical_depth.h), as
+// render_dom takes them; sky lights enter through the boundary and have none. `warm`, when given and of the same shape, starts the iteration from its moments (the
 // paper's one-iteration-per-frame mode when density or lights change a little).
-DomSolution solve_dom(const ExtinctionVolume& volume, const std::vector<Light>& lights, const std::vector<DenseGrid>& depths,
+DomSolution solve_dom(const ExtinctionVolume& volume, const std::vector<Light>& lights, const std::vector<DenseGrid>& delta_depths,
                       const DomSettings& settings, const DomSolution* warm = nullptr);
 
 // For a direction w (propagation direction of the scattered light): c_k with
@@ -96,8 +96,8 @@ DomSolution solve_dom(const ExtinctionVolume& volume, const std::vector<Light>& 
 // (PhaseMatrix::scaling) and projected on the kept eigenvectors.
 Eigen::VectorXd inscatter_weights(const DomSolution& solution, const Vec3& w);
 
-// The image of a solved scene: unscattered light (surfaces lit through `delta_depths`, one per
-// point, spot or directional light of scene.lights in order; the background plus any sky) through
+// The image of a solved scene: unscattered light (surfaces lit through `delta_depths`, as
+// solve_dom takes them; the background plus any sky) through
 // the medium, plus, along each camera ray, the single-scattered light and the in-scattered diffuse
 // radiance sum_k c_k m_k (c from inscatter_weights toward the eye), both carried by the delta-M
 // scaled extinction when the solve used it (the formal solution of the scaled equation; with f = 0
