@@ -91,25 +91,12 @@ void cloud(std::FILE* csv, const Scene& scene, const RenderResult& reference, co
   auto start = std::chrono::steady_clock::now();
   const RenderResult dom = render(scene, "dom", options);
   const double seconds = seconds_since(start);
-  double peak = 0.0;
-  for (int y = 0; y < 18; ++y)
-    for (int x = 0; x < 24; ++x) peak = std::max(peak, luminance(reference.radiance.at(x, y)));
-  double error = 0.0, squared = 0.0, bias = 0.0, noise = 0.0;
-  int count = 0;
-  for (int y = 0; y < 18; ++y)
-    for (int x = 0; x < 24; ++x) {
-      const double ref = luminance(reference.radiance.at(x, y));
-      if (ref < 0.01 * peak) continue;
-      const double d = (luminance(dom.radiance.at(x, y)) - ref) / ref, se = luminance(reference.std_error->at(x, y)) / ref;
-      error += std::abs(d), squared += d * d, bias += d, noise += se * se;
-      ++count;
-    }
-  const double rms = std::sqrt(std::max(0.0, (squared - noise) / count));
+  const LitPixelError e = lit_pixel_error(dom.radiance, reference.radiance, &*reference.std_error);
   std::printf("| %s | %d | %d | %d | %g | %.2f%% | %.2f%% | %+.2f%% | %.2f | %d |\n", varied, resolution, directions,
-              dom.stats["terms"].get<int>(), tolerance, 100 * error / count, 100 * rms, 100 * bias / count, seconds,
+              dom.stats["terms"].get<int>(), tolerance, 100 * e.mean_abs, 100 * e.rms_noise_removed, 100 * e.signed_mean, seconds,
               dom.stats["iterations"].get<int>());
   std::fprintf(csv, "%s,%d,%d,%d,%g,%g,%g,%g,%g,%d\n", varied, resolution, directions, dom.stats["terms"].get<int>(), tolerance,
-               error / count, rms, bias / count, seconds, dom.stats["iterations"].get<int>());
+               e.mean_abs, e.rms_noise_removed, e.signed_mean, seconds, dom.stats["iterations"].get<int>());
   std::fflush(stdout);
 }
 

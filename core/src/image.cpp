@@ -198,4 +198,35 @@ double relative_rmse(const Image& a, const Image& reference) {
   return scale > 0.0 ? rmse(a, reference) / scale : rmse(a, reference);
 }
 
+LitPixelError lit_pixel_error(const Image& image, const Image& reference, const Image* reference_std_error, const Image* lit,
+                              double threshold) {
+  const Image& mask = lit ? *lit : reference;
+  if (image.width() != reference.width() || image.height() != reference.height() || mask.width() != reference.width() ||
+      mask.height() != reference.height())
+    throw Error("image", to_text(image.width()) + " x " + to_text(image.height()),
+                "the reference's size, " + to_text(reference.width()) + " x " + to_text(reference.height()));
+  double peak = 0.0;
+  for (int y = 0; y < mask.height(); ++y)
+    for (int x = 0; x < mask.width(); ++x) peak = std::max(peak, luminance(mask.at(x, y)));
+  LitPixelError e;
+  double squared = 0.0, noise = 0.0;
+  for (int y = 0; y < reference.height(); ++y)
+    for (int x = 0; x < reference.width(); ++x) {
+      if (luminance(mask.at(x, y)) < threshold * peak) continue;
+      const double ref = luminance(reference.at(x, y)), d = (luminance(image.at(x, y)) - ref) / ref;
+      const double se = reference_std_error ? luminance(reference_std_error->at(x, y)) / ref : 0.0;
+      e.mean_abs += std::abs(d), e.signed_mean += d, squared += d * d, noise += se * se;
+      ++e.pixels;
+    }
+  if (e.pixels == 0) return e;
+  const double n = e.pixels;
+  e.mean_abs /= n, e.signed_mean /= n;
+  if (reference_std_error) {
+    e.noise_rms = std::sqrt(noise / n);
+    e.signed_mean_error = std::sqrt(noise) / n;
+    e.rms_noise_removed = std::sqrt(std::max(0.0, (squared - noise) / n));
+  }
+  return e;
+}
+
 }  // namespace haze

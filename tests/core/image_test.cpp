@@ -64,5 +64,26 @@ TEST(Image, RmseAndMean) {
   EXPECT_EQ(b.mean(), Rgb(1.0));
 }
 
+// Three pixels lit (the fourth is below 1% of the peak), errors +10%, -20%, 0; standard errors 5%.
+// Images hold float32, hence 1e-7.
+TEST(Image, LitPixelError) {
+  Image image(4, 1), reference(4, 1), se(4, 1);
+  const double ref[4] = {1.0, 2.0, 4.0, 0.001}, ours[4] = {1.1, 1.6, 4.0, 7.0};
+  for (int x = 0; x < 4; ++x) {
+    reference.set(x, 0, Rgb(ref[x]));
+    image.set(x, 0, Rgb(ours[x]));
+    se.set(x, 0, Rgb(0.05 * ref[x]));
+  }
+  const LitPixelError e = lit_pixel_error(image, reference, &se);
+  EXPECT_EQ(e.pixels, 3);
+  EXPECT_NEAR(e.mean_abs, 0.1, 1e-7);
+  EXPECT_NEAR(e.signed_mean, -0.1 / 3.0, 1e-7);
+  EXPECT_NEAR(e.noise_rms, 0.05, 1e-7);
+  EXPECT_NEAR(e.signed_mean_error, std::sqrt(3 * 0.0025) / 3.0, 1e-7);
+  EXPECT_NEAR(e.rms_noise_removed, std::sqrt((0.01 + 0.04 - 3 * 0.0025) / 3.0), 1e-7);
+  EXPECT_EQ(lit_pixel_error(image, reference, nullptr, &image).pixels, 4);  // lit by another image
+  EXPECT_THROW(lit_pixel_error(Image(3, 1), reference), Error);
+}
+
 }  // namespace
 }  // namespace haze

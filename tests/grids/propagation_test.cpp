@@ -6,6 +6,8 @@
 #include <haze/grids/optical_depth.h>
 #include <haze/grids/propagation.h>
 
+#include "cloud_scene.h"
+
 #include <gtest/gtest.h>
 #include <hwy/tests/hwy_gtest.h>
 
@@ -13,25 +15,6 @@
 
 namespace haze::grids {
 namespace {
-
-// An RBF cloud of 9 blobs lit by 2 point lights, one inside its bounds and one outside; no
-// surfaces, so single scattering is the only light path both methods see.
-Scene cloud_scene(int width, int height) {
-  nlohmann::json blobs = nlohmann::json::array();
-  for (int i = 0; i < 9; ++i) {
-    double t = 0.7 * i;
-    blobs.push_back({{"center", {0.45 * std::cos(t), 0.3 * std::sin(1.7 * t), 0.35 * std::cos(1.3 * t + 0.5)}},
-                     {"weight", 0.8 + 0.4 * std::sin(2.0 * t)},
-                     {"sharpness", 2.5 + (i % 3)}});
-  }
-  nlohmann::json j = {
-      {"camera", {{"type", "pinhole"}, {"position", {0.3, 0.4, 3.2}}, {"look_at", {0, 0, 0}}, {"fov_y_deg", 40}, {"width_px", width}, {"height_px", height}}},
-      {"medium", {{"density", {{"type", "rbf"}, {"blobs", blobs}}}, {"sigma_t", {2.0, 2.4, 2.8}}, {"albedo", 0.9}, {"phase", {{"type", "hg"}, {"g", 0.4}}}}},
-      {"lights", {{{"type", "point"}, {"position", {0.9, 0.9, -0.6}}, {"intensity", {2.0, 1.8, 1.5}}},
-                  {{"type", "point"}, {"position", {-2.0, -0.5, 1.0}}, {"intensity", {3.0, 3.0, 4.0}}}}},
-      {"background", {0, 0, 0}}};
-  return Scene::from_json(j);
-}
 
 // The criterion, mean relative error over pixels above 1% of the reference's maximum
 // (luminance) under 3%, against two yardsticks: the deterministic `quadrature` method (single
@@ -47,27 +30,14 @@ TEST(Propagation, MatchesTheReferenceInSingleScatteringMode) {
   RenderResult reference = render(scene, "reference", reference_options);
   RenderResult quadrature = render(scene, "quadrature");
   RenderResult sweep = render(scene, "propagation");
-  double peak = 0.0;
-  for (int y = 0; y < 24; ++y)
-    for (int x = 0; x < 32; ++x) peak = std::max(peak, luminance(reference.radiance.at(x, y)));
-  double error_quadrature = 0.0, error_reference = 0.0, bias = 0.0, noise = 0.0;
-  int count = 0;
-  for (int y = 0; y < 24; ++y)
-    for (int x = 0; x < 32; ++x) {
-      double ref = luminance(reference.radiance.at(x, y)), quad = luminance(quadrature.radiance.at(x, y));
-      if (ref < 0.01 * peak) continue;
-      double ours = luminance(sweep.radiance.at(x, y));
-      error_quadrature += std::abs(ours - quad) / quad;
-      error_reference += std::abs(ours - ref) / ref;
-      bias += (ours - ref) / ref;
-      noise += std::pow(luminance(reference.std_error->at(x, y)) / ref, 2);
-      ++count;
-    }
-  error_quadrature /= count, error_reference /= count, bias /= count;
-  const double bias_error = std::sqrt(noise) / count;  // standard error of the signed mean
+  const LitPixelError against_quadrature = lit_pixel_error(sweep.radiance, quadrature.radiance, nullptr, &reference.radiance);
+  const LitPixelError against_reference = lit_pixel_error(sweep.radiance, reference.radiance, &*reference.std_error);
+  const int count = against_reference.pixels;
+  const double error_quadrature = against_quadrature.mean_abs, bias = against_reference.signed_mean;
+  const double bias_error = against_reference.signed_mean_error;  // standard error of the signed mean
   std::printf("propagation (sweep, 64 cells) over %d pixels: mean relative error %.4f against quadrature; against the "
               "reference %.4f per pixel (its noise %.4f), signed mean %+.4f +- %.4f\n",
-              count, error_quadrature, error_reference, std::sqrt(noise / count), bias, bias_error);
+              count, error_quadrature, against_reference.mean_abs, against_reference.noise_rms, bias, bias_error);
   ASSERT_GT(count, 300);
   EXPECT_LT(error_quadrature, 0.03);
   EXPECT_LT(std::abs(bias), 0.01 + 3.0 * bias_error);

@@ -59,4 +59,19 @@ double rmse(const Image& a, const Image& b);
 // rmse(a, b) / rms(b): the relative error `haze demo` reports against the reference.
 double relative_rmse(const Image& a, const Image& reference);
 
+// Per-pixel relative error of `image` against `reference` (luminance), over the lit pixels: those
+// where `lit` (the reference when null) is at least `threshold` of its peak. With the reference's
+// per-pixel standard error, also its noise and what it does to the measures.
+struct LitPixelError {
+  int pixels = 0;
+  double mean_abs = 0.0;     // mean |d|, d = (image - reference) / reference
+  double signed_mean = 0.0;  // mean d: the bias, in which the reference's noise averages out
+  // With reference_std_error (zero otherwise):
+  double noise_rms = 0.0;           // sqrt(mean se^2), se = standard error / reference
+  double signed_mean_error = 0.0;   // standard error of signed_mean, sqrt(sum se^2) / pixels
+  double rms_noise_removed = 0.0;   // sqrt(max(0, mean(d^2 - se^2))): bounds the noise-free mean |d|
+};
+LitPixelError lit_pixel_error(const Image& image, const Image& reference, const Image* reference_std_error = nullptr,
+                              const Image* lit = nullptr, double threshold = 0.01);
+
 }  // namespace haze
