@@ -224,14 +224,12 @@ std::vector<float> Transport::paper(const Channel& ch, const std::vector<float>&
     previous.swap(moments);
     moments.resize(previous.size());
     project(radiance, moments);
-    changes.push_back(it == 0 && !warm ? 1.0 : [&] {
-      double diff = 0.0, ref = 0.0;
-      for (size_t i = 0; i < moments.size(); ++i) {
-        const double m = moments[i], dm = m - static_cast<double>(previous[i]);
-        diff += dm * dm, ref += m * m;
-      }
-      return ref > 0.0 ? std::sqrt(diff / ref) : 0.0;
-    }());
+    double diff = 0.0, ref = 0.0;  // relative L2 change of the moments, as the sweep scheme measures it
+    for (size_t i = 0; i < moments.size(); ++i) {
+      const double m = moments[i], dm = m - static_cast<double>(previous[i]);
+      diff += dm * dm, ref += m * m;
+    }
+    changes.push_back(ref > 0.0 ? std::sqrt(diff / ref) : 0.0);
     if (settings.progress && !settings.progress(std::min(1.0, (it + 1.0) / settings.max_iterations))) throw Cancelled();
     if (changes.back() < settings.tolerance) break;
   }
