@@ -85,9 +85,9 @@ Scene cloud_scene() {
 }
 
 void cloud(std::FILE* csv, const Scene& scene, const RenderResult& reference, const char* varied, int resolution, int directions, int terms,
-           double tolerance) {
+           double tolerance, const char* storage = "float32") {
   RenderOptions options;
-  options.settings = {{"resolution", resolution}, {"directions", directions}, {"terms", terms}, {"tolerance", tolerance}};
+  options.settings = {{"resolution", resolution}, {"directions", directions}, {"terms", terms}, {"tolerance", tolerance}, {"storage", storage}};
   auto start = std::chrono::steady_clock::now();
   const RenderResult dom = render(scene, "dom", options);
   const double seconds = seconds_since(start);
@@ -143,6 +143,8 @@ int main(int argc, char** argv) {
   for (int d : {32, 64, 256}) cloud(cloud_csv, scene, reference, "directions", 64, d, std::min(d, 24), 1e-3);
   for (int n : {1, 4, 9, 16, 49}) cloud(cloud_csv, scene, reference, "terms", 64, 128, n, 1e-3);
   for (double t : {1e-1, 1e-2}) cloud(cloud_csv, scene, reference, "tolerance", 64, 128, 24, t);
+  cloud(cloud_csv, scene, reference, "float16", 64, 128, 25, 1e-3, "float16");
+  cloud(cloud_csv, scene, reference, "float32", 64, 128, 25, 1e-3);
   std::fclose(slab_csv);
   std::fclose(cloud_csv);
   return 0;

@@ -3,7 +3,8 @@
 // default scheme against the paper's with the full matrix, to the same tolerance.
 // Run: build/release/bench/haze_bench_dom --benchmark_repetitions=3 --benchmark_report_aggregates_only=true
 // Counters: sweep_ms (per transport sweep), grind_ns (per cell, direction and sweep), GBps (moment
-// traffic: each octant pass reads m_in and reads and writes m_out, 12 N bytes per cell).
+// traffic: each octant pass reads m_in and reads and writes m_out, 12 N bytes per cell), MB (the
+// solver's memory estimate, dom_memory_bytes).
 #include <haze/core/rng.h>
 #include <haze/grids/dom.h>
 #include <haze/grids/optical_depth.h>
@@ -45,6 +46,7 @@ void report(benchmark::State& state, const DomSolution& s, size_t cells, int dir
   state.counters["grind_ns"] = 1e9 * per_sweep / (static_cast<double>(cells) * directions);
   state.counters["GBps"] = 8.0 * 12.0 * s.terms() * static_cast<double>(cells) / per_sweep / 1e9;
   state.counters["solve_ms"] = 1e3 * s.seconds;
+  state.counters["MB"] = static_cast<double>(s.bytes) / 1e6;
 }
 
 // Args: cells per side, directions, terms, scalar kernel. Four source iterations.
@@ -64,18 +66,21 @@ void BM_Sweep(benchmark::State& state) {
 BENCHMARK(BM_Sweep)->Name("dom/sweep/cells,directions,terms,scalar")->Args({64, 128, 24, 0})->Args({64, 128, 24, 1})
     ->Args({64, 256, 24, 0})->Args({64, 128, 48, 0})->Args({32, 128, 24, 0})->UseRealTime()->Unit(benchmark::kMillisecond);
 
-// Args: cells per side, albedo in percent, accelerator (0 none, 1 gmres). To a change below 1e-3.
+// Args: cells per side, albedo in percent, accelerator (0 none, 1 gmres), storage (0 float32, 1
+// float16). To a change below 1e-3.
 void BM_Converge(benchmark::State& state) {
   const Problem p(static_cast<int>(state.range(0)), state.range(1) / 100.0);
   DomSettings settings;
   settings.accelerator = state.range(2) ? DomAccelerator::gmres : DomAccelerator::none;
+  settings.storage = state.range(3) ? DomStorage::float16 : DomStorage::float32;
   DomSolution s;
   for (auto _ : state) s = solve_dom(p.volume, p.lights, p.depths, settings);
   report(state, s, p.volume.density.cell_count(), settings.directions);
   state.counters["converged"] = s.converged;
 }
-BENCHMARK(BM_Converge)->Name("dom/converge/cells,albedo%,gmres")->Args({64, 90, 1})->Args({64, 90, 0})->Args({64, 99, 1})
-    ->Args({64, 99, 0})->Args({64, 50, 1})->Iterations(1)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Converge)->Name("dom/converge/cells,albedo%,gmres,float16")->Args({64, 90, 1, 0})->Args({64, 90, 1, 1})->Args({64, 90, 0, 0})
+    ->Args({64, 99, 1, 0})->Args({64, 99, 1, 1})->Args({64, 99, 0, 0})->Args({64, 50, 1, 0})->Iterations(1)->UseRealTime()
+    ->Unit(benchmark::kMillisecond);
 
 // The default scheme (sweep, GMRES, N = 25, delta-M) against the paper's (Jacobi, full matrix) on
 // 32^3 with 128 directions at albedo 0.9, to a change below 10^-tolerance_exp; `error` is the

@@ -136,6 +136,7 @@ class DomMethod final : public Method {
     dom.max_iterations = static_cast<int>(settings.integer("iterations", dom.max_iterations, 1, 100000));
     dom.tolerance = settings.number("tolerance", dom.tolerance, 1e-9, 1.0);
     dom.delta_m = settings.integer("delta_m", 1, 0, 1) != 0;
+    dom.storage = dom_storage_from_name(settings.choice("storage", "float32", {"float32", "float16"}));
     dom.threads = options.threads;
     DepthOptions depth;
     depth.scheme = depth_scheme_from_name(settings.choice("optical_depth", "exact", {"exact", "paper", "sweep"}));
@@ -170,6 +171,7 @@ class DomMethod final : public Method {
                     {"delta_m_fraction", solution.delta_m_fraction},
                     {"scheme", name(dom.scheme)},
                     {"accelerator", name(dom.accelerator)},
+                    {"storage", name(dom.storage)},
                     {"channels", solution.channels},
                     {"iterations", solution.iterations},
                     {"converged", solution.converged},

@@ -25,6 +25,14 @@ struct Channel {
 };
 Channel make_channel(const ExtinctionVolume& volume, const std::vector<Light>& lights, int channel, double delta_m_fraction);
 
+// The first-collision source per cell and direction (regrouped and padded: [cell * padded + i]),
+// in float32 or, divided by a per-cell scale (the cell's largest value), in float16.
+struct FirstCollision {
+  std::vector<float> values;
+  std::vector<simd::Half> half;
+  std::vector<float> scale;  // [cell], with `half`
+};
+
 // The directions regrouped by octant (signs of x, y, z), so that each octant's directions share
 // one upwind order through the grid, with their separable-phase rows and face coefficients.
 class Transport {
@@ -34,25 +42,25 @@ class Transport {
 
   // One upwind sweep of every direction with the step scheme (a face carries its upwind cell's
   // value):  L_d = (sigma_s S_d + sum_e a_e L_up,e) / (sigma_t + sum_e a_e),  a_e = |w_e| / h_e,
-  //   S_d = first[cell * D + d] + sum_k lambda_k Q[d][k] m_in[cell * N + k]   (seed 000 eq. 9),
+  //   S_d = first[cell][d] + sum_k lambda_k Q[d][k] m_in[cell * N + k]   (seed 000 eq. 9),
   // radiance `boundary` entering through every face, and the moments of the result
   //   m_out[cell * N + k] = sum_d Q[d][k] L_d   (eq. 10).
   // first (from first_collision) and m_in may be null. Rows run through simd::dom_sweep_row. Directions going up and
   // going down run on two threads into separate buffers, summed in a fixed order.
-  void sweep(const Channel& channel, const float* first, const float* m_in, float boundary, float* m_out, int threads) const;
+  void sweep(const Channel& channel, const FirstCollision* first, const float* m_in, float boundary, float* m_out, int threads) const;
 
   // The first-collision source from point, spot and directional lights, depths[i] to lights[i],
-  // per cell and direction (regrouped and padded: [cell * padded + i]
-  // for octant o's directions from padded_start(o)), before the factor sigma_s:
+  // per cell and direction, before the factor sigma_s:
   //   sum_lights p(w_light . w_d) E_light e^(-sigma_t depth) / sum_j p(w_light . w_j) w_j,
   // normalized so its quadrature over directions is exactly E e^(-sigma_t depth), times `scale`
   // (1 / (1 - f) under delta-M scaling, so that the scaled sigma_s gives back the true one).
-  std::vector<float> first_collision(const ExtinctionVolume& volume, const std::vector<Light>& lights,
-                                     const std::vector<DenseGrid>& depths, int channel, double scale, int threads) const;
+  // In float16 when `half`.
+  FirstCollision first_collision(const ExtinctionVolume& volume, const std::vector<Light>& lights, const std::vector<DenseGrid>& depths,
+                                 int channel, double scale, bool half, int threads) const;
 
   // The paper's scheme: full radiance per cell and direction, every cell updated from its upwind
   // neighbours' previous values (Jacobi). Returns the moments; appends one change per iteration.
-  std::vector<float> paper(const Channel& channel, const std::vector<float>& first, const std::vector<float>* warm,
+  std::vector<float> paper(const Channel& channel, const FirstCollision& first, const std::vector<float>* warm,
                            const DomSettings& settings, int& iterations, std::vector<double>& changes) const;
 
   // Wall time spent in sweep() and paper() so far.

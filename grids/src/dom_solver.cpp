@@ -31,6 +31,13 @@ DomAccelerator dom_accelerator_from_name(const std::string& name) {
 }
 const char* name(DomAccelerator accelerator) { return accelerator == DomAccelerator::none ? "none" : "gmres"; }
 
+DomStorage dom_storage_from_name(const std::string& name) {
+  if (name == "float32") return DomStorage::float32;
+  if (name == "float16") return DomStorage::float16;
+  throw Error("storage", name, "\"float32\" or \"float16\"");
+}
+const char* name(DomStorage storage) { return storage == DomStorage::float32 ? "float32" : "float16"; }
+
 namespace {
 
 size_t available_memory() {
@@ -50,32 +57,89 @@ constexpr int kGmresRestart = 12;
 // so results do not depend on the thread count).
 constexpr long long kChunk = 1 << 16;
 
+double chunk_dot(const float* a, const float* b, size_t count) {  // 8 float sums, then double
+  float sum[8] = {};
+  size_t i = 0;
+  for (; i + 8 <= count; i += 8)
+    for (size_t e = 0; e < 8; ++e) sum[e] += a[i + e] * b[i + e];
+  double total = 0.0;
+  for (float e : sum) total += static_cast<double>(e);
+  for (; i < count; ++i) total += static_cast<double>(a[i] * b[i]);
+  return total;
+}
+
 double dot(const std::vector<float>& a, const std::vector<float>& b, int threads) {
   const auto size = static_cast<long long>(a.size());
   std::vector<double> partial(static_cast<size_t>((size + kChunk - 1) / kChunk), 0.0);
   parallel_for(size, threads, kChunk, [&](long long i0, long long i1) {
-    float sum[8] = {};
-    long long i = i0;
-    for (; i + 8 <= i1; i += 8)
-      for (long long e = 0; e < 8; ++e) sum[e] += a[static_cast<size_t>(i + e)] * b[static_cast<size_t>(i + e)];
-    double total = 0.0;
-    for (float e : sum) total += static_cast<double>(e);
-    for (; i < i1; ++i) total += static_cast<double>(a[static_cast<size_t>(i)] * b[static_cast<size_t>(i)]);
-    partial[static_cast<size_t>(i0 / kChunk)] = total;
+    partial[static_cast<size_t>(i0 / kChunk)] = chunk_dot(a.data() + i0, b.data() + i0, static_cast<size_t>(i1 - i0));
   });
   double total = 0.0;
   for (double p : partial) total += p;
   return total;
 }
 double norm(const std::vector<float>& a, int threads) { return std::sqrt(dot(a, a, threads)); }
-// a = alpha a + beta b
-void combine(std::vector<float>& a, double alpha, double beta, const std::vector<float>& b, int threads) {
-  const auto fa = static_cast<float>(alpha), fb = static_cast<float>(beta);
+// a += s b
+void axpy(std::vector<float>& a, double s, const std::vector<float>& b, int threads) {
+  const auto fs = static_cast<float>(s);
   parallel_for(static_cast<long long>(a.size()), threads, kChunk, [&](long long i0, long long i1) {
-    for (auto i = static_cast<size_t>(i0); i < static_cast<size_t>(i1); ++i) a[i] = fa * a[i] + fb * b[i];
+    for (auto i = static_cast<size_t>(i0); i < static_cast<size_t>(i1); ++i) a[i] = a[i] + fs * b[i];
   });
 }
-void axpy(std::vector<float>& a, double s, const std::vector<float>& b, int threads) { combine(a, 1.0, s, b, threads); }
+
+// GMRES's basis vectors (unit length), in float32 or float16; the vector operations read a
+// float16 vector a chunk at a time, converted, in the same fixed chunks.
+class KrylovBasis {
+ public:
+  KrylovBasis(int count, size_t size, bool half) : size_(size), half_(half) {
+    if (half) halves_.assign(static_cast<size_t>(count), std::vector<simd::Half>(size));
+    else floats_.assign(static_cast<size_t>(count), std::vector<float>(size));
+  }
+  void store(int i, const std::vector<float>& w, double scale, int threads) {  // v_i = scale w
+    const auto s = static_cast<float>(scale);
+    parallel_for(static_cast<long long>(size_), threads, kChunk, [&](long long i0, long long i1) {
+      const auto b = static_cast<size_t>(i0), count = static_cast<size_t>(i1 - i0);
+      std::vector<float> converted(half_ ? count : 0);
+      float* to = half_ ? converted.data() : floats_[static_cast<size_t>(i)].data() + b;
+      for (size_t e = 0; e < count; ++e) to[e] = s * w[b + e];
+      if (half_) simd::to_half(to, halves_[static_cast<size_t>(i)].data() + b, count);
+    });
+  }
+  void load(int i, std::vector<float>& w, int threads) const {  // w = v_i
+    chunks(i, threads, [&](size_t b, size_t count, const float* v) { std::copy(v, v + count, w.data() + b); });
+  }
+  double dot(const std::vector<float>& w, int i, int threads) const {
+    const auto chunk = static_cast<size_t>(kChunk);
+    std::vector<double> partial((size_ + chunk - 1) / chunk, 0.0);
+    chunks(i, threads, [&](size_t b, size_t count, const float* v) { partial[b / chunk] = chunk_dot(w.data() + b, v, count); });
+    double total = 0.0;
+    for (double p : partial) total += p;
+    return total;
+  }
+  void axpy(std::vector<float>& w, double scale, int i, int threads) const {  // w += scale v_i
+    const auto s = static_cast<float>(scale);
+    chunks(i, threads, [&](size_t b, size_t count, const float* v) {
+      for (size_t e = 0; e < count; ++e) w[b + e] = w[b + e] + s * v[e];
+    });
+  }
+
+ private:
+  // f(begin, count, v_i's values there as float32), per fixed chunk.
+  template <class F>
+  void chunks(int i, int threads, const F& f) const {
+    parallel_for(static_cast<long long>(size_), threads, kChunk, [&](long long i0, long long i1) {
+      const auto b = static_cast<size_t>(i0), count = static_cast<size_t>(i1 - i0);
+      if (!half_) return f(b, count, floats_[static_cast<size_t>(i)].data() + b);
+      std::vector<float> converted(count);
+      simd::to_float(halves_[static_cast<size_t>(i)].data() + b, converted.data(), count);
+      f(b, count, converted.data());
+    });
+  }
+  size_t size_;
+  bool half_;
+  std::vector<std::vector<float>> floats_;
+  std::vector<std::vector<simd::Half>> halves_;
+};
 
 // Calls the progress callback once per iteration; throws haze::Cancelled when it says stop.
 struct IterationProgress {
@@ -112,33 +176,34 @@ void solve_moments(const dom::Transport& t, const dom::Channel& channel, const s
     return;
   }
   // GMRES(m) with modified Gram-Schmidt and Givens rotations (Saad, Iterative Methods, alg. 6.9).
+  // A float16 basis is not exactly orthonormal; the true residual at each restart still decides.
   const int m = kGmresRestart;
-  std::vector<std::vector<float>> v(static_cast<size_t>(m + 1), std::vector<float>(x.size()));
+  KrylovBasis v(m + 1, x.size(), settings.storage == DomStorage::float16);
   std::vector<float> w(x.size());
   Eigen::MatrixXd h = Eigen::MatrixXd::Zero(m + 1, m);
   Eigen::VectorXd cs(m), sn(m), g(m + 1);
   while (out.iterations < settings.max_iterations) {
-    residual(v[0]);
+    residual(w);
     const double x_norm = std::max(norm(x, th), 1e-300);
-    double beta = norm(v[0], th);
+    double beta = norm(w, th);
     out.changes.push_back(beta / x_norm);
     progress(out.iterations);
     if (beta / x_norm < settings.tolerance || beta == 0.0) return;
-    combine(v[0], 1.0 / beta, 0.0, v[0], th);
+    v.store(0, w, 1.0 / beta, th);
     g.setZero();
     g(0) = beta;
     int j = 0;
     for (; j < m && out.iterations < settings.max_iterations; ++j) {
-      t.sweep(channel, nullptr, v[static_cast<size_t>(j)].data(), 0.0f, kx.data(), th);  // w = (I - K) v_j
+      v.load(j, w, th);
+      t.sweep(channel, nullptr, w.data(), 0.0f, kx.data(), th);  // w = (I - K) v_j
       ++out.iterations;
-      w = v[static_cast<size_t>(j)];
       axpy(w, -1.0, kx, th);
       for (int i = 0; i <= j; ++i) {
-        h(i, j) = dot(w, v[static_cast<size_t>(i)], th);
-        axpy(w, -h(i, j), v[static_cast<size_t>(i)], th);
+        h(i, j) = v.dot(w, i, th);
+        v.axpy(w, -h(i, j), i, th);
       }
       h(j + 1, j) = norm(w, th);
-      if (h(j + 1, j) > 0.0) combine(v[static_cast<size_t>(j + 1)], 0.0, 1.0 / h(j + 1, j), w, th);
+      if (h(j + 1, j) > 0.0) v.store(j + 1, w, 1.0 / h(j + 1, j), th);
       for (int i = 0; i < j; ++i) {
         const double a = cs(i) * h(i, j) + sn(i) * h(i + 1, j);
         h(i + 1, j) = -sn(i) * h(i, j) + cs(i) * h(i + 1, j);
@@ -158,7 +223,7 @@ void solve_moments(const dom::Transport& t, const dom::Channel& channel, const s
     }
     // x += V_j y, with H_j y = g_j (upper triangular).
     Eigen::VectorXd y = h.topLeftCorner(j, j).triangularView<Eigen::Upper>().solve(g.head(j));
-    for (int i = 0; i < j; ++i) axpy(x, y(i), v[static_cast<size_t>(i)], th);
+    for (int i = 0; i < j; ++i) v.axpy(x, y(i), i, th);
   }
 }
 
@@ -168,17 +233,16 @@ size_t dom_memory_bytes(const std::array<int, 3>& resolution, int channels, cons
   const size_t cells = static_cast<size_t>(resolution[0]) * static_cast<size_t>(resolution[1]) * static_cast<size_t>(resolution[2]);
   const auto d = static_cast<size_t>(settings.directions), n = static_cast<size_t>(kept_terms(settings));
   const size_t padded = d + 8 * 7;  // the first-collision source pads each octant to a multiple of 8
-  const size_t result = static_cast<size_t>(channels) * cells * n;
-  size_t work;
-  if (settings.scheme == DomScheme::paper) {
-    work = cells * padded + 3 * cells * d + 2 * cells * n;  // first-collision source; radiance twice, in-scatter; moments twice
-  } else {
-    // first-collision source (freed before iterating), b, K x and the second half's sweep output;
-    // GMRES adds its Krylov basis.
-    const size_t vectors = 3 + (settings.accelerator == DomAccelerator::gmres ? kGmresRestart + 2 : 1);
-    work = std::max(cells * padded + 2 * cells * n, vectors * cells * n);
-  }
-  return sizeof(float) * (result + work);
+  const size_t result = sizeof(float) * static_cast<size_t>(channels) * cells * n;
+  if (settings.scheme == DomScheme::paper)  // first-collision source; radiance twice, in-scatter; moments twice
+    return result + sizeof(float) * (cells * padded + 3 * cells * d + 2 * cells * n);
+  // The first-collision source (float16 adds a scale per cell) with b and the second half's sweep
+  // output; then, the source freed, b, K x, the sweep output, a work vector and GMRES's basis.
+  const bool half = settings.storage == DomStorage::float16;
+  const size_t first = half ? sizeof(simd::Half) * cells * padded + sizeof(float) * cells : sizeof(float) * cells * padded;
+  const size_t basis = settings.accelerator == DomAccelerator::gmres ? kGmresRestart + 1 : 0;
+  const size_t iterating = sizeof(float) * 4 * cells * n + (half ? sizeof(simd::Half) : sizeof(float)) * basis * cells * n;
+  return result + std::max(first + sizeof(float) * 2 * cells * n, iterating);
 }
 
 DomSolution solve_dom(const ExtinctionVolume& volume, const std::vector<Light>& lights, const std::vector<DenseGrid>& delta_depths,
@@ -190,6 +254,8 @@ DomSolution solve_dom(const ExtinctionVolume& volume, const std::vector<Light>& 
                 "a term count in [1, " + to_text(settings.directions) + "] (the direction count), or 0 for the full matrix");
   if (settings.max_iterations < 1) throw Error("iterations", to_text(settings.max_iterations), "at least 1");
   if (!(settings.tolerance > 0.0)) throw Error("tolerance", to_text(settings.tolerance), "a relative change > 0");
+  if (settings.storage == DomStorage::float16 && settings.scheme == DomScheme::paper)
+    throw Error("storage", "float16", "float32 with scheme \"paper\" (float16 storage is for scheme \"sweep\")");
   std::vector<Light> delta_lights;
   std::copy_if(lights.begin(), lights.end(), std::back_inserter(delta_lights), [](const Light& l) { return !std::holds_alternative<SkyLight>(l); });
   if (delta_depths.size() != delta_lights.size())
@@ -243,7 +309,8 @@ DomSolution solve_dom(const ExtinctionVolume& volume, const std::vector<Light>& 
   out.moments.resize(static_cast<size_t>(out.channels));
   for (int c = 0; c < out.channels; ++c) {
     const dom::Channel channel = dom::make_channel(volume, lights, c, out.delta_m_fraction);
-    std::vector<float> first = transport.first_collision(volume, delta_lights, delta_depths, c, 1.0 / (1.0 - out.delta_m_fraction), settings.threads);
+    dom::FirstCollision first = transport.first_collision(volume, delta_lights, delta_depths, c, 1.0 / (1.0 - out.delta_m_fraction),
+                                                          settings.storage == DomStorage::float16, settings.threads);
     std::vector<float>& x = out.moments[static_cast<size_t>(c)];
     if (settings.scheme == DomScheme::paper) {
       x = transport.paper(channel, first, warm_fits ? &warm->moments[static_cast<size_t>(c)] : nullptr, settings, out.iterations,
@@ -251,9 +318,9 @@ DomSolution solve_dom(const ExtinctionVolume& volume, const std::vector<Light>& 
       continue;
     }
     std::vector<float> b(size);
-    transport.sweep(channel, first.data(), nullptr, channel.sky, b.data(), settings.threads);
+    transport.sweep(channel, &first, nullptr, channel.sky, b.data(), settings.threads);
     ++out.iterations;
-    std::vector<float>().swap(first);
+    first = {};
     x = warm_fits ? warm->moments[static_cast<size_t>(c)] : b;
     solve_moments(transport, channel, b, x, settings, out);
   }

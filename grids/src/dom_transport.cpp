@@ -79,7 +79,7 @@ Transport::Transport(const DenseGrid& density, const DirectionSet& directions, c
   }
 }
 
-void Transport::sweep(const Channel& ch, const float* first, const float* m_in, float boundary, float* m_out, int threads) const {
+void Transport::sweep(const Channel& ch, const FirstCollision* first, const float* m_in, float boundary, float* m_out, int threads) const {
   const auto nx = n_[0], ny = n_[1], nz = n_[2];
   const auto start = std::chrono::steady_clock::now();
   const size_t size = cells_ * static_cast<size_t>(n_terms_);
@@ -100,7 +100,8 @@ void Transport::sweep(const Channel& ch, const float* first, const float* m_in, 
         row.step = o & 1 ? -1 : 1;
         row.x0 = o & 1 ? nx - 1 : 0;
         row.density = ch.density, row.sigma_t_scale = ch.sigma_t_scale, row.albedo = ch.albedo;
-        row.first = first ? first + oc.offset : nullptr;
+        if (first && first->half.empty()) row.first = first->values.data() + oc.offset;
+        if (first && !first->half.empty()) row.first_half = first->half.data() + oc.offset, row.first_scale = first->scale.data();
         row.first_stride = padded_;
         row.m_in = m_in, row.m_out = out;
         row.x_run = x_run.data(), row.y_row = y_row.data(), row.scratch = scratch.data();
@@ -123,8 +124,8 @@ void Transport::sweep(const Channel& ch, const float* first, const float* m_in, 
   seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
-std::vector<float> Transport::first_collision(const ExtinctionVolume& volume, const std::vector<Light>& lights,
-                                              const std::vector<DenseGrid>& depths, int channel, double scale_all, int threads) const {
+FirstCollision Transport::first_collision(const ExtinctionVolume& volume, const std::vector<Light>& lights,
+                                          const std::vector<DenseGrid>& depths, int channel, double scale_all, bool half, int threads) const {
   const DenseGrid& grid = volume.density;
   const auto d = static_cast<size_t>(d_);
   const Vec3 h = grid.cell_size();
@@ -132,16 +133,19 @@ std::vector<float> Transport::first_collision(const ExtinctionVolume& volume, co
   // cell's source stays finite (and isotropic when the light sits at its centre).
   const double nearest = 0.5 * std::min({h.x, h.y, h.z});
   const double sigma_t = volume.sigma_t_scale[channel], weight = 4.0 * kPi / d_;
-  std::vector<float> first(cells_ * padded_, 0.0f);
+  FirstCollision first;
+  if (half) first.half.resize(cells_ * padded_), first.scale.resize(cells_);
+  else first.values.assign(cells_ * padded_, 0.0f);
   const auto nx = n_[0], ny = n_[1];
   parallel_for(n_[2], threads, 1, [&](long long k0, long long k1) {
-    std::vector<float> cosines(d), phase(d);
+    std::vector<float> cosines(d), phase(d), cell(half ? padded_ : 0);
     for (auto k = static_cast<int>(k0); k < k1; ++k)
       for (int j = 0; j < ny; ++j)
         for (int i = 0; i < nx; ++i) {
           const size_t c = grid.index(i, j, k);
           const Vec3 x = grid.cell_center(i, j, k);
-          float* f = first.data() + c * padded_;
+          float* f = half ? cell.data() : first.values.data() + c * padded_;
+          if (half) std::fill(cell.begin(), cell.end(), 0.0f);
           for (size_t l = 0; l < lights.size(); ++l) {
             LightArrival a;
             if (!arrival(lights[l], x, a)) continue;
@@ -161,12 +165,19 @@ std::vector<float> Transport::first_collision(const ExtinctionVolume& volume, co
             const auto scale = static_cast<float>(scale_all * e / (sum * weight));
             for (size_t t = 0; t < d; ++t) f[padded_index_[t]] += scale * phase[t];
           }
+          if (half) {  // values / their largest, in [0, 1]: no overflow, 2^-11 relative
+            const float largest = *std::max_element(cell.begin(), cell.end());
+            if (largest > 0.0f)
+              for (float& v : cell) v /= largest;
+            first.scale[c] = largest;
+            simd::to_half(cell.data(), first.half.data() + c * padded_, padded_);
+          }
         }
   });
   return first;
 }
 
-std::vector<float> Transport::paper(const Channel& ch, const std::vector<float>& first, const std::vector<float>* warm,
+std::vector<float> Transport::paper(const Channel& ch, const FirstCollision& first, const std::vector<float>* warm,
                                     const DomSettings& settings, int& iterations, std::vector<double>& changes) const {
   const auto d = static_cast<long>(d_), n = static_cast<long>(n_terms_);
   const auto nx = n_[0], ny = n_[1], nz = n_[2];
@@ -213,7 +224,7 @@ std::vector<float> Transport::paper(const Channel& ch, const std::vector<float>&
                 const float* a = a_.data() + 3 * t;
                 const size_t cd = c * static_cast<size_t>(d) + t;
                 const float in = a[0] * (ux ? ux[t] : ch.sky) + a[1] * (uy ? uy[t] : ch.sky) + a[2] * (uz ? uz[t] : ch.sky);
-                const float source = first[c * padded_ + padded_index_[t]] + inscatter[cd];
+                const float source = first.values[c * padded_ + padded_index_[t]] + inscatter[cd];
                 next[cd] = (sigma_s * source + in) / (sigma_t + a[0] + a[1] + a[2]);
               }
             }

@@ -21,6 +21,7 @@ namespace hn = hwy::HWY_NAMESPACE;
 void DomSweepRow(const DomOctant& o, const DomRow& r) {
   const hn::CappedTag<float, 8> d;
   using V = hn::Vec<decltype(d)>;
+  const hn::Rebind<hwy::float16_t, decltype(d)> dh;
   const size_t lanes = hn::Lanes(d);
   const auto p = static_cast<size_t>(o.directions), n = static_cast<size_t>(o.terms), np = static_cast<size_t>(o.terms_padded);
   float* HWY_RESTRICT light = r.scratch;
@@ -38,11 +39,15 @@ void DomSweepRow(const DomOctant& o, const DomRow& r) {
     float* HWY_RESTRICT z = r.z_row + x * p;
     const float* HWY_RESTRICT m_in = r.m_in ? r.m_in + c * n : nullptr;
     const float* HWY_RESTRICT first = r.first ? r.first + c * r.first_stride : nullptr;
+    const Half* HWY_RESTRICT first_half = !r.first && r.first_half ? r.first_half + c * r.first_stride : nullptr;
     for (size_t i = 0; i < p; i += 4 * lanes) {
       const size_t count = std::min<size_t>(4, (p - i) / lanes);
       // Source: the first-collision term plus lambda Q m_in, one term (a broadcast) at a time.
       V s[4];
       for (size_t v = 0; v < 4; ++v) s[v] = first && v < count ? hn::LoadU(d, first + i + v * lanes) : hn::Zero(d);
+      if (first_half)
+        for (size_t v = 0; v < count; ++v)
+          s[v] = hn::Mul(hn::Set(d, r.first_scale[c]), hn::PromoteTo(d, hn::LoadU(dh, reinterpret_cast<const hwy::float16_t*>(first_half + i + v * lanes))));
       if (m_in) {
         for (size_t k = 0; k < n; ++k) {
           const V mk = hn::Set(d, m_in[k]);

@@ -38,6 +38,16 @@ enum class DomAccelerator {
 DomAccelerator dom_accelerator_from_name(const std::string& name);  // "none", "gmres"
 const char* name(DomAccelerator accelerator);
 
+enum class DomStorage {
+  float32,
+  // float16 (simd/half.h) for the two fields that dominate memory: the first-collision source
+  // (D values per cell, scaled per cell by its largest) and GMRES's basis vectors (unit length).
+  // Arithmetic, the iterate and the solution's moments stay float32. Scheme `sweep` only.
+  float16,
+};
+DomStorage dom_storage_from_name(const std::string& name);  // "float32", "float16"
+const char* name(DomStorage storage);
+
 struct DomSettings {
   int directions = 128;  // D, spherical Fibonacci
   // N separable terms of the phase matrix, at most D; 0 (or D) keeps the full matrix. Eigenvalues
@@ -56,6 +66,7 @@ struct DomSettings {
   // has moments (b_k - f) / (1 - f), k < M, which N terms represent well. The first-collision
   // source keeps the exact phase function.
   bool delta_m = true;
+  DomStorage storage = DomStorage::float32;
   bool scalar_kernel = false;  // sweep: the scalar reference kernel instead of the SIMD one (tests, benchmarks)
   ProgressCallback progress;  // once per iteration, with the fraction of max_iterations done
 };

@@ -10,6 +10,8 @@
 //   m_out[c][k] += sum_d Q[d][k] L_d          (eq. 10)
 #pragma once
 
+#include <haze/simd/half.h>
+
 #include <cstddef>
 
 namespace haze::simd {
@@ -33,6 +35,8 @@ struct DomRow {
   const float* density = nullptr;  // per cell
   float sigma_t_scale = 1.0f, albedo = 0.0f;
   const float* first = nullptr;    // [cell * first_stride + d], or null
+  const Half* first_half = nullptr;  // or the same in float16, times first_scale[cell]
+  const float* first_scale = nullptr;
   size_t first_stride = 0;
   const float* m_in = nullptr;     // [cell * terms + k], or null
   float* m_out = nullptr;          // [cell * terms + k], added to
