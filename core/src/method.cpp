@@ -15,6 +15,7 @@ namespace {
 struct Registry {
   std::mutex mutex;
   std::map<std::string, MethodInfo> methods;
+  ParticleMediumFactory particle_medium;
   Registry() {
     methods["quadrature"] = {"quadrature",
                              "single scattering by deterministic numerical quadrature (any medium; a yardstick, not fast)",
@@ -50,6 +51,12 @@ std::vector<MethodInfo> registered_methods() {
   return out;
 }
 
+void register_particle_medium(ParticleMediumFactory factory) {
+  auto& r = registry();
+  std::lock_guard lock(r.mutex);
+  r.particle_medium = std::move(factory);
+}
+
 std::unique_ptr<Method> create_method(const std::string& name) {
   auto& r = registry();
   std::lock_guard lock(r.mutex);
@@ -77,6 +84,25 @@ RenderResult render(const Scene& scene, const std::string& method_name, RenderOp
   if (scene.method_name() == name) settings = scene.method;
   for (const auto& [key, value] : options.settings.items()) settings[key] = value;
   settings.erase("name");
+  if (!scene.particles.is_null()) {
+    auto& r = registry();
+    ParticleMediumFactory factory;
+    bool reads_particles = false;
+    {
+      std::lock_guard lock(r.mutex);
+      factory = r.particle_medium;
+      reads_particles = r.methods.at(name).reads_particles;
+    }
+    if (!reads_particles) {
+      if (scene.medium)
+        throw Error("particles", "given with a medium", "one of `medium` and `particles` for method " + name + ", which renders one medium");
+      if (!factory) throw Error("particles", "no particle module registered", "haze::particles::register_methods() before rendering particles");
+      Scene converted = scene;
+      converted.medium = factory(scene, settings);
+      options.settings = std::move(settings);
+      return method->render(converted, options);
+    }
+  }
   options.settings = std::move(settings);
   return method->render(scene, options);
 }

@@ -443,6 +443,7 @@ Scene parse(const json& j, const fs::path& base_dir) {
   Object top(j, "");
   top.allow({"camera", "medium", "particles", "lights", "surfaces", "background", "method"});
   Scene scene;
+  scene.directory = base_dir;
   scene.camera = read_camera(Object(top.need("camera", "a camera object"), "camera"));
   if (const json* m = top.find("medium")) scene.medium = read_medium(Object(*m, "medium"), base_dir);
   if (const json* p = top.find("particles")) {
@@ -462,6 +463,15 @@ Scene parse(const json& j, const fs::path& base_dir) {
 }
 
 }  // namespace
+
+MaterialDesc read_material(const nlohmann::json& j, const std::string& path) {
+  const Object o(j, path);
+  MaterialDesc m;
+  m.sigma_t = o.color("sigma_t", kNonNegative);
+  m.albedo = o.color("albedo", Rgb(0.8), kUnit);
+  if (const json* p = o.find("phase")) m.phase = read_phase(Object(*p, o.at("phase")));
+  return m;
+}
 
 Scene Scene::from_json(const nlohmann::json& json, const std::filesystem::path& base_dir) {
   try {

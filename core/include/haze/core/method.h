@@ -46,7 +46,16 @@ struct MethodInfo {
   std::string name;
   std::string summary;  // one line for `haze render --help` and error messages
   std::function<std::unique_ptr<Method>()> create;
+  // The method reads the scene's `particles` block itself; any other method is given the
+  // particles' continuous density as the scene's medium (register_particle_medium).
+  bool reads_particles = false;
 };
+
+// Turns a scene's `particles` block into a medium (the particle module registers one when its
+// methods are registered: the particles' continuous density sampled on a grid). `settings` are the
+// render's method settings, from which it may read (and must remove) its own keys.
+using ParticleMediumFactory = std::function<MediumDesc(const Scene& scene, nlohmann::json& settings)>;
+void register_particle_medium(ParticleMediumFactory factory);
 
 // Reads a method's settings with validation: a bad value or a key the method never asked for
 // throws haze::Error naming "method.<key>".
@@ -74,7 +83,9 @@ std::vector<MethodInfo> registered_methods();
 std::unique_ptr<Method> create_method(const std::string& name);
 
 // Renders with `method_name`, or the scene's method when empty. The scene's method settings
-// apply when its name matches; options.settings override them key by key.
+// apply when its name matches; options.settings override them key by key. A scene with particles
+// and no medium renders with a method that does not read particles through the registered
+// ParticleMediumFactory.
 RenderResult render(const Scene& scene, const std::string& method_name, RenderOptions options = {});
 
 }  // namespace haze

@@ -17,10 +17,20 @@
 
 namespace haze {
 
+// The fields a medium and a particle set share, read with the scene's validation from the JSON
+// object `j` found at `path` (e.g. "particles"); its other fields are left to the caller.
+struct MaterialDesc {
+  Rgb sigma_t{1.0};  // required: per unit length and unit density
+  Rgb albedo{0.8};
+  PhaseFunction phase;  // isotropic unless given
+};
+MaterialDesc read_material(const nlohmann::json& j, const std::string& path);
+
 struct Scene {
   Camera camera;
   std::optional<MediumDesc> medium;
   nlohmann::json particles;  // kept as written until the particle module reads it
+  std::filesystem::path directory = ".";  // relative file names in the scene resolve against it
   std::vector<Light> lights;
   std::vector<Surface> surfaces;
   Rgb background{0.0};

@@ -3,8 +3,8 @@
 
 namespace haze::particles {
 
-// Registers every particle method this build has; safe to call more than once. Today there is
-// none yet: the illumination-network method lands here.
+// Registers method "network" and the conversion of a scene's particles into a medium (their
+// continuous density on a grid, field.h) for every other method; safe to call more than once.
 void register_methods();
 
 }  // namespace haze::particles

@@ -1,0 +1,59 @@
+// The continuous density a particle set stands for, so that the same particles can be rendered by
+// the network, the reference path tracer and the grid methods. One Gaussian per particle:
+//   rho(x) = sum_p w_p exp(-|x - x_p|^2 / h_p^2),  h_p = delta_s_p,  w_p = rho_p / (6 sqrt(pi)),
+// so a particle's integral, w_p pi^(3/2) h_p^3, is rho_p pi delta_s_p^3 / 6: its sphere's volume
+// times its density. Each Gaussian is cut at 3 h_p (e^-9 = 1.2e-4 of its peak). Neighbourhoods
+// come from a FLANN kd-tree: k nearest neighbours for the sizes, radius queries for rho(x).
+#pragma once
+
+#include <haze/core/medium.h>
+#include <haze/particles/particle_set.h>
+
+#include <memory>
+
+namespace haze::particles {
+
+class ParticleField {
+ public:
+  // Where diameters are not given, delta_s_p = 2 r_k / k^(1/3) from the distance r_k to the k-th
+  // nearest neighbour (the diameter of a sphere holding 1/k of that neighbourhood's volume), at
+  // least 1e-3 of the set's bounding radius. Throws haze::Error when no size can follow (one
+  // particle, or all at one point, without diameters). `particles` must outlive the field.
+  explicit ParticleField(const ParticleView& particles, int neighbours = 8);
+  ~ParticleField();
+  ParticleField(const ParticleField&) = delete;
+  ParticleField& operator=(const ParticleField&) = delete;
+
+  size_t size() const { return h_.size(); }
+  const ParticleView& particles() const { return view_; }
+  Vec3 position(size_t p) const { return Vec3(view_.positions[p]); }
+  double h(size_t p) const { return h_[p]; }          // the Gaussian's width, delta_s_p
+  double weight(size_t p) const { return w_[p]; }     // its peak density w_p
+  const std::vector<double>& diameters() const { return h_; }
+  // The bounding sphere of the positions, and the box holding every particle's support.
+  Vec3 centre() const { return centre_; }
+  double radius() const { return radius_; }
+  Aabb bounds() const { return bounds_; }
+
+  double density(const Vec3& x) const;
+  std::vector<float> density_at_particles(int threads) const;
+  // integral of rho from x along the unit direction over length (may be infinite): exact for the
+  // Gaussians (erf), summed over the particles whose support the segment meets.
+  double density_integral(const Vec3& x, const Vec3& direction, double length) const;
+  // rho at the cell centres of `resolution` cells over bounds(), x fastest (a grid medium).
+  GridDensity to_grid(const std::array<int, 3>& resolution, int threads) const;
+  // The medium the field stands for: the grid over bounds() with the particles' material.
+  MediumDesc to_medium(int resolution, int threads) const;
+
+ private:
+  struct Index;
+  ParticleView view_;
+  std::vector<double> h_, w_;
+  double h_max_ = 0.0;
+  Vec3 centre_{0.0};
+  double radius_ = 0.0;
+  Aabb bounds_;
+  std::unique_ptr<Index> index_;
+};
+
+}  // namespace haze::particles

@@ -1,0 +1,129 @@
+// The particles' continuous density (field.h): sizes from FLANN's nearest neighbours, density by
+// FLANN radius queries, line integrals in closed form.
+#include <haze/core/error.h>
+#include <haze/core/progress.h>
+#include <haze/particles/field.h>
+#include <haze/particles/neighbours.h>
+
+#include <flann/flann.hpp>
+
+#include <algorithm>
+#include <cmath>
+
+namespace haze::particles {
+
+namespace {
+constexpr double kCut = 3.0;  // each Gaussian ends at 3 h
+}
+
+struct ParticleField::Index {
+  flann::Matrix<float> data;
+  flann::Index<flann::L2<float>> tree;
+  explicit Index(const ParticleView& v)
+      : data(const_cast<float*>(&v.positions[0].x), v.positions.size(), 3), tree(data, flann::KDTreeSingleIndexParams(12)) {
+    tree.buildIndex();
+  }
+};
+
+ParticleField::ParticleField(const ParticleView& particles, int neighbours) : view_(particles) {
+  validate(particles);
+  const size_t n = particles.positions.size();
+  if (n == 0) return;
+  Aabb box{Vec3(kInfinity), Vec3(-kInfinity)};
+  for (const Vec3f& x : particles.positions) box.lo = glm::min(box.lo, Vec3(x)), box.hi = glm::max(box.hi, Vec3(x));
+  centre_ = 0.5 * (box.lo + box.hi);
+  for (const Vec3f& x : particles.positions) radius_ = std::max(radius_, glm::length(Vec3(x) - centre_));
+  if (!particles.diameters.empty()) {
+    for (float ds : particles.diameters) h_.push_back(static_cast<double>(ds));
+  } else {
+    if (n < 2 || !(radius_ > 0.0))
+      throw Error("particles.diameter", "missing", "diameters: " + std::string(n < 2 ? "a single particle" : "particles all at one point") +
+                                                       " have no neighbours to size them by");
+    const int k = std::min(neighbours, static_cast<int>(n) - 1);
+    const Neighbourhoods nb = nearest_neighbours(std::vector<Vec3f>(particles.positions.begin(), particles.positions.end()), k);
+    const double floor = 1e-3 * radius_, scale = 2.0 / std::cbrt(static_cast<double>(k));
+    h_.resize(n);
+    for (size_t p = 0; p < n; ++p)
+      h_[p] = std::max(floor, scale * std::sqrt(static_cast<double>(nb.distances2[p * static_cast<size_t>(k) + static_cast<size_t>(k) - 1])));
+  }
+  w_.resize(n);
+  for (size_t p = 0; p < n; ++p) w_[p] = (particles.density.empty() ? 1.0 : static_cast<double>(particles.density[p])) / (6.0 * std::sqrt(kPi));
+  h_max_ = *std::max_element(h_.begin(), h_.end());
+  bounds_ = {box.lo - Vec3(kCut * h_max_), box.hi + Vec3(kCut * h_max_)};
+  index_ = std::make_unique<Index>(view_);
+}
+
+ParticleField::~ParticleField() = default;
+
+double ParticleField::density(const Vec3& x) const {
+  if (!index_) return 0.0;
+  float q[3] = {static_cast<float>(x.x), static_cast<float>(x.y), static_cast<float>(x.z)};
+  std::vector<std::vector<size_t>> found;
+  std::vector<std::vector<float>> dist2;
+  flann::SearchParams params(flann::FLANN_CHECKS_UNLIMITED);
+  params.sorted = false;
+  index_->tree.radiusSearch(flann::Matrix<float>(q, 1, 3), found, dist2, static_cast<float>(kCut * kCut * h_max_ * h_max_), params);
+  double rho = 0.0;
+  for (size_t j = 0; j < found[0].size(); ++j) {
+    const size_t p = found[0][j];
+    const double h2 = h_[p] * h_[p], d2 = static_cast<double>(dist2[0][j]);
+    if (d2 < kCut * kCut * h2) rho += w_[p] * std::exp(-d2 / h2);
+  }
+  return rho;
+}
+
+std::vector<float> ParticleField::density_at_particles(int threads) const {
+  std::vector<float> out(size());
+  parallel_for(static_cast<long long>(size()), threads, 256, [&](long long p0, long long p1) {
+    for (auto p = static_cast<size_t>(p0); p < static_cast<size_t>(p1); ++p) out[p] = static_cast<float>(density(position(p)));
+  });
+  return out;
+}
+
+double ParticleField::density_integral(const Vec3& x, const Vec3& direction, double length) const {
+  double sum = 0.0;
+  for (size_t p = 0; p < size(); ++p) {
+    const Vec3 d = position(p) - x;
+    const double h = h_[p], t = glm::dot(d, direction);
+    if (t < -kCut * h || t > length + kCut * h) continue;
+    const double perp2 = std::max(0.0, glm::dot(d, d) - t * t);
+    if (perp2 >= kCut * kCut * h * h) continue;
+    // integral over s in [0, length] of exp(-(perp^2 + (s - t)^2) / h^2)
+    const double far = std::isfinite(length) ? std::erf((length - t) / h) : 1.0;
+    sum += w_[p] * std::exp(-perp2 / (h * h)) * 0.5 * std::sqrt(kPi) * h * (far + std::erf(t / h));
+  }
+  return sum;
+}
+
+GridDensity ParticleField::to_grid(const std::array<int, 3>& r, int threads) const {
+  GridDensity grid{r, std::vector<float>(static_cast<size_t>(r[0]) * static_cast<size_t>(r[1]) * static_cast<size_t>(r[2]), 0.0f)};
+  if (size() == 0) return grid;
+  const Vec3 cell = bounds_.extent() / Vec3(r[0], r[1], r[2]);
+  parallel_for(r[2], threads, 1, [&](long long k0, long long k1) {
+    for (auto k = static_cast<int>(k0); k < k1; ++k)
+      for (int j = 0; j < r[1]; ++j)
+        for (int i = 0; i < r[0]; ++i)
+          grid.values[(static_cast<size_t>(k) * static_cast<size_t>(r[1]) + static_cast<size_t>(j)) * static_cast<size_t>(r[0]) + static_cast<size_t>(i)] =
+              static_cast<float>(density(bounds_.lo + (Vec3(i, j, k) + 0.5) * cell));
+  });
+  return grid;
+}
+
+MediumDesc ParticleField::to_medium(int resolution, int threads) const {
+  MediumDesc m;
+  m.sigma_t = view_.material.sigma_t, m.albedo = view_.material.albedo, m.phase = view_.material.phase;
+  if (size() == 0) {  // nothing: a zero-density box
+    m.bounds = {Vec3(-1.0), Vec3(1.0)};
+    m.density = GridDensity{{1, 1, 1}, {0.0f}};
+    return m;
+  }
+  m.bounds = bounds_;
+  const Vec3 e = bounds_.extent();
+  const double cell = std::max({e.x, e.y, e.z}) / resolution;
+  std::array<int, 3> r;
+  for (int a = 0; a < 3; ++a) r[static_cast<size_t>(a)] = std::max(2, static_cast<int>(std::ceil(e[a] / cell)));
+  m.density = to_grid(r, threads);
+  return m;
+}
+
+}  // namespace haze::particles

@@ -1,0 +1,212 @@
+// Visibility network, direct light and the illumination-network iteration (seed 001 sections
+// 3.1-3.3; network.h says what Haze does past the paper).
+#include <haze/core/error.h>
+#include <haze/particles/network.h>
+#include <haze/simd/phase_batch.h>
+
+#include <Eigen/Core>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <numeric>
+
+namespace haze::particles {
+
+namespace {
+
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+// Two unit vectors perpendicular to w and to each other.
+void frame(const Vec3& w, Vec3& t1, Vec3& t2) {
+  t1 = glm::normalize(glm::cross(w, std::abs(w.x) < 0.9 ? Vec3(1, 0, 0) : Vec3(0, 1, 0)));
+  t2 = glm::cross(w, t1);
+}
+
+}  // namespace
+
+int default_window(const ParticleField& field) {
+  if (field.size() == 0 || !(field.radius() > 0.0)) return 1;
+  double mean = 0.0;
+  for (double h : field.diameters()) mean += h;
+  mean /= static_cast<double>(field.size());
+  return std::clamp(static_cast<int>(std::lround(std::sqrt(static_cast<double>(field.size()) * mean / (2.0 * field.radius())))), 1, 4096);
+}
+
+VisibilityNetwork build_visibility(const ParticleField& field, const std::vector<float>& rho, const DirectionSet& directions, int window,
+                                   int threads) {
+  if (window < 1 || window > 65536) throw Error("window", to_text(window), "a window resolution M in [1, 65536]");
+  VisibilityNetwork v;
+  const auto n = static_cast<int>(field.size());
+  v.particles = n, v.directions = directions.size(), v.window = window;
+  const size_t total = static_cast<size_t>(n) * static_cast<size_t>(directions.size());
+  v.upstream.assign(total, -1), v.depth.assign(total, 0.0f), v.order.resize(total);
+  if (n == 0) return v;
+  // A window slightly larger than the bounding sphere, so that every particle lands inside.
+  const double r = std::max(field.radius(), 1e-6 * std::max(1.0, glm::length(field.centre()))) * (1.0 + 1e-6);
+  const Vec3 c = field.centre();
+  parallel_for(directions.size(), threads, 1, [&](long long i0, long long i1) {
+    std::vector<int> key(static_cast<size_t>(n)), sorted(static_cast<size_t>(n));
+    std::vector<double> depth(static_cast<size_t>(n));
+    std::vector<int> start(static_cast<size_t>(window) * static_cast<size_t>(window) + 1);
+    for (auto i = static_cast<int>(i0); i < i1; ++i) {
+      const Vec3 w = directions[i];
+      Vec3 t1, t2;
+      frame(w, t1, t2);
+      std::fill(start.begin(), start.end(), 0);
+      for (int p = 0; p < n; ++p) {
+        const Vec3 d = field.position(static_cast<size_t>(p)) - c;
+        const int px = std::clamp(static_cast<int>((glm::dot(d, t1) + r) / (2.0 * r) * window), 0, window - 1);
+        const int py = std::clamp(static_cast<int>((glm::dot(d, t2) + r) / (2.0 * r) * window), 0, window - 1);
+        key[static_cast<size_t>(p)] = py * window + px;
+        depth[static_cast<size_t>(p)] = glm::dot(d, w);
+        ++start[static_cast<size_t>(key[static_cast<size_t>(p)]) + 1];
+      }
+      // Counting sort by pixel, then by depth (ties by index) within each pixel.
+      std::partial_sum(start.begin(), start.end(), start.begin());
+      std::vector<int> fill(start.begin(), start.end() - 1);
+      for (int p = 0; p < n; ++p) sorted[static_cast<size_t>(fill[static_cast<size_t>(key[static_cast<size_t>(p)])]++)] = p;
+      for (size_t b = 0; b + 1 < start.size(); ++b) {
+        auto* first = sorted.data() + start[b];
+        auto* last = sorted.data() + start[b + 1];
+        std::sort(first, last, [&](int a, int q) {
+          return depth[static_cast<size_t>(a)] < depth[static_cast<size_t>(q)] || (depth[static_cast<size_t>(a)] == depth[static_cast<size_t>(q)] && a < q);
+        });
+        for (auto* e = first + 1; e < last; ++e) {
+          const auto p = static_cast<size_t>(*e), up = static_cast<size_t>(*(e - 1));
+          const size_t at = static_cast<size_t>(i) * static_cast<size_t>(n) + p;
+          v.upstream[at] = *(e - 1);
+          // The gap's density integral by the trapezoid rule on the continuous density.
+          v.depth[at] = static_cast<float>(0.5 * (static_cast<double>(rho[p]) + static_cast<double>(rho[up])) * (depth[p] - depth[up]));
+        }
+      }
+      std::copy(sorted.begin(), sorted.end(), v.order.begin() + static_cast<long>(i) * n);
+    }
+  });
+  return v;
+}
+
+NetworkSolution solve_network(const ParticleField& field, const std::vector<Light>& lights, const NetworkSettings& settings,
+                              const NetworkSolution* warm) {
+  if (settings.directions < 8 || settings.directions > 4096)
+    throw Error("directions", to_text(settings.directions), "a direction count in [8, 4096]");
+  if (settings.max_iterations < 0) throw Error("iterations", to_text(settings.max_iterations), "at least 0 (0: single scattering only)");
+  if (!(settings.tolerance > 0.0)) throw Error("tolerance", to_text(settings.tolerance), "a relative change > 0");
+  const MaterialDesc& material = field.particles().material;
+  NetworkSolution out;
+  auto start = std::chrono::steady_clock::now();
+  out.directions = std::make_shared<DirectionSet>(DirectionSet::fibonacci(settings.directions));
+  out.matrix = std::make_shared<PhaseMatrix>(material.phase, *out.directions);
+  const DirectionSet& dirs = *out.directions;
+  const auto n = static_cast<size_t>(field.size()), d = static_cast<size_t>(dirs.size());
+  out.rho = field.density_at_particles(settings.threads);
+  out.visibility = build_visibility(field, out.rho, dirs, settings.window ? settings.window : default_window(field), settings.threads);
+  out.build_seconds = seconds_since(start);
+
+  // Direct light at every particle, attenuated by the continuous density; a light inside a
+  // particle gives it the irradiance at a quarter of its diameter, no more.
+  start = std::chrono::steady_clock::now();
+  std::vector<const Light*> delta;
+  Rgb sky(0.0);
+  for (const Light& l : lights) {
+    if (const auto* s = std::get_if<SkyLight>(&l)) sky += s->radiance;
+    else delta.push_back(&l);
+  }
+  out.direct.assign(delta.size() * n, Rgb(0.0));
+  out.to_light.assign(delta.size() * n, Vec3(0.0));
+  std::array<std::vector<float>, 3> source;  // S[c][i * n + p]: direct light scattered into w_i, per unit albedo
+  for (auto& s : source) s.assign(n * d, 0.0f);
+  parallel_for(static_cast<long long>(n), settings.threads, 16, [&](long long p0, long long p1) {
+    std::vector<float> cosines(d), phase(d);
+    for (auto p = static_cast<size_t>(p0); p < static_cast<size_t>(p1); ++p) {
+      const Vec3 x = field.position(p);
+      const double nearest = 0.25 * field.h(p);
+      for (size_t l = 0; l < delta.size(); ++l) {
+        LightArrival a;
+        if (!arrival(*delta[l], x, a)) continue;
+        Rgb e = a.irradiance;
+        if (std::isfinite(a.distance) && a.distance < nearest) e *= (a.distance / nearest) * (a.distance / nearest);
+        if (!(a.distance > 0.0)) {
+          const auto* point = std::get_if<PointLight>(delta[l]);
+          e = point ? point->intensity / (nearest * nearest) : Rgb(0.0);
+          a.to_light = Vec3(0.0);
+        }
+        e *= glm::exp(-material.sigma_t * field.density_integral(x, a.to_light, a.distance));
+        out.direct[l * n + p] = e, out.to_light[l * n + p] = a.to_light;
+        if (e == Rgb(0.0)) continue;
+        for (size_t i = 0; i < d; ++i) cosines[i] = static_cast<float>(-glm::dot(a.to_light, dirs[static_cast<int>(i)]));
+        simd::eval_phase(material.phase, cosines.data(), phase.data(), d);
+        double sum = 0.0;
+        for (size_t i = 0; i < d; ++i) sum += static_cast<double>(phase[i]) * dirs.weight(static_cast<int>(i));
+        for (int c = 0; c < 3; ++c) {
+          const auto scale = static_cast<float>(e[c] / sum);  // quadrature over directions gives back E exactly
+          for (size_t i = 0; i < d; ++i) source[static_cast<size_t>(c)][i * n + p] += scale * phase[i];
+        }
+      }
+    }
+  });
+  out.direct_seconds = seconds_since(start);
+
+  // Iteration (section 3.3, with DESIGN.md's normalization): for p and direction i with upstream
+  // v, over the gap's transmittance T = exp(-sigma_t depth),
+  //   I[p, i] = T I[v, i] + (1 - T) albedo (J[v, i] + J[p, i]) / 2,   J[q, i] = sum_d P[i][d] I[q, d] + S[q, i],
+  // the formal solution over the gap with its in-scattered radiance averaged from both ends; I = sky
+  // where no particle is upstream. Columns run in upstream order (Gauss-Seidel along each column).
+  start = std::chrono::steady_clock::now();
+  using Matrix = Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic>;
+  const Matrix pt = out.matrix->matrix().transpose().cast<float>();
+  const bool warm_fits = warm && warm->visibility.particles == static_cast<int>(n) && warm->directions && warm->directions->size() == dirs.size();
+  std::array<std::vector<float>, 3> transmittance;
+  for (int c = 0; c < 3; ++c) {
+    auto& t = transmittance[static_cast<size_t>(c)];
+    t.resize(n * d);
+    for (size_t e = 0; e < n * d; ++e) t[e] = static_cast<float>(std::exp(-material.sigma_t[c] * static_cast<double>(out.visibility.depth[e])));
+    out.incoming[static_cast<size_t>(c)] = warm_fits ? warm->incoming[static_cast<size_t>(c)] : std::vector<float>(n * d, 0.0f);
+  }
+  std::vector<float> j(n * d), previous;
+  const VisibilityNetwork& v = out.visibility;
+  while (n > 0 && out.iterations < settings.max_iterations) {
+    double diff = 0.0, ref = 0.0;
+    for (int c = 0; c < 3; ++c) {
+      std::vector<float>& in = out.incoming[static_cast<size_t>(c)];
+      previous = in;
+      Eigen::Map<Matrix>(j.data(), static_cast<long>(n), static_cast<long>(d)).noalias() =
+          Eigen::Map<const Matrix>(in.data(), static_cast<long>(n), static_cast<long>(d)) * pt;
+      const std::vector<float>& s = source[static_cast<size_t>(c)];
+      const std::vector<float>& t = transmittance[static_cast<size_t>(c)];
+      const auto albedo = static_cast<float>(material.albedo[c]), sky_c = static_cast<float>(sky[c]);
+      parallel_for(static_cast<long long>(d), settings.threads, 1, [&](long long i0, long long i1) {
+        for (auto i = static_cast<size_t>(i0); i < static_cast<size_t>(i1); ++i) {
+          const size_t base = i * n;
+          for (size_t k = 0; k < n; ++k) {
+            const auto p = static_cast<size_t>(v.order[base + k]);
+            const int up = v.upstream[base + p];
+            if (up < 0) {
+              in[base + p] = sky_c;
+              continue;
+            }
+            const size_t q = base + static_cast<size_t>(up);
+            const float tp = t[base + p];
+            in[base + p] = tp * in[q] + (1.0f - tp) * albedo * 0.5f * (j[q] + s[q] + j[base + p] + s[base + p]);
+          }
+        }
+      });
+      for (size_t e = 0; e < n * d; ++e) {
+        const double a = in[e], b = a - static_cast<double>(previous[e]);
+        diff += b * b, ref += a * a;
+      }
+    }
+    ++out.iterations;
+    out.changes.push_back(ref > 0.0 ? std::sqrt(diff / ref) : 0.0);
+    if (settings.progress && !settings.progress(std::min(1.0, out.iterations / static_cast<double>(settings.max_iterations))))
+      throw Cancelled();
+    if (out.changes.back() < settings.tolerance) break;
+  }
+  out.converged = n == 0 || (!out.changes.empty() && out.changes.back() < settings.tolerance);
+  out.iterate_seconds = seconds_since(start);
+  return out;
+}
+
+}  // namespace haze::particles
