@@ -3,9 +3,8 @@
 #include <haze/core/error.h>
 #include <haze/core/progress.h>
 #include <haze/particles/field.h>
-#include <haze/particles/neighbours.h>
 
-#include <flann/flann.hpp>
+#include "kd_tree.h"
 
 #include <algorithm>
 #include <cmath>
@@ -16,15 +15,6 @@ namespace {
 constexpr double kCut = 3.0;  // each Gaussian ends at 3 h
 }
 
-struct ParticleField::Index {
-  flann::Matrix<float> data;
-  flann::Index<flann::L2<float>> tree;
-  explicit Index(const ParticleView& v)
-      : data(const_cast<float*>(&v.positions[0].x), v.positions.size(), 3), tree(data, flann::KDTreeSingleIndexParams(12)) {
-    tree.buildIndex();
-  }
-};
-
 ParticleField::ParticleField(const ParticleView& particles, int neighbours) : view_(particles) {
   validate(particles);
   const size_t n = particles.positions.size();
@@ -32,6 +22,7 @@ ParticleField::ParticleField(const ParticleView& particles, int neighbours) : vi
   Aabb box{Vec3(kInfinity), Vec3(-kInfinity)};
   for (const Vec3f& x : particles.positions) box.lo = glm::min(box.lo, Vec3(x)), box.hi = glm::max(box.hi, Vec3(x));
   centre_ = 0.5 * (box.lo + box.hi);
+  tree_ = std::make_unique<KdTree>(particles.positions);
   for (const Vec3f& x : particles.positions) radius_ = std::max(radius_, glm::length(Vec3(x) - centre_));
   if (!particles.diameters.empty()) {
     for (float ds : particles.diameters) h_.push_back(static_cast<double>(ds));
@@ -40,7 +31,7 @@ ParticleField::ParticleField(const ParticleView& particles, int neighbours) : vi
       throw Error("particles.diameter", "missing", "diameters: " + std::string(n < 2 ? "a single particle" : "particles all at one point") +
                                                        " have no neighbours to size them by");
     const int k = std::min(neighbours, static_cast<int>(n) - 1);
-    const Neighbourhoods nb = nearest_neighbours(std::vector<Vec3f>(particles.positions.begin(), particles.positions.end()), k);
+    const Neighbourhoods nb = nearest_neighbours(*tree_, k);
     const double floor = 1e-3 * radius_, scale = 2.0 / std::cbrt(static_cast<double>(k));
     h_.resize(n);
     for (size_t p = 0; p < n; ++p)
@@ -50,19 +41,18 @@ ParticleField::ParticleField(const ParticleView& particles, int neighbours) : vi
   for (size_t p = 0; p < n; ++p) w_[p] = (particles.density.empty() ? 1.0 : static_cast<double>(particles.density[p])) / (6.0 * std::sqrt(kPi));
   h_max_ = *std::max_element(h_.begin(), h_.end());
   bounds_ = {box.lo - Vec3(kCut * h_max_), box.hi + Vec3(kCut * h_max_)};
-  index_ = std::make_unique<Index>(view_);
 }
 
 ParticleField::~ParticleField() = default;
 
 double ParticleField::density(const Vec3& x) const {
-  if (!index_) return 0.0;
+  if (!tree_) return 0.0;
   float q[3] = {static_cast<float>(x.x), static_cast<float>(x.y), static_cast<float>(x.z)};
   std::vector<std::vector<size_t>> found;
   std::vector<std::vector<float>> dist2;
   flann::SearchParams params(flann::FLANN_CHECKS_UNLIMITED);
   params.sorted = false;
-  index_->tree.radiusSearch(flann::Matrix<float>(q, 1, 3), found, dist2, static_cast<float>(kCut * kCut * h_max_ * h_max_), params);
+  tree_->index.radiusSearch(flann::Matrix<float>(q, 1, 3), found, dist2, static_cast<float>(kCut * kCut * h_max_ * h_max_), params);
   double rho = 0.0;
   for (size_t j = 0; j < found[0].size(); ++j) {
     const size_t p = found[0][j];

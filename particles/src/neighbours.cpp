@@ -1,7 +1,7 @@
 #include <haze/core/error.h>
 #include <haze/particles/neighbours.h>
 
-#include <flann/flann.hpp>
+#include "kd_tree.h"
 
 namespace haze::particles {
 
@@ -12,12 +12,11 @@ Neighbourhoods nearest_neighbours(const std::vector<Vec3f>& positions, int k) {
   for (size_t i = 0; i < n; ++i)
     if (!std::isfinite(positions[i].x + positions[i].y + positions[i].z))
       throw Error("positions[" + std::to_string(i) + "]", "not finite", "finite coordinates");
-  // FLANN reads rows of 3 floats; glm::vec3 is exactly that.
-  static_assert(sizeof(Vec3f) == 3 * sizeof(float));
-  flann::Matrix<float> data(const_cast<float*>(&positions[0].x), n, 3);
-  flann::Index<flann::L2<float>> index(data, flann::KDTreeSingleIndexParams(12));
-  index.buildIndex();
+  return nearest_neighbours(KdTree(positions), k);
+}
 
+Neighbourhoods nearest_neighbours(const KdTree& tree, int k) {
+  const size_t n = tree.data.rows;
   // Ask for k + 1 and drop the particle itself; among duplicates at distance 0 it may be missing,
   // and then the first k are kept.
   const size_t kk = static_cast<size_t>(k) + 1;
@@ -27,7 +26,7 @@ Neighbourhoods nearest_neighbours(const std::vector<Vec3f>& positions, int k) {
   flann::Matrix<float> dist_m(dist.data(), n, kk);
   flann::SearchParams params(flann::FLANN_CHECKS_UNLIMITED);
   params.cores = 1;  // deterministic; callers parallelize above this
-  index.knnSearch(data, found_m, dist_m, kk, params);
+  tree.index.knnSearch(tree.data, found_m, dist_m, kk, params);
 
   Neighbourhoods out;
   out.k = k;

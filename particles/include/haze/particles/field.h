@@ -13,6 +13,8 @@
 
 namespace haze::particles {
 
+struct KdTree;  // internal
+
 class ParticleField {
  public:
   // Where diameters are not given, delta_s_p = 2 r_k / k^(1/3) from the distance r_k to the k-th
@@ -46,14 +48,13 @@ class ParticleField {
   MediumDesc to_medium(int resolution, int threads) const;
 
  private:
-  struct Index;
   ParticleView view_;
   std::vector<double> h_, w_;
   double h_max_ = 0.0;
   Vec3 centre_{0.0};
   double radius_ = 0.0;
   Aabb bounds_;
-  std::unique_ptr<Index> index_;
+  std::unique_ptr<KdTree> tree_;
 };
 
 }  // namespace haze::particles
