@@ -10,6 +10,8 @@
 #include <haze/grids/methods.h>
 #include <haze/grids/optical_depth.h>
 
+#include "cloud_scene.h"  // tests/grids: the scene the dom tests measure
+
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -66,24 +68,6 @@ void slab(std::FILE* csv, int directions, int terms, int nz, bool delta_m = true
   std::fflush(stdout);
 }
 
-// The tests' RBF cloud (9 blobs, sigma_t (2, 2.4, 2.8), albedo 0.9, HG 0.4), a point light and a sun.
-Scene cloud_scene() {
-  nlohmann::json blobs = nlohmann::json::array();
-  for (int i = 0; i < 9; ++i) {
-    double t = 0.7 * i;
-    blobs.push_back({{"center", {0.45 * std::cos(t), 0.3 * std::sin(1.7 * t), 0.35 * std::cos(1.3 * t + 0.5)}},
-                     {"weight", 0.8 + 0.4 * std::sin(2.0 * t)},
-                     {"sharpness", 2.5 + (i % 3)}});
-  }
-  nlohmann::json j = {
-      {"camera", {{"type", "pinhole"}, {"position", {0.3, 0.4, 3.2}}, {"look_at", {0, 0, 0}}, {"fov_y_deg", 40}, {"width_px", 24}, {"height_px", 18}}},
-      {"medium", {{"density", {{"type", "rbf"}, {"blobs", blobs}}}, {"sigma_t", {2.0, 2.4, 2.8}}, {"albedo", 0.9}, {"phase", {{"type", "hg"}, {"g", 0.4}}}}},
-      {"lights", {{{"type", "point"}, {"position", {0.9, 0.9, -0.6}}, {"intensity", {2.0, 1.8, 1.5}}},
-                  {{"type", "directional"}, {"direction", {0.4, -0.8, -0.45}}, {"irradiance", {1.0, 1.0, 1.1}}}}},
-      {"background", {0, 0, 0}}};
-  return Scene::from_json(j);
-}
-
 void cloud(std::FILE* csv, const Scene& scene, const RenderResult& reference, const char* varied, int resolution, int directions, int terms,
            double tolerance, const char* storage = "float32") {
   RenderOptions options;
@@ -118,7 +102,7 @@ int main(int argc, char** argv) {
   for (bool delta_m : {false, true})
     for (int n : {1, 4, 9, 16, 24, 25, 49, 100}) slab(slab_csv, 256, n, 128, delta_m);
 
-  const Scene scene = cloud_scene();
+  const Scene scene = lit_cloud(true, 24, 18);  // the dom tests' RBF cloud, a point light and a sun
   RenderOptions reference_options;
   reference_options.settings = {{"spp", 65536}, {"seed", 11}};
   auto start = std::chrono::steady_clock::now();

@@ -1,4 +1,4 @@
-// The grid tests' RBF cloud scene, shared by the propagation and dom tests.
+// The grid tests' RBF cloud scene, shared by the propagation and dom tests and haze_dom_accuracy.
 #pragma once
 
 #include <haze/core/scene.h>
@@ -24,6 +24,18 @@ inline Scene cloud_scene(int width, int height) {
                   {{"type", "point"}, {"position", {-2.0, -0.5, 1.0}}, {"intensity", {3.0, 3.0, 4.0}}}}},
       {"background", {0, 0, 0}}};
   return Scene::from_json(j);
+}
+
+// A point light and a sun on a cloud: `rbf` the propagation tests' 9-blob cloud, else a box of
+// constant density. Full multiple scattering, no surfaces.
+inline Scene lit_cloud(bool rbf, int width, int height) {
+  Scene scene = cloud_scene(width, height);
+  scene.lights[1] = DirectionalLight{glm::normalize(Vec3(0.4, -0.8, -0.45)), Rgb(1.0, 1.0, 1.1)};
+  if (!rbf) {
+    scene.medium->density = ConstantDensity{1.0};
+    scene.medium->bounds = {Vec3(-0.6, -0.5, -0.5), Vec3(0.6, 0.5, 0.5)};
+  }
+  return scene;
 }
 
 }  // namespace haze::grids

@@ -83,18 +83,6 @@ TEST(DomSlab, DeltaMHoldsTruncatedPhase) {
 namespace haze::grids {
 namespace {
 
-// A point light and a sun on a cloud: `rbf` the propagation tests' 9-blob cloud, else a box of
-// constant density. Full multiple scattering, no surfaces.
-Scene lit_cloud(bool rbf, int width, int height) {
-  Scene scene = cloud_scene(width, height);
-  scene.lights[1] = DirectionalLight{glm::normalize(Vec3(0.4, -0.8, -0.45)), Rgb(1.0, 1.0, 1.1)};
-  if (!rbf) {
-    scene.medium->density = ConstantDensity{1.0};
-    scene.medium->bounds = {Vec3(-0.6, -0.5, -0.5), Vec3(0.6, 0.5, 0.5)};
-  }
-  return scene;
-}
-
 // The criterion: mean relative error over lit pixels (reference above 1% of its peak)
 // under 3% at the default settings. The reference's own per-pixel noise at a test's budget (2 to
 // 4% at 8192 spp) is as large as that, so the test bounds the root-mean-square relative error with
