@@ -8,7 +8,7 @@
 
 namespace haze {
 
-PhaseMatrix::PhaseMatrix(const PhaseFunction& phase, const DirectionSet& directions) {
+PhaseMatrix::PhaseMatrix(const PhaseFunction& phase, const DirectionSet& directions) : phase_(phase), directions_(directions) {
   const int d = directions.size();
   for (int j = 1; j < d; ++j)
     if (std::abs(directions.weight(j) - directions.weight(0)) > 1e-12 * directions.weight(0))
@@ -31,6 +31,12 @@ PhaseMatrix::PhaseMatrix(const PhaseFunction& phase, const DirectionSet& directi
   }
   matrix_ = s.asDiagonal() * k * s.asDiagonal();
   scaling_ = s;
+}
+
+Eigen::VectorXd PhaseMatrix::row(const Vec3& w) const {
+  Eigen::VectorXd r(size());
+  for (int j = 0; j < size(); ++j) r(j) = phase_.eval(glm::dot(w, directions_[j])) * directions_.weight(j) * scaling_(j);
+  return r / r.sum();
 }
 
 SeparablePhase::SeparablePhase(const PhaseMatrix& matrix, int terms) {

@@ -331,13 +331,7 @@ DomSolution solve_dom(const ExtinctionVolume& volume, const std::vector<Light>& 
 }
 
 Eigen::VectorXd inscatter_weights(const DomSolution& solution, const Vec3& w) {
-  const PhaseFunction& phase = solution.phase;
-  const DirectionSet& dirs = *solution.directions;
-  const Eigen::VectorXd& s = solution.matrix->scaling();
-  Eigen::VectorXd row(dirs.size());
-  for (int j = 0; j < dirs.size(); ++j) row(j) = phase.eval(glm::dot(w, dirs[j])) * dirs.weight(j) * s(j);
-  row /= row.sum();
-  return solution.separable->basis().transpose() * row;
+  return solution.separable->basis().transpose() * solution.matrix->row(w);
 }
 
 }  // namespace haze::grids

@@ -13,37 +13,44 @@ namespace {
 constexpr int kTile = 16;
 constexpr double kCut = 3.0;  // as field.h: each Gaussian ends at 3 h
 
-// Pixel position and footprint radius (pixels) of a sphere of radius `extent` around x; false when
-// it lies wholly behind a pinhole camera.
-bool project(const Camera& cam, const Vec3& x, double extent, double& px, double& py, double& radius) {
-  const Vec3 forward = glm::normalize(cam.look_at - cam.position);
-  const Vec3 right = glm::normalize(glm::cross(forward, cam.up));
-  const Vec3 up = glm::cross(right, forward);
-  const double aspect = static_cast<double>(cam.width_px) / cam.height_px;
-  const Vec3 d = x - cam.position;
-  double scale;  // film units per world unit at x
-  if (cam.type == Camera::Type::orthographic) {
-    scale = 2.0 / cam.height;
-  } else {
-    const double z = glm::dot(d, forward);
-    if (z <= extent) {  // touching or behind the eye: cover the whole image
-      if (z < -extent) return false;
-      px = 0.5 * cam.width_px, py = 0.5 * cam.height_px, radius = 2.0 * (cam.width_px + cam.height_px);
-      return true;
-    }
-    scale = 1.0 / ((z - extent) * std::tan(0.5 * cam.fov_y_deg * kPi / 180.0));
-  }
-  const double sx = glm::dot(d, right) * scale, sy = glm::dot(d, up) * scale;
-  px = (sx / aspect + 1.0) * 0.5 * cam.width_px;
-  py = (1.0 - sy) * 0.5 * cam.height_px;
-  radius = extent * scale * 0.5 * cam.height_px + 1.0;
-  return true;
-}
+// Camera::generate_ray inverted: the pixel position and footprint radius (pixels) of a sphere.
+struct Projection {
+  const Camera& cam;
+  Vec3 forward = glm::normalize(cam.look_at - cam.position);
+  Vec3 right = glm::normalize(glm::cross(forward, cam.up));
+  Vec3 up = glm::cross(right, forward);
+  double aspect = static_cast<double>(cam.width_px) / cam.height_px;
+  double tan_half = std::tan(0.5 * cam.fov_y_deg * kPi / 180.0);
 
-// A particle's Gaussian along a ray: rho(t) = amplitude 2 / (sqrt(pi) h) exp(-(t - centre)^2 / h^2).
+  // False when the sphere of radius `extent` around x lies wholly behind a pinhole camera.
+  bool operator()(const Vec3& x, double extent, double& px, double& py, double& radius) const {
+    const Vec3 d = x - cam.position;
+    double scale;  // film units per world unit at x
+    if (cam.type == Camera::Type::orthographic) {
+      scale = 2.0 / cam.height;
+    } else {
+      const double z = glm::dot(d, forward);
+      if (z <= extent) {  // touching or behind the eye: cover the whole image
+        if (z < -extent) return false;
+        px = 0.5 * cam.width_px, py = 0.5 * cam.height_px, radius = 2.0 * (cam.width_px + cam.height_px);
+        return true;
+      }
+      scale = 1.0 / ((z - extent) * tan_half);
+    }
+    const double sx = glm::dot(d, right) * scale, sy = glm::dot(d, up) * scale;
+    px = (sx / aspect + 1.0) * 0.5 * cam.width_px;
+    py = (1.0 - sy) * 0.5 * cam.height_px;
+    radius = extent * scale * 0.5 * cam.height_px + 1.0;
+    return true;
+  }
+};
+
+// A particle's Gaussian along a ray: rho(t) = amplitude / (sqrt(pi) h) exp(-(t - centre)^2 / h^2).
 struct Along {
   double centre, h, amplitude;  // amplitude: its integral over the whole line
   int index;
+  double enter() const { return centre - kCut * h; }
+  double leave() const { return centre + kCut * h; }
 };
 
 // The formal solution along the ray through the particles' Gaussians, in steps of at most a
@@ -54,24 +61,24 @@ struct Along {
 Rgb march(std::vector<Along>& along, const Rgb& sigma_t, const std::vector<Rgb>& scattered, Rgb& transmittance) {
   Rgb radiance(0.0);
   if (along.empty()) return radiance;
-  std::sort(along.begin(), along.end(), [](const Along& a, const Along& b) { return a.centre - kCut * a.h < b.centre - kCut * b.h; });
+  std::sort(along.begin(), along.end(), [](const Along& a, const Along& b) { return a.enter() < b.enter(); });
   std::vector<double> erf_at(along.size());  // erf((t - centre) / h) at the current t, per entered particle
   std::vector<size_t> active;
-  double t = std::max(0.0, along[0].centre - kCut * along[0].h);
+  double t = std::max(0.0, along[0].enter());
   size_t next = 0;
   while (next < along.size() || !active.empty()) {
-    if (active.empty()) t = std::max(t, along[next].centre - kCut * along[next].h);
-    while (next < along.size() && along[next].centre - kCut * along[next].h <= t) {
+    if (active.empty()) t = std::max(t, along[next].enter());
+    while (next < along.size() && along[next].enter() <= t) {
       erf_at[next] = std::erf((t - along[next].centre) / along[next].h);
       active.push_back(next++);
     }
     double step = kInfinity;
     for (size_t a : active) step = std::min(step, 0.25 * along[a].h);
     double t1 = t + step;
-    if (next < along.size()) t1 = std::min(t1, std::max(t + 1e-9, along[next].centre - kCut * along[next].h));
+    if (next < along.size()) t1 = std::min(t1, std::max(t + 1e-9, along[next].enter()));
     double tau = 0.0;
     Rgb source(0.0);
-    for (size_t& a : active) {
+    for (size_t a : active) {
       const Along& g = along[a];
       const double e1 = std::erf((t1 - g.centre) / g.h), dtau = 0.5 * g.amplitude * (e1 - erf_at[a]);
       erf_at[a] = e1;
@@ -84,7 +91,7 @@ Rgb march(std::vector<Along>& along, const Rgb& sigma_t, const std::vector<Rgb>&
       transmittance *= step_transmittance;
     }
     t = t1;
-    std::erase_if(active, [&](size_t a) { return along[a].centre + kCut * along[a].h <= t; });
+    std::erase_if(active, [&](size_t a) { return along[a].leave() <= t; });
   }
   return radiance;
 }
@@ -105,24 +112,17 @@ Image render_network(const Scene& scene, const ParticleField& field, const Netwo
     throw Error("solution", "one for other particles or lights", "the network solved for these particles and lights");
   // Each particle's scattered radiance toward the eye (seed 001 section 3.3, last paragraphs):
   // albedo times the network's in-scattering at the eye's direction (the phase-matrix row extended
-  // off the direction set, PhaseMatrix::scaling) plus direct light with the exact phase function.
-  const DirectionSet& dirs = *solution.directions;
-  const Eigen::VectorXd& s = solution.matrix->scaling();
-  const auto d = static_cast<size_t>(dirs.size());
+  // off the direction set, PhaseMatrix::row) plus direct light with the exact phase function.
+  const auto d = static_cast<size_t>(solution.directions->size());
   std::vector<Rgb> scattered(n);
   parallel_for(static_cast<long long>(n), options.threads, 64, [&](long long p0, long long p1) {
-    std::vector<double> row(d);
     for (auto p = static_cast<size_t>(p0); p < static_cast<size_t>(p1); ++p) {
       const Vec3 x = field.position(p);
       const Vec3 w = cam.type == Camera::Type::orthographic ? glm::normalize(cam.position - cam.look_at) : glm::normalize(cam.position - x);
-      double sum = 0.0;
-      for (size_t i = 0; i < d; ++i) sum += row[i] = material.phase.eval(glm::dot(w, dirs[static_cast<int>(i)])) * dirs.weight(static_cast<int>(i)) * s(static_cast<long>(i));
+      const Eigen::VectorXd row = solution.matrix->row(w);
       Rgb j(0.0);
-      for (int c = 0; c < 3; ++c) {
-        double jc = 0.0;
-        for (size_t i = 0; i < d; ++i) jc += row[i] * static_cast<double>(solution.incoming[static_cast<size_t>(c)][i * n + p]);
-        j[c] = jc / sum;
-      }
+      for (int c = 0; c < 3; ++c)
+        for (size_t i = 0; i < d; ++i) j[c] += row(static_cast<long>(i)) * static_cast<double>(solution.incoming[static_cast<size_t>(c)][i * n + p]);
       for (size_t l = 0; l < delta.size(); ++l) {
         const Vec3& to_light = solution.to_light[l * n + p];
         const double phase = to_light == Vec3(0.0) ? 1.0 / (4.0 * kPi) : material.phase.eval(glm::dot(-to_light, w));
@@ -132,33 +132,31 @@ Image render_network(const Scene& scene, const ParticleField& field, const Netwo
     }
   });
 
-  // Particles binned to 16 x 16 tiles by their footprints, each tile's list sorted by depth.
+  // Particles binned to 16 x 16 tiles by their footprints (march() orders each ray's).
   const int tiles_x = (cam.width_px + kTile - 1) / kTile, tiles_y = (cam.height_px + kTile - 1) / kTile;
-  std::vector<std::vector<std::pair<double, int>>> tiles(static_cast<size_t>(tiles_x) * static_cast<size_t>(tiles_y));
-  const Vec3 forward = glm::normalize(cam.look_at - cam.position);
+  std::vector<std::vector<int>> tiles(static_cast<size_t>(tiles_x) * static_cast<size_t>(tiles_y));
+  const Projection project{cam};
   for (size_t p = 0; p < n; ++p) {
     if (field.weight(p) <= 0.0) continue;
     double px, py, radius;
-    if (!project(cam, field.position(p), kCut * field.h(p), px, py, radius)) continue;
+    if (!project(field.position(p), kCut * field.h(p), px, py, radius)) continue;
     const int x0 = std::max(0, static_cast<int>(std::floor((px - radius) / kTile))), x1 = std::min(tiles_x - 1, static_cast<int>(std::floor((px + radius) / kTile)));
     const int y0 = std::max(0, static_cast<int>(std::floor((py - radius) / kTile))), y1 = std::min(tiles_y - 1, static_cast<int>(std::floor((py + radius) / kTile)));
-    const double depth = glm::dot(field.position(p) - cam.position, forward);
     for (int ty = y0; ty <= y1; ++ty)
-      for (int tx = x0; tx <= x1; ++tx) tiles[static_cast<size_t>(ty * tiles_x + tx)].emplace_back(depth, static_cast<int>(p));
+      for (int tx = x0; tx <= x1; ++tx) tiles[static_cast<size_t>(ty * tiles_x + tx)].push_back(static_cast<int>(p));
   }
   Image image(cam.width_px, cam.height_px);
   ProgressTracker progress(options.progress, static_cast<long long>(tiles.size()));
   parallel_for(static_cast<long long>(tiles.size()), options.threads, 1, [&](long long t0, long long t1) {
     for (auto t = t0; t < t1 && !progress.cancelled(); ++t) {
-      auto& list = tiles[static_cast<size_t>(t)];
-      std::sort(list.begin(), list.end());
+      const std::vector<int>& list = tiles[static_cast<size_t>(t)];
       const int tx = static_cast<int>(t % tiles_x), ty = static_cast<int>(t / tiles_x);
       std::vector<Along> along;
       for (int y = ty * kTile; y < std::min(cam.height_px, (ty + 1) * kTile); ++y)
         for (int x = tx * kTile; x < std::min(cam.width_px, (tx + 1) * kTile); ++x) {
           const Ray ray = cam.pixel_ray(x, y);
           along.clear();
-          for (const auto& [depth, index] : list) {
+          for (const int index : list) {
             const auto p = static_cast<size_t>(index);
             const Vec3 o = field.position(p) - ray.origin;
             const double h = field.h(p), tc = glm::dot(o, ray.direction), perp2 = glm::dot(o, o) - tc * tc;

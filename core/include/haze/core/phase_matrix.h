@@ -25,10 +25,15 @@ class PhaseMatrix {
   // The symmetric scaling: P_ij = s_i p(w_i . w_j) w_j s_j. A direction w outside the set gets the
   // row s(w) p(w . w_j) w_j s_j with s(w) = 1 / sum_j p(w . w_j) w_j s_j (the same rule at w_i).
   const Eigen::VectorXd& scaling() const { return scaling_; }
+  // That row at w, normalized to sum to 1: the in-scattering weights of the D directions toward a
+  // direction off the set (a camera's view; seed 000's separable form and seed 001's splats).
+  Eigen::VectorXd row(const Vec3& w) const;
   // out_i = sum_j P_ij in_j: the direct O(D^2) in-scattering sum (seed 000 eq. 6).
   Eigen::VectorXd apply(const Eigen::VectorXd& in) const { return matrix_ * in; }
 
  private:
+  PhaseFunction phase_;
+  DirectionSet directions_;
   Eigen::MatrixXd matrix_;
   Eigen::VectorXd raw_row_sums_, scaling_;
 };

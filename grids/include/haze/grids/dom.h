@@ -104,7 +104,7 @@ DomSolution solve_dom(const ExtinctionVolume& volume, const std::vector<Light>& 
 
 // For a direction w (propagation direction of the scattered light): c_k with
 // sum_j P(w, w_j) L_j ~ sum_k c_k m_k, the row of P at w extended off the direction set
-// (PhaseMatrix::scaling) and projected on the kept eigenvectors.
+// (PhaseMatrix::row) and projected on the kept eigenvectors.
 Eigen::VectorXd inscatter_weights(const DomSolution& solution, const Vec3& w);
 
 // The image of a solved scene: unscattered light (surfaces lit through `delta_depths`, as
