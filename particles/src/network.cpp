@@ -105,8 +105,8 @@ NetworkSolution solve_network(const ParticleField& field, const std::vector<Ligh
   out.visibility = build_visibility(field, out.rho, dirs, settings.window ? settings.window : default_window(field), settings.threads);
   out.build_seconds = seconds_since(start);
 
-  // Direct light at every particle, attenuated by the continuous density; a light inside a
-  // particle gives it the irradiance at a quarter of its diameter, no more.
+  // Direct light at every particle, attenuated by the continuous density (a depth map per light);
+  // a light inside a particle gives it the irradiance at a quarter of its diameter, no more.
   start = std::chrono::steady_clock::now();
   std::vector<const Light*> delta;
   Rgb sky(0.0);
@@ -114,6 +114,7 @@ NetworkSolution solve_network(const ParticleField& field, const std::vector<Ligh
     if (const auto* s = std::get_if<SkyLight>(&l)) sky += s->radiance;
     else delta.push_back(&l);
   }
+  for (const Light* l : delta) out.light_maps.emplace_back(field, *l, settings.threads);
   out.direct.assign(delta.size() * n, Rgb(0.0));
   out.to_light.assign(delta.size() * n, Vec3(0.0));
   std::array<std::vector<float>, 3> source;  // S[c][i * n + p]: direct light scattered into w_i, per unit albedo
@@ -133,7 +134,7 @@ NetworkSolution solve_network(const ParticleField& field, const std::vector<Ligh
           e = point ? point->intensity / (nearest * nearest) : Rgb(0.0);
           a.to_light = Vec3(0.0);
         }
-        e *= glm::exp(-material.sigma_t * field.density_integral(x, a.to_light, a.distance));
+        e *= glm::exp(-material.sigma_t * out.light_maps[l].depth(x));
         out.direct[l * n + p] = e, out.to_light[l * n + p] = a.to_light;
         if (e == Rgb(0.0)) continue;
         for (size_t i = 0; i < d; ++i) cosines[i] = static_cast<float>(-glm::dot(a.to_light, dirs[static_cast<int>(i)]));

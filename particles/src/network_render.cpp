@@ -56,9 +56,10 @@ struct Along {
 // The formal solution along the ray through the particles' Gaussians, in steps of at most a
 // quarter of the narrowest active width: each step's optical depth per particle is exact (erf
 // differences), and the step's source is the particles' scattered radiance weighted by their
-// share of that depth (the SPH interpolation of the source). Returns the radiance; leaves the
-// transmittance through all of it.
-Rgb march(std::vector<Along>& along, const Rgb& sigma_t, const std::vector<Rgb>& scattered, Rgb& transmittance) {
+// share of that depth (the SPH interpolation of the source), plus `direct(t)`, the single-scattered
+// direct light at the step's middle. Returns the radiance; leaves the transmittance through all of it.
+template <class Direct>
+Rgb march(std::vector<Along>& along, const Rgb& sigma_t, const std::vector<Rgb>& scattered, const Direct& direct, Rgb& transmittance) {
   Rgb radiance(0.0);
   if (along.empty()) return radiance;
   std::sort(along.begin(), along.end(), [](const Along& a, const Along& b) { return a.enter() < b.enter(); });
@@ -86,6 +87,7 @@ Rgb march(std::vector<Along>& along, const Rgb& sigma_t, const std::vector<Rgb>&
       source += dtau * scattered[static_cast<size_t>(g.index)];
     }
     if (tau > 0.0) {
+      source += tau * direct(0.5 * (t + t1));
       const Rgb step_transmittance = glm::exp(-sigma_t * tau);
       radiance += transmittance * (Rgb(1.0) - step_transmittance) * source / tau;
       transmittance *= step_transmittance;
@@ -108,7 +110,7 @@ Image render_network(const Scene& scene, const ParticleField& field, const Netwo
     else delta.push_back(&l);
   }
   const size_t n = field.size();
-  if (n > 0 && (solution.visibility.particles != static_cast<int>(n) || solution.direct.size() != delta.size() * n))
+  if (n > 0 && (solution.visibility.particles != static_cast<int>(n) || solution.light_maps.size() != delta.size()))
     throw Error("solution", "one for other particles or lights", "the network solved for these particles and lights");
   // Each particle's scattered radiance toward the eye (seed 001 section 3.3, last paragraphs):
   // albedo times the network's in-scattering at the eye's direction (the phase-matrix row extended
@@ -123,14 +125,26 @@ Image render_network(const Scene& scene, const ParticleField& field, const Netwo
       Rgb j(0.0);
       for (int c = 0; c < 3; ++c)
         for (size_t i = 0; i < d; ++i) j[c] += row(static_cast<long>(i)) * static_cast<double>(solution.incoming[static_cast<size_t>(c)][i * n + p]);
-      for (size_t l = 0; l < delta.size(); ++l) {
-        const Vec3& to_light = solution.to_light[l * n + p];
-        const double phase = to_light == Vec3(0.0) ? 1.0 / (4.0 * kPi) : material.phase.eval(glm::dot(-to_light, w));
-        j += phase * solution.direct[l * n + p];
-      }
       scattered[p] = material.albedo * j;
     }
   });
+  // Single-scattered direct light at any point, from the lights' depth maps, with the exact phase
+  // function toward the eye; within a quarter of the mean particle width of a point light, the
+  // irradiance there.
+  double nearest = 0.0;
+  for (double h : field.diameters()) nearest += h;
+  nearest = n ? 0.25 * nearest / static_cast<double>(n) : 0.0;
+  const auto direct = [&](const Vec3& x, const Vec3& w) {
+    Rgb s(0.0);
+    for (size_t l = 0; l < delta.size(); ++l) {
+      LightArrival a;
+      if (!arrival(*delta[l], x, a)) continue;
+      Rgb e = a.irradiance;
+      if (std::isfinite(a.distance) && a.distance < nearest) e *= (a.distance / nearest) * (a.distance / nearest);
+      s += material.phase.eval(glm::dot(-a.to_light, w)) * e * glm::exp(-material.sigma_t * solution.light_maps[l].depth(x));
+    }
+    return material.albedo * s;
+  };
 
   // Particles binned to 16 x 16 tiles by their footprints (march() orders each ray's).
   const int tiles_x = (cam.width_px + kTile - 1) / kTile, tiles_y = (cam.height_px + kTile - 1) / kTile;
@@ -164,7 +178,8 @@ Image render_network(const Scene& scene, const ParticleField& field, const Netwo
             along.push_back({tc, h, field.weight(p) * std::exp(-perp2 / (h * h)) * std::sqrt(kPi) * h, index});
           }
           Rgb transmittance(1.0);
-          const Rgb radiance = march(along, material.sigma_t, scattered, transmittance);
+          const Rgb radiance = march(
+              along, material.sigma_t, scattered, [&](double t) { return direct(ray.origin + t * ray.direction, -ray.direction); }, transmittance);
           image.set(x, y, radiance + transmittance * background);
         }
       progress.advance();

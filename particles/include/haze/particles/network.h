@@ -16,6 +16,7 @@
 #include <haze/core/method.h>
 #include <haze/core/phase_matrix.h>
 #include <haze/particles/field.h>
+#include <haze/particles/light_depth.h>
 
 #include <memory>
 #include <vector>
@@ -58,10 +59,11 @@ struct NetworkSolution {
   std::array<std::vector<float>, 3> incoming;  // I per channel, [i * particles + p]
   std::vector<Rgb> direct;                // [l * particles + p]: light l's irradiance at p after extinction
   std::vector<Vec3> to_light;             // [l * particles + p]
+  std::vector<LightDepthMap> light_maps;  // per delta light l, in the scene's order (sky lights skipped)
   int iterations = 0;
   bool converged = false;
   std::vector<double> changes;
-  double build_seconds = 0.0, direct_seconds = 0.0, iterate_seconds = 0.0;
+  double build_seconds = 0.0, direct_seconds = 0.0, iterate_seconds = 0.0;  // direct: the light maps and E
 };
 
 // Emission is not modelled. `warm` (same particles and directions) starts from its I.

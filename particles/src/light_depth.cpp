@@ -1,0 +1,220 @@
+// Deep shadow maps of the particles' continuous density (light_depth.h).
+#include <haze/core/error.h>
+#include <haze/core/progress.h>
+#include <haze/particles/light_depth.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace haze::particles {
+
+namespace {
+
+constexpr double kCut = 3.0;               // as field.h: each Gaussian ends at 3 h
+constexpr double kMaxValues = 16e6;        // floats per map (64 MB): texels are widened beyond it
+
+void frame(const Vec3& w, Vec3& t1, Vec3& t2) {
+  t1 = glm::normalize(glm::cross(w, std::abs(w.x) < 0.9 ? Vec3(1, 0, 0) : Vec3(0, 1, 0)));
+  t2 = glm::cross(w, t1);
+}
+
+}  // namespace
+
+LightDepthMap::LightDepthMap(const ParticleField& field, const Light& light, int threads) {
+  if (std::holds_alternative<SkyLight>(light)) throw Error("light", "sky", "a point, spot or directional light for a depth map");
+  // The sphere holding every particle's support.
+  const Vec3 centre = field.centre();
+  double mean_h = 0.0, max_h = 0.0;
+  for (double h : field.diameters()) mean_h += h, max_h = std::max(max_h, h);
+  mean_h = field.size() ? mean_h / static_cast<double>(field.size()) : 1.0;
+  const double radius = std::max(field.radius() + kCut * max_h, 1e-9);
+  double spacing = 0.5 * mean_h;
+  int face_count = 1;
+  double width = 2.0 * radius;  // the window's width where texels are `spacing` wide
+  if (const auto* d = std::get_if<DirectionalLight>(&light)) {
+    directional_ = true;
+    origin_ = centre, extent_ = radius;
+    faces_.resize(1);
+    faces_[0].axis = glm::normalize(d->direction);
+    s0_ = 0.0;
+  } else {
+    origin_ = std::holds_alternative<PointLight>(light) ? std::get<PointLight>(light).position : std::get<SpotLight>(light).position;
+    const double distance = glm::length(centre - origin_);
+    if (distance > 1.01 * radius) {  // outside: one face looking at the support
+      faces_.resize(1);
+      faces_[0].axis = (centre - origin_) / distance;
+      extent_ = radius / std::sqrt(distance * distance - radius * radius);
+      width = 2.0 * distance * extent_;
+      s0_ = distance - radius;
+    } else {  // inside: a cube map
+      face_count = 6;
+      faces_.resize(6);
+      for (int a = 0; a < 3; ++a)
+        for (int sign = 0; sign < 2; ++sign) {
+          Vec3 axis(0.0);
+          axis[a] = sign ? -1.0 : 1.0;
+          faces_[static_cast<size_t>(2 * a + sign)].axis = axis;
+        }
+      extent_ = 1.0;
+      width = 2.0 * radius;
+      s0_ = 0.0;
+    }
+  }
+  const double depth_range = directional_ || face_count == 1 ? 2.0 * radius : glm::length(centre - origin_) + radius;
+  for (;;) {
+    resolution_ = std::clamp(static_cast<int>(std::ceil(width / spacing)), 2, 1024);
+    nodes_ = std::clamp(static_cast<int>(std::ceil(depth_range / spacing)) + 1, 2, 4096);
+    if (static_cast<double>(resolution_) * resolution_ * nodes_ * face_count <= kMaxValues) break;
+    spacing *= 1.25;
+  }
+  ds_ = depth_range / (nodes_ - 1);
+  for (Face& f : faces_) {
+    frame(f.axis, f.t1, f.t2);
+    f.depth.assign(static_cast<size_t>(resolution_) * static_cast<size_t>(resolution_) * static_cast<size_t>(nodes_), 0.0f);
+    if (field.size()) splat(f, field, threads);
+  }
+}
+
+size_t LightDepthMap::bytes() const {
+  size_t b = 0;
+  for (const Face& f : faces_) b += f.depth.size() * sizeof(float);
+  return b;
+}
+
+void LightDepthMap::texel_ray(const Face& f, int i, int j, Vec3& o, Vec3& d) const {
+  const double a = ((i + 0.5) / resolution_ * 2.0 - 1.0) * extent_, b = ((j + 0.5) / resolution_ * 2.0 - 1.0) * extent_;
+  if (directional_) {
+    o = origin_ + a * f.t1 + b * f.t2 - extent_ * f.axis;
+    d = f.axis;
+  } else {
+    o = origin_;
+    d = glm::normalize(f.axis + a * f.t1 + b * f.t2);
+  }
+}
+
+int LightDepthMap::locate(const Vec3& x, double& u, double& v, double& s) const {
+  const Vec3 local = x - origin_;
+  int face = 0;
+  if (faces_.size() == 6) {
+    const Vec3 m = glm::abs(local);
+    const int a = m.x >= m.y && m.x >= m.z ? 0 : (m.y >= m.z ? 1 : 2);
+    face = 2 * a + (local[a] < 0.0 ? 1 : 0);
+  }
+  const Face& f = faces_[static_cast<size_t>(face)];
+  double a, b;
+  if (directional_) {
+    a = glm::dot(local, f.t1), b = glm::dot(local, f.t2);
+    s = glm::dot(local, f.axis) + extent_;
+  } else {
+    const double z = glm::dot(local, f.axis);
+    if (!(z > 0.0)) return -1;
+    a = glm::dot(local, f.t1) / z, b = glm::dot(local, f.t2) / z;
+    s = glm::length(local);
+  }
+  u = (a / extent_ + 1.0) * 0.5 * resolution_ - 0.5;
+  v = (b / extent_ + 1.0) * 0.5 * resolution_ - 0.5;
+  return face;
+}
+
+double LightDepthMap::depth(const Vec3& x) const {
+  double u, v, s;
+  const int face = locate(x, u, v, s);
+  if (face < 0 || !(u > -1.0 && u < resolution_ && v > -1.0 && v < resolution_)) return 0.0;
+  const double k = (s - s0_) / ds_;
+  if (!(k > 0.0)) return 0.0;
+  const auto& depth = faces_[static_cast<size_t>(face)].depth;
+  const int m = resolution_;
+  const double uc = std::clamp(u, 0.0, m - 1.0), vc = std::clamp(v, 0.0, m - 1.0), kc = std::min(k, nodes_ - 1.0);
+  const int i = std::min(static_cast<int>(uc), m - 2), j = std::min(static_cast<int>(vc), m - 2), n = std::min(static_cast<int>(kc), nodes_ - 2);
+  const double fu = uc - i, fv = vc - j, fk = kc - n;
+  double sum = 0.0;
+  for (int dj = 0; dj < 2; ++dj)
+    for (int di = 0; di < 2; ++di) {
+      const size_t at = (static_cast<size_t>(j + dj) * static_cast<size_t>(m) + static_cast<size_t>(i + di)) * static_cast<size_t>(nodes_) + static_cast<size_t>(n);
+      const double along = (1.0 - fk) * static_cast<double>(depth[at]) + fk * static_cast<double>(depth[at + 1]);
+      sum += (di ? fu : 1.0 - fu) * (dj ? fv : 1.0 - fv) * along;
+    }
+  return sum;
+}
+
+// Each particle adds, to every texel ray passing within 3 h of it, the integral of its Gaussian
+// from the ray's origin to each depth node: A (erf((s_k - t) / h) + erf(t / h)) with t the
+// particle's depth along the ray and A = w_p exp(-perp^2 / h^2) h sqrt(pi) / 2. Nodes past t + 3 h
+// take the whole A (1 + erf(t / h)) through a running sum. Threaded over bands of texel rows.
+void LightDepthMap::splat(Face& f, const ParticleField& field, int threads) {
+  const int m = resolution_;
+  const auto k_count = static_cast<size_t>(nodes_);
+  std::vector<float> tail(f.depth.size(), 0.0f);
+  // Each particle's footprint in texels, [i0, i1] x [j0, j1]; i0 > i1 when it misses the face.
+  struct Footprint {
+    int i0, i1, j0, j1;
+  };
+  std::vector<Footprint> footprint(field.size());
+  for (size_t p = 0; p < field.size(); ++p) {
+    const Vec3 x = field.position(p);
+    const double reach = kCut * field.h(p);
+    Footprint& fp = footprint[p];
+    fp = {0, m - 1, 0, m - 1};
+    const Vec3 local = x - origin_;
+    if (directional_) {
+      const double texel = 2.0 * extent_ / m;
+      const double a = glm::dot(local, f.t1), b = glm::dot(local, f.t2);
+      fp = {static_cast<int>(std::floor((a - reach + extent_) / texel - 0.5)), static_cast<int>(std::ceil((a + reach + extent_) / texel - 0.5)),
+            static_cast<int>(std::floor((b - reach + extent_) / texel - 0.5)), static_cast<int>(std::ceil((b + reach + extent_) / texel - 0.5))};
+    } else {
+      const double z = glm::dot(local, f.axis);
+      if (z < -reach) {
+        fp = {1, 0, 1, 0};
+        continue;
+      }
+      if (z > reach) {  // the box around the sphere, projected: X / Z over its corners bounds the footprint
+        const double texel = 2.0 * extent_ / m;
+        const auto range = [&](double c, int& lo, int& hi) {
+          const double a0 = std::min((c - reach) / (z - reach), (c - reach) / (z + reach));
+          const double a1 = std::max((c + reach) / (z - reach), (c + reach) / (z + reach));
+          lo = static_cast<int>(std::floor((a0 + extent_) / texel - 0.5)), hi = static_cast<int>(std::ceil((a1 + extent_) / texel - 0.5));
+        };
+        range(glm::dot(local, f.t1), fp.i0, fp.i1);
+        range(glm::dot(local, f.t2), fp.j0, fp.j1);
+      }
+    }
+    fp.i0 = std::max(fp.i0, 0), fp.i1 = std::min(fp.i1, m - 1), fp.j0 = std::max(fp.j0, 0), fp.j1 = std::min(fp.j1, m - 1);
+  }
+  const double sqrt_pi = std::sqrt(kPi);
+  parallel_for(m, threads, 2, [&](long long r0, long long r1) {
+    for (size_t p = 0; p < field.size(); ++p) {
+      const Footprint& fp = footprint[p];
+      if (fp.i0 > fp.i1 || fp.j1 < r0 || fp.j0 >= r1) continue;
+      const Vec3 x = field.position(p);
+      const double h = field.h(p), w = field.weight(p);
+      for (int j = std::max(fp.j0, static_cast<int>(r0)); j <= std::min(fp.j1, static_cast<int>(r1) - 1); ++j)
+        for (int i = fp.i0; i <= fp.i1; ++i) {
+          Vec3 o, d;
+          texel_ray(f, i, j, o, d);
+          const Vec3 to = x - o;
+          const double t = glm::dot(to, d), perp2 = glm::dot(to, to) - t * t;
+          if (perp2 >= kCut * kCut * h * h || t < -kCut * h) continue;
+          const double amplitude = w * std::exp(-perp2 / (h * h)) * h * 0.5 * sqrt_pi, before = std::erf(t / h);
+          const size_t base = (static_cast<size_t>(j) * static_cast<size_t>(m) + static_cast<size_t>(i)) * k_count;
+          // nodes with s_k in [t - 3h, t + 3h]
+          const auto k0 = static_cast<long long>(std::max(0.0, std::ceil((t - kCut * h - s0_) / ds_)));
+          const auto k1 = std::min(static_cast<long long>(k_count) - 1, static_cast<long long>(std::floor((t + kCut * h - s0_) / ds_)));
+          for (long long k = k0; k <= k1; ++k)
+            f.depth[base + static_cast<size_t>(k)] += static_cast<float>(amplitude * (std::erf((s0_ + static_cast<double>(k) * ds_ - t) / h) + before));
+          const long long after = std::max(k0, k1 + 1);
+          if (after < static_cast<long long>(k_count)) tail[base + static_cast<size_t>(after)] += static_cast<float>(amplitude * (1.0 + before));
+        }
+    }
+  });
+  parallel_for(static_cast<long long>(m) * m, threads, 64, [&](long long t0, long long t1) {
+    for (auto t = static_cast<size_t>(t0); t < static_cast<size_t>(t1); ++t) {
+      float run = 0.0f;
+      for (size_t k = 0; k < k_count; ++k) {
+        run += tail[t * k_count + k];
+        f.depth[t * k_count + k] += run;
+      }
+    }
+  });
+}
+
+}  // namespace haze::particles
