@@ -1,8 +1,8 @@
 // Error and cost of method "network" (seed 001) for docs/NETWORKS.md, against the reference path
 // tracer on the particles' continuous density:
 // - examples/particle_cloud.json at the defaults, single scattering alone and in full;
-// - a procedural cloud (three overlapping balls) drawn with N particles, N from 500 to 30000, at the
-//   default D; and the example as D varies.
+// - the example as D and the separable terms N vary;
+// - a procedural cloud (three overlapping balls) drawn with 500 to 30000 particles, at the defaults.
 // Writes network_error.csv into the directory given (default .) and prints markdown tables.
 // Not a Google Benchmark: it measures error, and the time each setting costs on this machine.
 // Run: build/release/bench/haze_network_accuracy build/network
@@ -39,18 +39,18 @@ Reference reference(const Scene& scene, long long spp, int max_scattering = -1) 
 }
 
 void row(std::FILE* csv, const char* scene_name, const Scene& scene, const Reference& ref, const char* varied, int directions,
-         int iterations) {
+         int iterations, int terms = 0) {
   RenderOptions options;
-  options.settings = {{"directions", directions}, {"iterations", iterations}};
+  options.settings = {{"directions", directions}, {"iterations", iterations}, {"terms", terms}};
   const auto start = std::chrono::steady_clock::now();
   const RenderResult network = render(scene, "network", options);
   const double seconds = seconds_since(start);
   const LitPixelError e = lit_pixel_error(network.radiance, ref.result.radiance, &*ref.result.std_error);
   const auto particles = network.stats["particles"].get<long long>();
-  std::printf("| %s | %s | %lld | %d | %s | %.1f%% | %.1f%% | %+.1f%% | %.1f%% | %.3f |\n", scene_name, varied, particles, directions,
-              iterations == 0 ? "single" : "full", 100 * e.mean_abs, 100 * e.rms_noise_removed, 100 * e.signed_mean, 100 * e.noise_rms,
+  std::printf("| %s | %s | %lld | %d | %d | %s | %.1f%% | %.1f%% | %+.1f%% | %.1f%% | %.3f |\n", scene_name, varied, particles, directions,
+              network.stats["terms"].get<int>(), iterations == 0 ? "single" : "full", 100 * e.mean_abs, 100 * e.rms_noise_removed, 100 * e.signed_mean, 100 * e.noise_rms,
               seconds);
-  std::fprintf(csv, "%s,%s,%lld,%d,%d,%g,%g,%g,%g,%g\n", scene_name, varied, particles, directions, iterations, e.mean_abs,
+  std::fprintf(csv, "%s,%s,%lld,%d,%d,%d,%g,%g,%g,%g,%g\n", scene_name, varied, particles, directions, network.stats["terms"].get<int>(), iterations, e.mean_abs,
                e.rms_noise_removed, e.signed_mean, e.noise_rms, seconds);
   std::fflush(stdout);
 }
@@ -85,7 +85,7 @@ int main(int argc, char** argv) {
   std::filesystem::create_directories(dir);
   std::FILE* csv = std::fopen((dir / "network_error.csv").c_str(), "w");
   if (!csv) return 1;
-  std::fprintf(csv, "scene,varied,particles,directions,iterations,mean_abs,rms_corrected,signed,reference_noise,seconds\n");
+  std::fprintf(csv, "scene,varied,particles,directions,terms,iterations,mean_abs,rms_corrected,signed,reference_noise,seconds\n");
 
   Scene example = Scene::load(std::filesystem::path(HAZE_SOURCE_DIR) / "examples" / "particle_cloud.json");
   const Reference single = reference(example, spp, 1), full = reference(example, spp);
@@ -94,11 +94,13 @@ int main(int argc, char** argv) {
               "the signed mean, and the reference's own mean relative standard error. Seconds: the network's whole render\n"
               "on 2 threads.\n\n",
               spp, full.seconds);
-  std::printf("| scene | varied | particles | D | scattering | mean abs | rms, noise removed | signed | reference noise | seconds |\n"
-              "|---|---|---|---|---|---|---|---|---|---|\n");
+  std::printf("| scene | varied | particles | D | N | scattering | mean abs | rms, noise removed | signed | reference noise | seconds |\n"
+              "|---|---|---|---|---|---|---|---|---|---|---|\n");
   row(csv, "example", example, single, "defaults", 128, 0);
   row(csv, "example", example, full, "defaults", 128, 200);
   for (int d : {32, 64, 256, 512}) row(csv, "example", example, full, "directions", d, 200);
+  row(csv, "example", example, full, "terms", 128, 200, 128);  // the full phase matrix
+  row(csv, "example", example, full, "terms", 128, 200, 4);
   for (int count : {500, 1000, 3000, 10000, 30000}) {
     const Scene balls = three_balls(example, count);
     const Reference r = reference(balls, spp);

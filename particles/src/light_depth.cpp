@@ -3,6 +3,8 @@
 #include <haze/core/progress.h>
 #include <haze/particles/light_depth.h>
 
+#include "erf_table.h"
+
 #include <algorithm>
 #include <cmath>
 
@@ -181,6 +183,7 @@ void LightDepthMap::splat(Face& f, const ParticleField& field, int threads) {
     fp.i0 = std::max(fp.i0, 0), fp.i1 = std::min(fp.i1, m - 1), fp.j0 = std::max(fp.j0, 0), fp.j1 = std::min(fp.j1, m - 1);
   }
   const double sqrt_pi = std::sqrt(kPi);
+  const ErfTable& erf = ErfTable::instance();
   parallel_for(m, threads, 2, [&](long long r0, long long r1) {
     for (size_t p = 0; p < field.size(); ++p) {
       const Footprint& fp = footprint[p];
@@ -194,13 +197,13 @@ void LightDepthMap::splat(Face& f, const ParticleField& field, int threads) {
           const Vec3 to = x - o;
           const double t = glm::dot(to, d), perp2 = glm::dot(to, to) - t * t;
           if (perp2 >= kCut * kCut * h * h || t < -kCut * h) continue;
-          const double amplitude = w * std::exp(-perp2 / (h * h)) * h * 0.5 * sqrt_pi, before = std::erf(t / h);
+          const double amplitude = w * std::exp(-perp2 / (h * h)) * h * 0.5 * sqrt_pi, before = erf(t / h);
           const size_t base = (static_cast<size_t>(j) * static_cast<size_t>(m) + static_cast<size_t>(i)) * k_count;
           // nodes with s_k in [t - 3h, t + 3h]
           const auto k0 = static_cast<long long>(std::max(0.0, std::ceil((t - kCut * h - s0_) / ds_)));
           const auto k1 = std::min(static_cast<long long>(k_count) - 1, static_cast<long long>(std::floor((t + kCut * h - s0_) / ds_)));
           for (long long k = k0; k <= k1; ++k)
-            f.depth[base + static_cast<size_t>(k)] += static_cast<float>(amplitude * (std::erf((s0_ + static_cast<double>(k) * ds_ - t) / h) + before));
+            f.depth[base + static_cast<size_t>(k)] += static_cast<float>(amplitude * (erf((s0_ + static_cast<double>(k) * ds_ - t) / h) + before));
           const long long after = std::max(k0, k1 + 1);
           if (after < static_cast<long long>(k_count)) tail[base + static_cast<size_t>(after)] += static_cast<float>(amplitude * (1.0 + before));
         }

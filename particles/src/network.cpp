@@ -10,6 +10,7 @@
 #include <chrono>
 #include <cmath>
 #include <numeric>
+#include <type_traits>
 
 namespace haze::particles {
 
@@ -117,8 +118,18 @@ NetworkSolution solve_network(const ParticleField& field, const std::vector<Ligh
   for (const Light* l : delta) out.light_maps.emplace_back(field, *l, settings.threads);
   out.direct.assign(delta.size() * n, Rgb(0.0));
   out.to_light.assign(delta.size() * n, Vec3(0.0));
-  std::array<std::vector<float>, 3> source;  // S[c][i * n + p]: direct light scattered into w_i, per unit albedo
-  for (auto& s : source) s.assign(n * d, 0.0f);
+  const auto grey = [](const Rgb& c) { return c.r == c.g && c.g == c.b; };
+  bool all_grey = grey(material.sigma_t) && grey(material.albedo) && grey(sky);
+  for (const Light* l : delta)
+    std::visit([&](const auto& light) {
+      using T = std::decay_t<decltype(light)>;
+      if constexpr (std::is_same_v<T, DirectionalLight>) all_grey = all_grey && grey(light.irradiance);
+      else if constexpr (!std::is_same_v<T, SkyLight>) all_grey = all_grey && grey(light.intensity);
+    }, *l);
+  out.channels = all_grey ? 1 : 3;
+  const auto channels = static_cast<size_t>(out.channels);
+  auto& source = out.source;  // S[c][i * n + p]: direct light scattered into w_i, per unit albedo
+  for (size_t c = 0; c < channels; ++c) source[c].assign(n * d, 0.0f);
   parallel_for(static_cast<long long>(n), settings.threads, 16, [&](long long p0, long long p1) {
     std::vector<float> cosines(d), phase(d);
     for (auto p = static_cast<size_t>(p0); p < static_cast<size_t>(p1); ++p) {
@@ -134,80 +145,134 @@ NetworkSolution solve_network(const ParticleField& field, const std::vector<Ligh
           e = point ? point->intensity / (nearest * nearest) : Rgb(0.0);
           a.to_light = Vec3(0.0);
         }
-        e *= glm::exp(-material.sigma_t * out.light_maps[l].depth(x));
+        // The particle's share of the light: E averaged over its Gaussian (2-point Gauss-Hermite
+        // per axis, nodes x +- h / sqrt(2)), not E at its centre, which misses the light its
+        // fringe gets near lit edges.
+        Rgb mean(0.0);
+        for (int corner = 0; corner < 8; ++corner) {
+          const Vec3 offset((corner & 1) ? 1.0 : -1.0, (corner & 2) ? 1.0 : -1.0, (corner & 4) ? 1.0 : -1.0);
+          const Vec3 y = x + field.h(p) * std::sqrt(0.5) * offset;
+          LightArrival at_y;
+          if (!arrival(*delta[l], y, at_y)) continue;
+          const double r = std::max(at_y.distance, nearest);
+          const Rgb unattenuated = std::isfinite(at_y.distance) && at_y.distance > 0.0 ? at_y.irradiance * (at_y.distance / r) * (at_y.distance / r) : at_y.irradiance;
+          mean += 0.125 * unattenuated * glm::exp(-material.sigma_t * out.light_maps[l].depth(y));
+        }
+        e = a.distance > 0.0 ? mean : e * glm::exp(-material.sigma_t * out.light_maps[l].depth(x));
         out.direct[l * n + p] = e, out.to_light[l * n + p] = a.to_light;
         if (e == Rgb(0.0)) continue;
         for (size_t i = 0; i < d; ++i) cosines[i] = static_cast<float>(-glm::dot(a.to_light, dirs[static_cast<int>(i)]));
         simd::eval_phase(material.phase, cosines.data(), phase.data(), d);
         double sum = 0.0;
         for (size_t i = 0; i < d; ++i) sum += static_cast<double>(phase[i]) * dirs.weight(static_cast<int>(i));
-        for (int c = 0; c < 3; ++c) {
-          const auto scale = static_cast<float>(e[c] / sum);  // quadrature over directions gives back E exactly
-          for (size_t i = 0; i < d; ++i) source[static_cast<size_t>(c)][i * n + p] += scale * phase[i];
+        for (size_t c = 0; c < channels; ++c) {
+          const auto scale = static_cast<float>(e[static_cast<int>(c)] / sum);  // quadrature over directions gives back E exactly
+          for (size_t i = 0; i < d; ++i) source[c][i * n + p] += scale * phase[i];
         }
       }
     }
   });
   out.direct_seconds = seconds_since(start);
 
-  // Iteration (section 3.3, with DESIGN.md's normalization): for p and direction i with upstream
-  // v, over the gap's transmittance T = exp(-sigma_t depth),
-  //   I[p, i] = T I[v, i] + (1 - T) albedo (J[v, i] + J[p, i]) / 2,   J[q, i] = sum_d P[i][d] I[q, d] + S[q, i],
-  // the formal solution over the gap with its in-scattered radiance averaged from both ends; I = sky
-  // where no particle is upstream. Columns run in upstream order (Gauss-Seidel along each column).
+  // The iteration's state: each gap's transmittance, the in-scattering product, a warm start.
   start = std::chrono::steady_clock::now();
-  using Matrix = Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic>;
-  const Matrix pt = out.matrix->matrix().transpose().cast<float>();
-  const bool warm_fits = warm && warm->visibility.particles == static_cast<int>(n) && warm->directions && warm->directions->size() == dirs.size();
-  std::array<std::vector<float>, 3> transmittance;
-  for (int c = 0; c < 3; ++c) {
-    auto& t = transmittance[static_cast<size_t>(c)];
-    t.resize(n * d);
-    for (size_t e = 0; e < n * d; ++e) t[e] = static_cast<float>(std::exp(-material.sigma_t[c] * static_cast<double>(out.visibility.depth[e])));
-    out.incoming[static_cast<size_t>(c)] = warm_fits ? warm->incoming[static_cast<size_t>(c)] : std::vector<float>(n * d, 0.0f);
+  out.albedo = material.albedo, out.sky = sky;
+  const int keep = settings.terms > 0 ? std::min(settings.terms, static_cast<int>(d)) : [&] {
+    const Eigen::VectorXd all = SeparablePhase(*out.matrix, 1).all_eigenvalues();
+    int k = 0;
+    while (k < all.size() && std::abs(all[k]) >= 0.01 * std::abs(all[0])) ++k;
+    return 4 * k > static_cast<int>(d) ? static_cast<int>(d) : std::max(k, 1);
+  }();
+  out.terms = keep;
+  if (keep >= static_cast<int>(d)) {
+    out.scatter_a = out.matrix->matrix().transpose().cast<float>();
+  } else {
+    const SeparablePhase separable(*out.matrix, keep);
+    out.scatter_a = separable.basis().cast<float>();
+    out.scatter_b = (separable.eigenvalues().asDiagonal() * separable.basis().transpose()).cast<float>();
   }
-  std::vector<float> j(n * d), previous;
-  const VisibilityNetwork& v = out.visibility;
-  while (n > 0 && out.iterations < settings.max_iterations) {
-    double diff = 0.0, ref = 0.0;
-    for (int c = 0; c < 3; ++c) {
-      std::vector<float>& in = out.incoming[static_cast<size_t>(c)];
-      previous = in;
-      Eigen::Map<Matrix>(j.data(), static_cast<long>(n), static_cast<long>(d)).noalias() =
-          Eigen::Map<const Matrix>(in.data(), static_cast<long>(n), static_cast<long>(d)) * pt;
-      const std::vector<float>& s = source[static_cast<size_t>(c)];
-      const std::vector<float>& t = transmittance[static_cast<size_t>(c)];
-      const auto albedo = static_cast<float>(material.albedo[c]), sky_c = static_cast<float>(sky[c]);
-      parallel_for(static_cast<long long>(d), settings.threads, 1, [&](long long i0, long long i1) {
-        for (auto i = static_cast<size_t>(i0); i < static_cast<size_t>(i1); ++i) {
-          const size_t base = i * n;
-          for (size_t k = 0; k < n; ++k) {
-            const auto p = static_cast<size_t>(v.order[base + k]);
-            const int up = v.upstream[base + p];
-            if (up < 0) {
-              in[base + p] = sky_c;
-              continue;
-            }
-            const size_t q = base + static_cast<size_t>(up);
-            const float tp = t[base + p];
-            in[base + p] = tp * in[q] + (1.0f - tp) * albedo * 0.5f * (j[q] + s[q] + j[base + p] + s[base + p]);
-          }
+  const bool warm_fits = warm && warm->visibility.particles == static_cast<int>(n) && warm->directions && warm->directions->size() == dirs.size();
+  for (size_t c = 0; c < channels; ++c) {
+    auto& t = out.transmittance[c];
+    t.resize(n * d);
+    const double sigma = material.sigma_t[static_cast<int>(c)];
+    parallel_for(static_cast<long long>(d), settings.threads, 1, [&](long long i0, long long i1) {
+      for (auto i = static_cast<size_t>(i0); i < static_cast<size_t>(i1); ++i)
+        for (size_t k = 0; k < n; ++k) {
+          const size_t at = i * n + static_cast<size_t>(out.visibility.order[i * n + k]);
+          t[i * n + k] = out.visibility.upstream[at] < 0 ? -1.0f : static_cast<float>(std::exp(-sigma * static_cast<double>(out.visibility.depth[at])));
         }
-      });
-      for (size_t e = 0; e < n * d; ++e) {
-        const double a = in[e], b = a - static_cast<double>(previous[e]);
-        diff += b * b, ref += a * a;
-      }
-    }
+    });
+    out.incoming[c] = warm_fits ? warm->incoming[c] : std::vector<float>(n * d, 0.0f);
+  }
+  while (n > 0 && out.iterations < settings.max_iterations) {
+    out.changes.push_back(iterate_network(out, settings.threads));
     ++out.iterations;
-    out.changes.push_back(ref > 0.0 ? std::sqrt(diff / ref) : 0.0);
     if (settings.progress && !settings.progress(std::min(1.0, out.iterations / static_cast<double>(settings.max_iterations))))
       throw Cancelled();
     if (out.changes.back() < settings.tolerance) break;
   }
+  for (size_t c = channels; c < 3; ++c) out.incoming[c] = out.incoming[0];
   out.converged = n == 0 || (!out.changes.empty() && out.changes.back() < settings.tolerance);
   out.iterate_seconds = seconds_since(start);
   return out;
+}
+
+// Iteration (section 3.3, with DESIGN.md's normalization): for p and direction i with upstream
+// v, over the gap's transmittance T = exp(-sigma_t depth),
+//   I[p, i] = T I[v, i] + (1 - T) albedo (J[v, i] + J[p, i]) / 2,   J[q, i] = sum_d P[i][d] I[q, d] + S[q, i],
+// the formal solution over the gap with its in-scattered radiance averaged from both ends; I = sky
+// where no particle is upstream. Columns run in upstream order (Gauss-Seidel along each column).
+double iterate_network(NetworkSolution& s, int threads) {
+  using Matrix = Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic>;
+  using Block = Eigen::Map<Matrix, 0, Eigen::OuterStride<>>;
+  const VisibilityNetwork& v = s.visibility;
+  const auto n = static_cast<size_t>(v.particles), d = static_cast<size_t>(v.directions);
+  std::vector<float> j(n * d);
+  std::vector<double> diff(d), ref(d);
+  double diff_sum = 0.0, ref_sum = 0.0;
+  for (size_t c = 0; c < static_cast<size_t>(s.channels); ++c) {
+    std::vector<float>& in = s.incoming[c];
+    const std::vector<float>& source = s.source[c];
+    const std::vector<float>& t = s.transmittance[c];
+    // J = S + I A (B), threaded over blocks of particles (the rows of I and J).
+    parallel_for(static_cast<long long>(n), threads, 256, [&](long long p0, long long p1) {
+      const auto rows = static_cast<long>(p1 - p0);
+      const Eigen::OuterStride<> stride(static_cast<long>(n));
+      Block out(j.data() + p0, rows, static_cast<long>(d), stride);
+      out = Block(const_cast<float*>(source.data()) + p0, rows, static_cast<long>(d), stride);
+      const Block i_block(in.data() + p0, rows, static_cast<long>(d), stride);
+      if (s.scatter_b.size() == 0) out.noalias() += i_block * s.scatter_a;
+      else out.noalias() += (i_block * s.scatter_a) * s.scatter_b;
+    });
+    const auto albedo = static_cast<float>(s.albedo[static_cast<int>(c)]), sky = static_cast<float>(s.sky[static_cast<int>(c)]);
+    // In sweep order a particle's upstream one is the previous particle of its column (the
+    // transmittance is stored in that order, -1 where a column starts), so I and J of the upstream
+    // particle are the values just handled.
+    parallel_for(static_cast<long long>(d), threads, 1, [&](long long i0, long long i1) {
+      for (auto i = static_cast<size_t>(i0); i < static_cast<size_t>(i1); ++i) {
+        const size_t base = i * n;
+        const int* order = v.order.data() + base;
+        const float* tk = t.data() + base;
+        float* in_i = in.data() + base;
+        const float* j_i = j.data() + base;
+        double change = 0.0, total = 0.0;
+        float up_in = 0.0f, up_j = 0.0f;
+        for (size_t k = 0; k < n; ++k) {
+          const auto p = static_cast<size_t>(order[k]);
+          const float jp = j_i[p], tp = tk[k];
+          const float value = tp < 0.0f ? sky : tp * up_in + (1.0f - tp) * albedo * 0.5f * (up_j + jp);
+          const float delta = value - in_i[p];
+          change += static_cast<double>(delta * delta), total += static_cast<double>(value * value);
+          in_i[p] = value;
+          up_in = value, up_j = jp;
+        }
+        diff[i] = change, ref[i] = total;
+      }
+    });
+    for (size_t i = 0; i < d; ++i) diff_sum += diff[i], ref_sum += ref[i];
+  }
+  return ref_sum > 0.0 ? std::sqrt(diff_sum / ref_sum) : 0.0;
 }
 
 }  // namespace haze::particles

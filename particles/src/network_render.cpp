@@ -2,6 +2,8 @@
 #include <haze/core/error.h>
 #include <haze/particles/network.h>
 
+#include "erf_table.h"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -54,7 +56,7 @@ struct Along {
 };
 
 // The formal solution along the ray through the particles' Gaussians, in steps of at most a
-// quarter of the narrowest active width: each step's optical depth per particle is exact (erf
+// half of the narrowest active width: each step's optical depth per particle is exact (erf
 // differences), and the step's source is the particles' scattered radiance weighted by their
 // share of that depth (the SPH interpolation of the source), plus `direct(t)`, the single-scattered
 // direct light at the step's middle. Returns the radiance; leaves the transmittance through all of it.
@@ -63,6 +65,7 @@ Rgb march(std::vector<Along>& along, const Rgb& sigma_t, const std::vector<Rgb>&
   Rgb radiance(0.0);
   if (along.empty()) return radiance;
   std::sort(along.begin(), along.end(), [](const Along& a, const Along& b) { return a.enter() < b.enter(); });
+  const ErfTable& erf = ErfTable::instance();
   std::vector<double> erf_at(along.size());  // erf((t - centre) / h) at the current t, per entered particle
   std::vector<size_t> active;
   double t = std::max(0.0, along[0].enter());
@@ -70,18 +73,18 @@ Rgb march(std::vector<Along>& along, const Rgb& sigma_t, const std::vector<Rgb>&
   while (next < along.size() || !active.empty()) {
     if (active.empty()) t = std::max(t, along[next].enter());
     while (next < along.size() && along[next].enter() <= t) {
-      erf_at[next] = std::erf((t - along[next].centre) / along[next].h);
+      erf_at[next] = erf((t - along[next].centre) / along[next].h);
       active.push_back(next++);
     }
     double step = kInfinity;
-    for (size_t a : active) step = std::min(step, 0.25 * along[a].h);
+    for (size_t a : active) step = std::min(step, 0.5 * along[a].h);
     double t1 = t + step;
     if (next < along.size()) t1 = std::min(t1, std::max(t + 1e-9, along[next].enter()));
     double tau = 0.0;
     Rgb source(0.0);
     for (size_t a : active) {
       const Along& g = along[a];
-      const double e1 = std::erf((t1 - g.centre) / g.h), dtau = 0.5 * g.amplitude * (e1 - erf_at[a]);
+      const double e1 = erf((t1 - g.centre) / g.h), dtau = 0.5 * g.amplitude * (e1 - erf_at[a]);
       erf_at[a] = e1;
       tau += dtau;
       source += dtau * scattered[static_cast<size_t>(g.index)];
@@ -200,6 +203,7 @@ class NetworkMethod final : public Method {
     network.window = static_cast<int>(settings.integer("window", 0, 0, 65536));
     network.max_iterations = static_cast<int>(settings.integer("iterations", network.max_iterations, 0, 100000));
     network.tolerance = settings.number("tolerance", network.tolerance, 1e-9, 1.0);
+    network.terms = static_cast<int>(settings.integer("terms", 0, 0, network.directions));
     const int neighbours = static_cast<int>(settings.integer("neighbours", 8, 1, 64));
     network.threads = options.threads;
     settings.reject_unknown();
@@ -218,6 +222,8 @@ class NetworkMethod final : public Method {
     result.stats = {{"particles", field.size()},
                     {"directions", network.directions},
                     {"window", solution.visibility.window},
+                    {"terms", solution.terms},
+                    {"channels", solution.channels},
                     {"iterations", solution.iterations},
                     {"converged", solution.converged},
                     {"final_change", solution.changes.empty() ? 0.0 : solution.changes.back()},

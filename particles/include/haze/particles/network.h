@@ -46,6 +46,10 @@ struct NetworkSettings {
   int directions = 128;   // D, spherical Fibonacci
   int window = 0;         // M; 0: default_window
   int max_iterations = 200;  // 0: single scattering only
+  // In-scattering through the phase matrix's N largest eigenpairs (core's SeparablePhase, seed 000
+  // eq. 8) in O(D N) per particle: 0 keeps those of |lambda| >= 0.01 (16 for HG g = 0.3) and uses
+  // the full O(D^2) matrix when that would be more than D / 4; N = D is the full matrix.
+  int terms = 0;
   double tolerance = 1e-3;  // relative L2 change of I between iterations
   int threads = 0;
   ProgressCallback progress;
@@ -56,10 +60,20 @@ struct NetworkSolution {
   std::shared_ptr<const PhaseMatrix> matrix;
   VisibilityNetwork visibility;
   std::vector<float> rho;                 // the continuous density at each particle
-  std::array<std::vector<float>, 3> incoming;  // I per channel, [i * particles + p]
+  // 1 when the medium and every light are grey (one solve serves all three), else 3.
+  int channels = 3;
+  std::array<std::vector<float>, 3> incoming;  // I per channel, [i * particles + p] (all three filled)
   std::vector<Rgb> direct;                // [l * particles + p]: light l's irradiance at p after extinction
   std::vector<Vec3> to_light;             // [l * particles + p]
   std::vector<LightDepthMap> light_maps;  // per delta light l, in the scene's order (sky lights skipped)
+  // The iteration's state (iterate_network): S, the direct light scattered into each direction per
+  // unit albedo, and each gap's transmittance in sweep order ([i * particles + k] for the k-th
+  // particle of visibility.order, -1 where no particle is upstream), per solved channel; the product
+  // J = I A (B): A = P^T, or A = Q and B = diag(lambda) Q^T with `terms` eigenpairs.
+  std::array<std::vector<float>, 3> source, transmittance;
+  Eigen::MatrixXf scatter_a, scatter_b;
+  int terms = 0;                          // eigenpairs used, or D for the full matrix
+  Rgb albedo{0.0}, sky{0.0};
   int iterations = 0;
   bool converged = false;
   std::vector<double> changes;
@@ -69,6 +83,10 @@ struct NetworkSolution {
 // Emission is not modelled. `warm` (same particles and directions) starts from its I.
 NetworkSolution solve_network(const ParticleField& field, const std::vector<Light>& lights, const NetworkSettings& settings,
                               const NetworkSolution* warm = nullptr);
+// One iteration of the network (every direction swept once, threaded over directions; the
+// in-scattering product threaded over particles): updates solution.incoming for the solved
+// channels and returns the relative L2 change of I. solve_network calls it until converged.
+double iterate_network(NetworkSolution& solution, int threads);
 
 // Camera rays through the particles' splats, front to back: each particle scatters
 //   albedo (sum_d c_d(w) I[p, d] + sum_lights p(w_light . w) E_l)

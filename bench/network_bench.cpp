@@ -1,0 +1,118 @@
+// Method "network" (seed 001) on this machine, in the paper's setting scaled up: N particles
+// uniform in a ball (optical radius 4, albedo 0.9, HG g = 0.3) lit by a sun, D directions.
+// - Field: the kd-tree and the particle sizes from 8 nearest neighbours;
+// - Build: the visibility network (the density at each particle, projection, sort, links);
+// - LightMap: one light's depth map and the direct light at every particle;
+// - Iteration: one sweep of every direction (grey: one channel; coloured: three), with the
+//   separable phase (terms 0, automatic) or the full matrix (terms = D).
+// Run: build/release/bench/haze_bench_network --benchmark_repetitions=3 --benchmark_report_aggregates_only=true
+// Counters: grind, seconds per particle (Field, LightMap), per particle and direction (Build), per particle,
+// direction and channel (Iteration), printed with SI prefixes (n: nanoseconds).
+#include <haze/core/rng.h>
+#include <haze/particles/network.h>
+
+#include <benchmark/benchmark.h>
+
+namespace {
+
+using namespace haze;
+using namespace haze::particles;
+
+struct Cloud {
+  std::vector<Vec3f> positions;
+  ParticleView view;
+  explicit Cloud(long long count, bool grey = true) {
+    Rng rng(3);
+    while (static_cast<long long>(positions.size()) < count) {
+      const Vec3 x(2.0 * rng.uniform() - 1.0, 2.0 * rng.uniform() - 1.0, 2.0 * rng.uniform() - 1.0);
+      if (glm::dot(x, x) < 1.0) positions.emplace_back(x);
+    }
+    view.positions = positions;
+    view.material.sigma_t = grey ? Rgb(4.0) : Rgb(4.0, 4.4, 4.8);
+    view.material.albedo = Rgb(0.9);
+    view.material.phase = PhaseFunction::henyey_greenstein(0.3);
+  }
+};
+
+const std::vector<Light> kSun{DirectionalLight{glm::normalize(Vec3(-0.5, -0.7, -0.5)), Rgb(1.0)}};
+
+// Args: particles.
+void BM_Field(benchmark::State& state) {
+  const Cloud cloud(state.range(0));
+  for (auto _ : state) {
+    const ParticleField field(cloud.view);
+    benchmark::DoNotOptimize(field.h(0));
+  }
+  state.counters["grind"] = benchmark::Counter(static_cast<double>(state.range(0)), benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+}
+
+// Args: particles, directions.
+void BM_Build(benchmark::State& state) {
+  const Cloud cloud(state.range(0));
+  const ParticleField field(cloud.view);
+  const DirectionSet dirs = DirectionSet::fibonacci(static_cast<int>(state.range(1)));
+  const int window = default_window(field);
+  for (auto _ : state) {
+    const VisibilityNetwork v = build_visibility(field, field.density_at_particles(0), dirs, window, 0);
+    benchmark::DoNotOptimize(v.upstream.data());
+  }
+  state.counters["window"] = window;
+  state.counters["grind"] = benchmark::Counter(static_cast<double>(state.range(0) * state.range(1)),
+                                                  benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+}
+
+// Args: particles.
+void BM_LightMap(benchmark::State& state) {
+  const Cloud cloud(state.range(0));
+  const ParticleField field(cloud.view);
+  double texels = 0.0;
+  for (auto _ : state) {
+    const LightDepthMap map(field, kSun[0], 0);
+    double sum = 0.0;
+    for (size_t p = 0; p < field.size(); ++p) sum += map.depth(field.position(p));
+    benchmark::DoNotOptimize(sum);
+    texels = map.resolution();
+  }
+  state.counters["texels"] = texels;
+  state.counters["grind"] = benchmark::Counter(static_cast<double>(state.range(0)), benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+}
+
+// Args: particles, directions, terms (0: automatic; D: the full matrix), grey.
+void BM_Iteration(benchmark::State& state) {
+  const Cloud cloud(state.range(0), state.range(3) != 0);
+  const ParticleField field(cloud.view);
+  NetworkSettings settings;
+  settings.directions = static_cast<int>(state.range(1));
+  settings.terms = static_cast<int>(state.range(2));
+  settings.max_iterations = 2;  // start from a lit state
+  NetworkSolution s = solve_network(field, kSun, settings);
+  for (auto _ : state) benchmark::DoNotOptimize(iterate_network(s, 0));
+  state.counters["channels"] = s.channels;
+  state.counters["terms"] = s.terms;
+  state.counters["grind"] = benchmark::Counter(static_cast<double>(state.range(0) * state.range(1) * s.channels),
+                                                  benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+}
+
+}  // namespace
+
+BENCHMARK(BM_Field)->Arg(1024)->Arg(10000)->Arg(100000)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_Build)
+    ->Args({1024, 128})
+    ->Args({1024, 32})
+    ->Args({1024, 512})
+    ->Args({10000, 128})
+    ->Args({100000, 128})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK(BM_LightMap)->Arg(1024)->Arg(10000)->Arg(100000)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_Iteration)
+    ->Args({1024, 128, 0, 1})
+    ->Args({1024, 128, 128, 1})
+    ->Args({1024, 128, 0, 0})
+    ->Args({1024, 32, 0, 1})
+    ->Args({1024, 512, 0, 1})
+    ->Args({10000, 128, 0, 1})
+    ->Args({100000, 128, 0, 1})
+    ->Args({100000, 128, 0, 0})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
