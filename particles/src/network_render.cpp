@@ -115,9 +115,9 @@ Image render_network(const Scene& scene, const ParticleField& field, const Netwo
   const size_t n = field.size();
   if (n > 0 && (solution.visibility.particles != static_cast<int>(n) || solution.light_maps.size() != delta.size()))
     throw Error("solution", "one for other particles or lights", "the network solved for these particles and lights");
-  // Each particle's scattered radiance toward the eye (seed 001 section 3.3, last paragraphs):
-  // albedo times the network's in-scattering at the eye's direction (the phase-matrix row extended
-  // off the direction set, PhaseMatrix::row) plus direct light with the exact phase function.
+  // Each particle's multiply scattered radiance toward the eye (seed 001 section 3.3, last
+  // paragraphs): albedo times the network's in-scattering at the eye's direction (the phase-matrix
+  // row extended off the direction set, PhaseMatrix::row). Direct light is added per ray step.
   const auto d = static_cast<size_t>(solution.directions->size());
   std::vector<Rgb> scattered(n);
   parallel_for(static_cast<long long>(n), options.threads, 64, [&](long long p0, long long p1) {

@@ -7,7 +7,8 @@
 // taken from the particles' continuous density (field.h), so the network and the reference path
 // tracer solve the same medium; each iteration sweeps every direction's columns in upstream order
 // (light crosses the volume in one iteration, not one particle per iteration); direct light is
-// attenuated by the continuous density, not binary visibility; splats are exact line integrals of
+// attenuated by the continuous density (light_depth.h), not binary visibility, and evaluated along
+// camera rays, not only at particle centres; splats are exact line integrals of
 // each particle's Gaussian along each pixel's ray.
 #pragma once
 
@@ -88,10 +89,11 @@ NetworkSolution solve_network(const ParticleField& field, const std::vector<Ligh
 // channels and returns the relative L2 change of I. solve_network calls it until converged.
 double iterate_network(NetworkSolution& solution, int threads);
 
-// Camera rays through the particles' splats, front to back: each particle scatters
-//   albedo (sum_d c_d(w) I[p, d] + sum_lights p(w_light . w) E_l)
-// toward the eye, with opacity 1 - exp(-sigma_t tau), tau its Gaussian's integral along the ray;
-// then the background (plus any sky) through what is left. Surfaces are not drawn.
+// Camera rays through the particles' Gaussians, front to back: each particle scatters
+// albedo sum_d c_d(w) I[p, d] toward the eye in proportion to its Gaussian's optical depth along
+// the ray, and every step adds the single-scattered direct light at its middle from the depth maps
+// with the exact phase function; then the background (plus any sky) through what is left.
+// Surfaces are not drawn.
 Image render_network(const Scene& scene, const ParticleField& field, const NetworkSolution& solution, const RenderOptions& options = {});
 
 std::unique_ptr<Method> make_network_method();
