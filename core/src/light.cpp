@@ -1,8 +1,18 @@
 #include <haze/core/light.h>
 
 #include <algorithm>
+#include <type_traits>
 
 namespace haze {
+
+bool is_grey(const Light& light) {
+  return std::visit([](const auto& l) {
+    using T = std::decay_t<decltype(l)>;
+    if constexpr (std::is_same_v<T, DirectionalLight>) return is_grey(l.irradiance);
+    else if constexpr (std::is_same_v<T, SkyLight>) return is_grey(l.radiance);
+    else return is_grey(l.intensity);
+  }, light);
+}
 
 bool arrival(const Light& light, const Vec3& x, LightArrival& out) {
   if (auto* p = std::get_if<PointLight>(&light)) {

@@ -266,14 +266,7 @@ DomSolution solve_dom(const ExtinctionVolume& volume, const std::vector<Light>& 
       throw Error("depths[" + std::to_string(i) + "]", "a grid of another resolution", "the density's resolution");
 
   bool grey = is_grey(volume.sigma_t_scale) && is_grey(volume.albedo);
-  for (const Light& l : lights) {
-    std::visit([&](const auto& light) {
-      using T = std::decay_t<decltype(light)>;
-      if constexpr (std::is_same_v<T, DirectionalLight>) grey = grey && is_grey(light.irradiance);
-      else if constexpr (std::is_same_v<T, SkyLight>) grey = grey && is_grey(light.radiance);
-      else grey = grey && is_grey(light.intensity);
-    }, l);
-  }
+  for (const Light& l : lights) grey = grey && is_grey(l);
   const auto start = std::chrono::steady_clock::now();
   DomSolution out;
   out.channels = grey ? 1 : 3;

@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 
 namespace haze::particles {
 
@@ -40,6 +41,7 @@ ParticleField::ParticleField(const ParticleView& particles, int neighbours) : vi
   w_.resize(n);
   for (size_t p = 0; p < n; ++p) w_[p] = (particles.density.empty() ? 1.0 : static_cast<double>(particles.density[p])) / (6.0 * std::sqrt(kPi));
   h_max_ = *std::max_element(h_.begin(), h_.end());
+  h_mean_ = std::accumulate(h_.begin(), h_.end(), 0.0) / static_cast<double>(n);
   bounds_ = {box.lo - Vec3(kCut * h_max_), box.hi + Vec3(kCut * h_max_)};
 }
 

@@ -15,21 +15,14 @@ namespace {
 constexpr double kCut = 3.0;               // as field.h: each Gaussian ends at 3 h
 constexpr double kMaxValues = 16e6;        // floats per map (64 MB): texels are widened beyond it
 
-void frame(const Vec3& w, Vec3& t1, Vec3& t2) {
-  t1 = glm::normalize(glm::cross(w, std::abs(w.x) < 0.9 ? Vec3(1, 0, 0) : Vec3(0, 1, 0)));
-  t2 = glm::cross(w, t1);
-}
-
 }  // namespace
 
-LightDepthMap::LightDepthMap(const ParticleField& field, const Light& light, int threads) {
+LightDepthMap::LightDepthMap(const ParticleField& field, const Light& light, int threads) : light_(light) {
   if (std::holds_alternative<SkyLight>(light)) throw Error("light", "sky", "a point, spot or directional light for a depth map");
   // The sphere holding every particle's support.
   const Vec3 centre = field.centre();
-  double mean_h = 0.0, max_h = 0.0;
-  for (double h : field.diameters()) mean_h += h, max_h = std::max(max_h, h);
-  mean_h = field.size() ? mean_h / static_cast<double>(field.size()) : 1.0;
-  const double radius = std::max(field.radius() + kCut * max_h, 1e-9);
+  const double mean_h = field.size() ? field.mean_h() : 1.0;
+  const double radius = std::max(field.radius() + kCut * field.max_h(), 1e-9);
   double spacing = 0.5 * mean_h;
   int face_count = 1;
   double width = 2.0 * radius;  // the window's width where texels are `spacing` wide
@@ -71,7 +64,8 @@ LightDepthMap::LightDepthMap(const ParticleField& field, const Light& light, int
   }
   ds_ = depth_range / (nodes_ - 1);
   for (Face& f : faces_) {
-    frame(f.axis, f.t1, f.t2);
+    const Frame frame = Frame::from_z(f.axis);
+    f.t1 = frame.s, f.t2 = frame.t;
     f.depth.assign(static_cast<size_t>(resolution_) * static_cast<size_t>(resolution_) * static_cast<size_t>(nodes_), 0.0f);
     if (field.size()) splat(f, field, threads);
   }
@@ -137,6 +131,13 @@ double LightDepthMap::depth(const Vec3& x) const {
       sum += (di ? fu : 1.0 - fu) * (dj ? fv : 1.0 - fv) * along;
     }
   return sum;
+}
+
+bool LightDepthMap::arrival(const Vec3& x, const Rgb& sigma_t, double nearest, LightArrival& out) const {
+  if (!haze::arrival(light_, x, out)) return false;
+  if (std::isfinite(out.distance) && out.distance < nearest) out.irradiance *= (out.distance / nearest) * (out.distance / nearest);
+  out.irradiance *= glm::exp(-sigma_t * depth(x));
+  return true;
 }
 
 // Each particle adds, to every texel ray passing within 3 h of it, the integral of its Gaussian

@@ -10,7 +10,6 @@
 #include <chrono>
 #include <cmath>
 #include <numeric>
-#include <type_traits>
 
 namespace haze::particles {
 
@@ -20,20 +19,11 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
-// Two unit vectors perpendicular to w and to each other.
-void frame(const Vec3& w, Vec3& t1, Vec3& t2) {
-  t1 = glm::normalize(glm::cross(w, std::abs(w.x) < 0.9 ? Vec3(1, 0, 0) : Vec3(0, 1, 0)));
-  t2 = glm::cross(w, t1);
-}
-
 }  // namespace
 
 int default_window(const ParticleField& field) {
   if (field.size() == 0 || !(field.radius() > 0.0)) return 1;
-  double mean = 0.0;
-  for (double h : field.diameters()) mean += h;
-  mean /= static_cast<double>(field.size());
-  return std::clamp(static_cast<int>(std::lround(std::sqrt(static_cast<double>(field.size()) * mean / (2.0 * field.radius())))), 1, 4096);
+  return std::clamp(static_cast<int>(std::lround(std::sqrt(static_cast<double>(field.size()) * field.mean_h() / (2.0 * field.radius())))), 1, 4096);
 }
 
 VisibilityNetwork build_visibility(const ParticleField& field, const std::vector<float>& rho, const DirectionSet& directions, int window,
@@ -54,8 +44,8 @@ VisibilityNetwork build_visibility(const ParticleField& field, const std::vector
     std::vector<int> start(static_cast<size_t>(window) * static_cast<size_t>(window) + 1);
     for (auto i = static_cast<int>(i0); i < i1; ++i) {
       const Vec3 w = directions[i];
-      Vec3 t1, t2;
-      frame(w, t1, t2);
+      const Frame frame = Frame::from_z(w);
+      const Vec3 t1 = frame.s, t2 = frame.t;
       std::fill(start.begin(), start.end(), 0);
       for (int p = 0; p < n; ++p) {
         const Vec3 d = field.position(static_cast<size_t>(p)) - c;
@@ -116,17 +106,9 @@ NetworkSolution solve_network(const ParticleField& field, const std::vector<Ligh
     else delta.push_back(&l);
   }
   for (const Light* l : delta) out.light_maps.emplace_back(field, *l, settings.threads);
-  out.direct.assign(delta.size() * n, Rgb(0.0));
-  out.to_light.assign(delta.size() * n, Vec3(0.0));
-  const auto grey = [](const Rgb& c) { return c.r == c.g && c.g == c.b; };
-  bool all_grey = grey(material.sigma_t) && grey(material.albedo) && grey(sky);
-  for (const Light* l : delta)
-    std::visit([&](const auto& light) {
-      using T = std::decay_t<decltype(light)>;
-      if constexpr (std::is_same_v<T, DirectionalLight>) all_grey = all_grey && grey(light.irradiance);
-      else if constexpr (!std::is_same_v<T, SkyLight>) all_grey = all_grey && grey(light.intensity);
-    }, *l);
-  out.channels = all_grey ? 1 : 3;
+  const bool grey = is_grey(material.sigma_t) && is_grey(material.albedo) && is_grey(sky) &&
+                    std::all_of(delta.begin(), delta.end(), [](const Light* l) { return is_grey(*l); });
+  out.channels = grey ? 1 : 3;
   const auto channels = static_cast<size_t>(out.channels);
   auto& source = out.source;  // S[c][i * n + p]: direct light scattered into w_i, per unit albedo
   for (size_t c = 0; c < channels; ++c) source[c].assign(n * d, 0.0f);
@@ -136,30 +118,24 @@ NetworkSolution solve_network(const ParticleField& field, const std::vector<Ligh
       const Vec3 x = field.position(p);
       const double nearest = 0.25 * field.h(p);
       for (size_t l = 0; l < delta.size(); ++l) {
+        const LightDepthMap& map = out.light_maps[l];
         LightArrival a;
         if (!arrival(*delta[l], x, a)) continue;
-        Rgb e = a.irradiance;
-        if (std::isfinite(a.distance) && a.distance < nearest) e *= (a.distance / nearest) * (a.distance / nearest);
-        if (!(a.distance > 0.0)) {
+        Rgb e(0.0);
+        if (a.distance > 0.0) {
+          // The particle's share of the light: E averaged over its Gaussian (2-point Gauss-Hermite
+          // per axis, nodes x +- h / sqrt(2)), not E at its centre, which misses the light its
+          // fringe gets near lit edges.
+          for (int corner = 0; corner < 8; ++corner) {
+            const Vec3 offset((corner & 1) ? 1.0 : -1.0, (corner & 2) ? 1.0 : -1.0, (corner & 4) ? 1.0 : -1.0);
+            LightArrival at;
+            if (map.arrival(x + field.h(p) * std::sqrt(0.5) * offset, material.sigma_t, nearest, at)) e += 0.125 * at.irradiance;
+          }
+        } else {  // the light at the centre: no direction; a point light's irradiance at `nearest`
           const auto* point = std::get_if<PointLight>(delta[l]);
-          e = point ? point->intensity / (nearest * nearest) : Rgb(0.0);
+          e = point ? point->intensity / (nearest * nearest) * glm::exp(-material.sigma_t * map.depth(x)) : Rgb(0.0);
           a.to_light = Vec3(0.0);
         }
-        // The particle's share of the light: E averaged over its Gaussian (2-point Gauss-Hermite
-        // per axis, nodes x +- h / sqrt(2)), not E at its centre, which misses the light its
-        // fringe gets near lit edges.
-        Rgb mean(0.0);
-        for (int corner = 0; corner < 8; ++corner) {
-          const Vec3 offset((corner & 1) ? 1.0 : -1.0, (corner & 2) ? 1.0 : -1.0, (corner & 4) ? 1.0 : -1.0);
-          const Vec3 y = x + field.h(p) * std::sqrt(0.5) * offset;
-          LightArrival at_y;
-          if (!arrival(*delta[l], y, at_y)) continue;
-          const double r = std::max(at_y.distance, nearest);
-          const Rgb unattenuated = std::isfinite(at_y.distance) && at_y.distance > 0.0 ? at_y.irradiance * (at_y.distance / r) * (at_y.distance / r) : at_y.irradiance;
-          mean += 0.125 * unattenuated * glm::exp(-material.sigma_t * out.light_maps[l].depth(y));
-        }
-        e = a.distance > 0.0 ? mean : e * glm::exp(-material.sigma_t * out.light_maps[l].depth(x));
-        out.direct[l * n + p] = e, out.to_light[l * n + p] = a.to_light;
         if (e == Rgb(0.0)) continue;
         for (size_t i = 0; i < d; ++i) cosines[i] = static_cast<float>(-glm::dot(a.to_light, dirs[static_cast<int>(i)]));
         simd::eval_phase(material.phase, cosines.data(), phase.data(), d);
@@ -228,7 +204,8 @@ double iterate_network(NetworkSolution& s, int threads) {
   using Block = Eigen::Map<Matrix, 0, Eigen::OuterStride<>>;
   const VisibilityNetwork& v = s.visibility;
   const auto n = static_cast<size_t>(v.particles), d = static_cast<size_t>(v.directions);
-  std::vector<float> j(n * d);
+  std::vector<float>& j = s.inscattered;
+  j.resize(n * d);
   std::vector<double> diff(d), ref(d);
   double diff_sum = 0.0, ref_sum = 0.0;
   for (size_t c = 0; c < static_cast<size_t>(s.channels); ++c) {

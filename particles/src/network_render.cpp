@@ -107,13 +107,13 @@ Image render_network(const Scene& scene, const ParticleField& field, const Netwo
   const Camera& cam = scene.camera;
   const MaterialDesc& material = field.particles().material;
   Rgb background = scene.background;
-  std::vector<const Light*> delta;
+  size_t delta = 0;  // point, spot and directional lights
   for (const Light& l : scene.lights) {
     if (const auto* s = std::get_if<SkyLight>(&l)) background += s->radiance;
-    else delta.push_back(&l);
+    else ++delta;
   }
   const size_t n = field.size();
-  if (n > 0 && (solution.visibility.particles != static_cast<int>(n) || solution.light_maps.size() != delta.size()))
+  if (n > 0 && (solution.visibility.particles != static_cast<int>(n) || solution.light_maps.size() != delta))
     throw Error("solution", "one for other particles or lights", "the network solved for these particles and lights");
   // Each particle's multiply scattered radiance toward the eye (seed 001 section 3.3, last
   // paragraphs): albedo times the network's in-scattering at the eye's direction (the phase-matrix
@@ -134,17 +134,12 @@ Image render_network(const Scene& scene, const ParticleField& field, const Netwo
   // Single-scattered direct light at any point, from the lights' depth maps, with the exact phase
   // function toward the eye; within a quarter of the mean particle width of a point light, the
   // irradiance there.
-  double nearest = 0.0;
-  for (double h : field.diameters()) nearest += h;
-  nearest = n ? 0.25 * nearest / static_cast<double>(n) : 0.0;
+  const double nearest = n ? 0.25 * field.mean_h() : 0.0;
   const auto direct = [&](const Vec3& x, const Vec3& w) {
     Rgb s(0.0);
-    for (size_t l = 0; l < delta.size(); ++l) {
+    for (const LightDepthMap& map : solution.light_maps) {
       LightArrival a;
-      if (!arrival(*delta[l], x, a)) continue;
-      Rgb e = a.irradiance;
-      if (std::isfinite(a.distance) && a.distance < nearest) e *= (a.distance / nearest) * (a.distance / nearest);
-      s += material.phase.eval(glm::dot(-a.to_light, w)) * e * glm::exp(-material.sigma_t * solution.light_maps[l].depth(x));
+      if (map.arrival(x, material.sigma_t, nearest, a)) s += material.phase.eval(glm::dot(-a.to_light, w)) * a.irradiance;
     }
     return material.albedo * s;
   };

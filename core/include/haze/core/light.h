@@ -41,6 +41,9 @@ struct LightArrival {
   Rgb irradiance{0.0};     // on a plane perpendicular to to_light
 };
 
+// Whether the light's intensity, irradiance or radiance is the same in every channel.
+bool is_grey(const Light& light);
+
 // Delta lights only: a sky light has no single direction (returns false).
 bool arrival(const Light& light, const Vec3& x, LightArrival& out);
 

@@ -32,6 +32,8 @@ class ParticleField {
   double h(size_t p) const { return h_[p]; }          // the Gaussian's width, delta_s_p
   double weight(size_t p) const { return w_[p]; }     // its peak density w_p
   const std::vector<double>& diameters() const { return h_; }
+  double mean_h() const { return h_mean_; }
+  double max_h() const { return h_max_; }
   // The bounding sphere of the positions, and the box holding every particle's support.
   Vec3 centre() const { return centre_; }
   double radius() const { return radius_; }
@@ -50,7 +52,7 @@ class ParticleField {
  private:
   ParticleView view_;
   std::vector<double> h_, w_;
-  double h_max_ = 0.0;
+  double h_max_ = 0.0, h_mean_ = 0.0;
   Vec3 centre_{0.0};
   double radius_ = 0.0;
   Aabb bounds_;

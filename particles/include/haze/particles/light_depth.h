@@ -23,6 +23,9 @@ class LightDepthMap {
 
   // integral of rho from x toward the light (to its position, or to infinity for a directional one).
   double depth(const Vec3& x) const;
+  // core's arrival() at x with the irradiance attenuated by exp(-sigma_t depth(x)) and, within
+  // `nearest` of a point or spot light, held at its value at that distance.
+  bool arrival(const Vec3& x, const Rgb& sigma_t, double nearest, LightArrival& out) const;
 
   int resolution() const { return resolution_; }
   int nodes() const { return nodes_; }
@@ -33,6 +36,7 @@ class LightDepthMap {
     Vec3 axis, t1, t2;  // the face's central ray direction and the image-plane frame
     std::vector<float> depth;  // [(j * M + i) * K + k]
   };
+  Light light_;
   bool directional_ = false;
   Vec3 origin_{0.0};  // the light's position; for a directional light, the window's centre
   double extent_ = 0.0;   // directional: half the window's width; perspective: tan of the half-angle

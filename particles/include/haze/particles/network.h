@@ -64,8 +64,6 @@ struct NetworkSolution {
   // 1 when the medium and every light are grey (one solve serves all three), else 3.
   int channels = 3;
   std::array<std::vector<float>, 3> incoming;  // I per channel, [i * particles + p] (all three filled)
-  std::vector<Rgb> direct;                // [l * particles + p]: light l's irradiance at p after extinction
-  std::vector<Vec3> to_light;             // [l * particles + p]
   std::vector<LightDepthMap> light_maps;  // per delta light l, in the scene's order (sky lights skipped)
   // The iteration's state (iterate_network): S, the direct light scattered into each direction per
   // unit albedo, and each gap's transmittance in sweep order ([i * particles + k] for the k-th
@@ -73,6 +71,7 @@ struct NetworkSolution {
   // J = I A (B): A = P^T, or A = Q and B = diag(lambda) Q^T with `terms` eigenpairs.
   std::array<std::vector<float>, 3> source, transmittance;
   Eigen::MatrixXf scatter_a, scatter_b;
+  std::vector<float> inscattered;         // J of the last channel iterated: kept so iterations reuse the memory
   int terms = 0;                          // eigenpairs used, or D for the full matrix
   Rgb albedo{0.0}, sky{0.0};
   int iterations = 0;
