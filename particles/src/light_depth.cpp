@@ -153,17 +153,19 @@ void LightDepthMap::splat(Face& f, const ParticleField& field, int threads) {
     int i0, i1, j0, j1;
   };
   std::vector<Footprint> footprint(field.size());
+  const double texel = 2.0 * extent_ / m;  // in the face's image-plane units
+  const auto texels = [&](double a0, double a1, int& lo, int& hi) {
+    lo = static_cast<int>(std::floor((a0 + extent_) / texel - 0.5)), hi = static_cast<int>(std::ceil((a1 + extent_) / texel - 0.5));
+  };
   for (size_t p = 0; p < field.size(); ++p) {
-    const Vec3 x = field.position(p);
     const double reach = kCut * field.h(p);
     Footprint& fp = footprint[p];
     fp = {0, m - 1, 0, m - 1};
-    const Vec3 local = x - origin_;
+    const Vec3 local = field.position(p) - origin_;
     if (directional_) {
-      const double texel = 2.0 * extent_ / m;
       const double a = glm::dot(local, f.t1), b = glm::dot(local, f.t2);
-      fp = {static_cast<int>(std::floor((a - reach + extent_) / texel - 0.5)), static_cast<int>(std::ceil((a + reach + extent_) / texel - 0.5)),
-            static_cast<int>(std::floor((b - reach + extent_) / texel - 0.5)), static_cast<int>(std::ceil((b + reach + extent_) / texel - 0.5))};
+      texels(a - reach, a + reach, fp.i0, fp.i1);
+      texels(b - reach, b + reach, fp.j0, fp.j1);
     } else {
       const double z = glm::dot(local, f.axis);
       if (z < -reach) {
@@ -171,11 +173,8 @@ void LightDepthMap::splat(Face& f, const ParticleField& field, int threads) {
         continue;
       }
       if (z > reach) {  // the box around the sphere, projected: X / Z over its corners bounds the footprint
-        const double texel = 2.0 * extent_ / m;
         const auto range = [&](double c, int& lo, int& hi) {
-          const double a0 = std::min((c - reach) / (z - reach), (c - reach) / (z + reach));
-          const double a1 = std::max((c + reach) / (z - reach), (c + reach) / (z + reach));
-          lo = static_cast<int>(std::floor((a0 + extent_) / texel - 0.5)), hi = static_cast<int>(std::ceil((a1 + extent_) / texel - 0.5));
+          texels(std::min((c - reach) / (z - reach), (c - reach) / (z + reach)), std::max((c + reach) / (z - reach), (c + reach) / (z + reach)), lo, hi);
         };
         range(glm::dot(local, f.t1), fp.i0, fp.i1);
         range(glm::dot(local, f.t2), fp.j0, fp.j1);
