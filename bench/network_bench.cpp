@@ -51,12 +51,12 @@ void BM_Build(benchmark::State& state) {
   const Cloud cloud(state.range(0));
   const ParticleField field(cloud.view);
   const DirectionSet dirs = DirectionSet::fibonacci(static_cast<int>(state.range(1)));
-  const int window = default_window(field);
+  const NetworkWindow window = network_window(field, default_window(field));
   for (auto _ : state) {
     const VisibilityNetwork v = build_visibility(field, field.density_at_particles(0), dirs, window, 0);
     benchmark::DoNotOptimize(v.upstream.data());
   }
-  state.counters["window"] = window;
+  state.counters["window"] = window.size;
   state.counters["grind"] = benchmark::Counter(static_cast<double>(state.range(0) * state.range(1)),
                                                   benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
 }

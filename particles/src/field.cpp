@@ -64,6 +64,17 @@ double ParticleField::density(const Vec3& x) const {
   return rho;
 }
 
+std::vector<size_t> ParticleField::within(const Vec3& x, double radius) const {
+  if (!tree_) return {};
+  float q[3] = {static_cast<float>(x.x), static_cast<float>(x.y), static_cast<float>(x.z)};
+  std::vector<std::vector<size_t>> found;
+  std::vector<std::vector<float>> dist2;
+  flann::SearchParams params(flann::FLANN_CHECKS_UNLIMITED);
+  params.sorted = false;
+  tree_->index.radiusSearch(flann::Matrix<float>(q, 1, 3), found, dist2, static_cast<float>(radius * radius), params);
+  return std::move(found[0]);
+}
+
 std::vector<float> ParticleField::density_at_particles(int threads) const {
   std::vector<float> out(size());
   parallel_for(static_cast<long long>(size()), threads, 256, [&](long long p0, long long p1) {

@@ -63,12 +63,44 @@ LightDepthMap::LightDepthMap(const ParticleField& field, const Light& light, int
     spacing *= 1.25;
   }
   ds_ = depth_range / (nodes_ - 1);
+  centre_ = centre, radius_ = radius;
+  std::vector<Gaussian> gaussians(field.size());
+  for (size_t p = 0; p < field.size(); ++p) gaussians[p] = {field.position(p), field.h(p), field.weight(p)};
   for (Face& f : faces_) {
     const Frame frame = Frame::from_z(f.axis);
     f.t1 = frame.s, f.t2 = frame.t;
     f.depth.assign(static_cast<size_t>(resolution_) * static_cast<size_t>(resolution_) * static_cast<size_t>(nodes_), 0.0f);
-    if (field.size()) splat(f, field, threads);
+    splat(f, gaussians, true, threads);
   }
+}
+
+bool LightDepthMap::update(std::span<const Gaussian> before, std::span<const Gaussian> after, int threads) {
+  if (before.size() != after.size()) throw Error("after", to_text(after.size()) + " Gaussians", "one for each of the " + to_text(before.size()) + " before");
+  for (const Gaussian& g : after)
+    if (glm::length(g.x - centre_) + kCut * g.h > radius_) return false;
+  std::vector<Gaussian> change;
+  change.reserve(2 * before.size());
+  for (const Gaussian& g : before) change.push_back({g.x, g.h, -g.w});
+  change.insert(change.end(), after.begin(), after.end());
+  for (Face& f : faces_) {
+    f.touched.assign(static_cast<size_t>(resolution_) * static_cast<size_t>(resolution_), 0);
+    splat(f, change, false, threads);
+  }
+  return true;
+}
+
+bool LightDepthMap::touched(const Vec3& x) const {
+  double u, v, s;
+  const int face = locate(x, u, v, s);
+  if (face < 0 || !(u > -1.0 && u < resolution_ && v > -1.0 && v < resolution_)) return false;
+  const auto& touched = faces_[static_cast<size_t>(face)].touched;
+  if (touched.empty()) return false;
+  const int m = resolution_;
+  const int i = std::min(static_cast<int>(std::clamp(u, 0.0, m - 1.0)), m - 2), j = std::min(static_cast<int>(std::clamp(v, 0.0, m - 1.0)), m - 2);
+  for (int dj = 0; dj < 2; ++dj)
+    for (int di = 0; di < 2; ++di)
+      if (touched[static_cast<size_t>(j + dj) * static_cast<size_t>(m) + static_cast<size_t>(i + di)]) return true;
+  return false;
 }
 
 size_t LightDepthMap::bytes() const {
@@ -144,24 +176,24 @@ bool LightDepthMap::arrival(const Vec3& x, const Rgb& sigma_t, double nearest, L
 // from the ray's origin to each depth node: A (erf((s_k - t) / h) + erf(t / h)) with t the
 // particle's depth along the ray and A = w_p exp(-perp^2 / h^2) h sqrt(pi) / 2. Nodes past t + 3 h
 // take the whole A (1 + erf(t / h)) through a running sum. Threaded over bands of texel rows.
-void LightDepthMap::splat(Face& f, const ParticleField& field, int threads) {
+void LightDepthMap::splat(Face& f, std::span<const Gaussian> gaussians, bool running, int threads) {
   const int m = resolution_;
   const auto k_count = static_cast<size_t>(nodes_);
-  std::vector<float> tail(f.depth.size(), 0.0f);
+  std::vector<float> tail(running ? f.depth.size() : 0, 0.0f);
   // Each particle's footprint in texels, [i0, i1] x [j0, j1]; i0 > i1 when it misses the face.
   struct Footprint {
     int i0, i1, j0, j1;
   };
-  std::vector<Footprint> footprint(field.size());
+  std::vector<Footprint> footprint(gaussians.size());
   const double texel = 2.0 * extent_ / m;  // in the face's image-plane units
   const auto texels = [&](double a0, double a1, int& lo, int& hi) {
     lo = static_cast<int>(std::floor((a0 + extent_) / texel - 0.5)), hi = static_cast<int>(std::ceil((a1 + extent_) / texel - 0.5));
   };
-  for (size_t p = 0; p < field.size(); ++p) {
-    const double reach = kCut * field.h(p);
+  for (size_t p = 0; p < gaussians.size(); ++p) {
+    const double reach = kCut * gaussians[p].h;
     Footprint& fp = footprint[p];
     fp = {0, m - 1, 0, m - 1};
-    const Vec3 local = field.position(p) - origin_;
+    const Vec3 local = gaussians[p].x - origin_;
     if (directional_) {
       const double a = glm::dot(local, f.t1), b = glm::dot(local, f.t2);
       texels(a - reach, a + reach, fp.i0, fp.i1);
@@ -185,11 +217,10 @@ void LightDepthMap::splat(Face& f, const ParticleField& field, int threads) {
   const double sqrt_pi = std::sqrt(kPi);
   const ErfTable& erf = ErfTable::instance();
   parallel_for(m, threads, 2, [&](long long r0, long long r1) {
-    for (size_t p = 0; p < field.size(); ++p) {
+    for (size_t p = 0; p < gaussians.size(); ++p) {
       const Footprint& fp = footprint[p];
       if (fp.i0 > fp.i1 || fp.j1 < r0 || fp.j0 >= r1) continue;
-      const Vec3 x = field.position(p);
-      const double h = field.h(p), w = field.weight(p);
+      const auto [x, h, w] = gaussians[p];
       for (int j = std::max(fp.j0, static_cast<int>(r0)); j <= std::min(fp.j1, static_cast<int>(r1) - 1); ++j)
         for (int i = fp.i0; i <= fp.i1; ++i) {
           Vec3 o, d;
@@ -205,10 +236,17 @@ void LightDepthMap::splat(Face& f, const ParticleField& field, int threads) {
           for (long long k = k0; k <= k1; ++k)
             f.depth[base + static_cast<size_t>(k)] += static_cast<float>(amplitude * (erf((s0_ + static_cast<double>(k) * ds_ - t) / h) + before));
           const long long after = std::max(k0, k1 + 1);
-          if (after < static_cast<long long>(k_count)) tail[base + static_cast<size_t>(after)] += static_cast<float>(amplitude * (1.0 + before));
+          const auto whole = static_cast<float>(amplitude * (1.0 + before));
+          if (running) {
+            if (after < static_cast<long long>(k_count)) tail[base + static_cast<size_t>(after)] += whole;
+          } else {
+            for (auto k = static_cast<size_t>(after); k < k_count; ++k) f.depth[base + k] += whole;
+            f.touched[static_cast<size_t>(j) * static_cast<size_t>(m) + static_cast<size_t>(i)] = 1;
+          }
         }
     }
   });
+  if (!running) return;
   parallel_for(static_cast<long long>(m) * m, threads, 64, [&](long long t0, long long t1) {
     for (auto t = static_cast<size_t>(t0); t < static_cast<size_t>(t1); ++t) {
       float run = 0.0f;

@@ -4,6 +4,8 @@
 #include <haze/particles/network.h>
 #include <haze/simd/phase_batch.h>
 
+#include "network_internal.h"
+
 #include <Eigen/Core>
 
 #include <algorithm>
@@ -13,67 +15,184 @@
 
 namespace haze::particles {
 
-namespace {
+namespace network_internal {
 
-double seconds_since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+Projector::Projector(const NetworkWindow& window, const Vec3& direction) : c(window.centre), w(direction), r(window.radius), m(window.size) {
+  const Frame frame = Frame::from_z(w);
+  t1 = frame.s, t2 = frame.t;
 }
 
-}  // namespace
+int Projector::pixel(const Vec3& x) const {
+  const Vec3 d = x - c;
+  const int px = std::clamp(static_cast<int>((glm::dot(d, t1) + r) / (2.0 * r) * m), 0, m - 1);
+  const int py = std::clamp(static_cast<int>((glm::dot(d, t2) + r) / (2.0 * r) * m), 0, m - 1);
+  return py * m + px;
+}
+
+void link_column(std::vector<std::pair<double, int>>& members, int* out, int* upstream, float* depth, const std::vector<float>& rho) {
+  std::sort(members.begin(), members.end());
+  for (size_t k = 0; k < members.size(); ++k) {
+    const auto p = static_cast<size_t>(members[k].second);
+    out[k] = members[k].second;
+    if (k == 0) {
+      upstream[p] = -1, depth[p] = 0.0f;
+      continue;
+    }
+    const auto [up_depth, up] = members[k - 1];
+    upstream[p] = up;
+    depth[p] = static_cast<float>(0.5 * (static_cast<double>(rho[p]) + static_cast<double>(rho[static_cast<size_t>(up)])) * (members[k].first - up_depth));
+  }
+}
+
+std::array<Vec3, 8> gaussian_nodes(const Vec3& x, double h) {
+  std::array<Vec3, 8> nodes;
+  for (int corner = 0; corner < 8; ++corner)
+    nodes[static_cast<size_t>(corner)] = x + h * std::sqrt(0.5) * Vec3((corner & 1) ? 1.0 : -1.0, (corner & 2) ? 1.0 : -1.0, (corner & 4) ? 1.0 : -1.0);
+  return nodes;
+}
+
+std::vector<const Light*> delta_lights(const std::vector<Light>& lights, Rgb& sky) {
+  std::vector<const Light*> delta;
+  sky = Rgb(0.0);
+  for (const Light& l : lights) {
+    if (const auto* s = std::get_if<SkyLight>(&l)) sky += s->radiance;
+    else delta.push_back(&l);
+  }
+  return delta;
+}
+
+bool grey_scene(const MaterialDesc& material, const Rgb& sky, const std::vector<const Light*>& delta) {
+  return is_grey(material.sigma_t) && is_grey(material.albedo) && is_grey(sky) &&
+         std::all_of(delta.begin(), delta.end(), [](const Light* l) { return is_grey(*l); });
+}
+
+// Direct light at each particle, attenuated by the continuous density (a depth map per light);
+// a light inside a particle gives it the irradiance at a quarter of its diameter, no more.
+void direct_light(NetworkSolution& s, const ParticleField& field, const std::vector<const Light*>& delta, const std::vector<int>& particles,
+                  int threads) {
+  const MaterialDesc& material = field.particles().material;
+  const DirectionSet& dirs = *s.directions;
+  const auto n = field.size(), d = static_cast<size_t>(dirs.size()), channels = static_cast<size_t>(s.channels);
+  parallel_for(static_cast<long long>(particles.size()), threads, 16, [&](long long q0, long long q1) {
+    std::vector<float> cosines(d), phase(d);
+    for (auto q = static_cast<size_t>(q0); q < static_cast<size_t>(q1); ++q) {
+      const auto p = static_cast<size_t>(particles[q]);
+      for (size_t c = 0; c < channels; ++c)
+        for (size_t i = 0; i < d; ++i) s.source[c][i * n + p] = 0.0f;
+      const Vec3 x = field.position(p);
+      const double nearest = 0.25 * field.h(p);
+      for (size_t l = 0; l < delta.size(); ++l) {
+        const LightDepthMap& map = s.light_maps[l];
+        LightArrival a;
+        if (!arrival(*delta[l], x, a)) continue;
+        Rgb e(0.0);
+        if (a.distance > 0.0) {
+          // The particle's share of the light: E averaged over its Gaussian (2-point Gauss-Hermite
+          // per axis), not E at its centre, which misses the light its fringe gets near lit edges.
+          for (const Vec3& node : gaussian_nodes(x, field.h(p))) {
+            LightArrival at;
+            if (map.arrival(node, material.sigma_t, nearest, at)) e += 0.125 * at.irradiance;
+          }
+        } else {  // the light at the centre: no direction; a point light's irradiance at `nearest`
+          const auto* point = std::get_if<PointLight>(delta[l]);
+          e = point ? point->intensity / (nearest * nearest) * glm::exp(-material.sigma_t * map.depth(x)) : Rgb(0.0);
+          a.to_light = Vec3(0.0);
+        }
+        if (e == Rgb(0.0)) continue;
+        for (size_t i = 0; i < d; ++i) cosines[i] = static_cast<float>(-glm::dot(a.to_light, dirs[static_cast<int>(i)]));
+        simd::eval_phase(material.phase, cosines.data(), phase.data(), d);
+        double sum = 0.0;
+        for (size_t i = 0; i < d; ++i) sum += static_cast<double>(phase[i]) * dirs.weight(static_cast<int>(i));
+        for (size_t c = 0; c < channels; ++c) {
+          const auto scale = static_cast<float>(e[static_cast<int>(c)] / sum);  // quadrature over directions gives back E exactly
+          for (size_t i = 0; i < d; ++i) s.source[c][i * n + p] += scale * phase[i];
+        }
+      }
+    }
+  });
+}
+
+void all_transmittance(NetworkSolution& s, const MaterialDesc& material, int threads) {
+  const VisibilityNetwork& v = s.visibility;
+  const auto n = static_cast<size_t>(v.particles), d = static_cast<size_t>(v.directions);
+  for (size_t c = 0; c < static_cast<size_t>(s.channels); ++c) {
+    auto& t = s.transmittance[c];
+    t.resize(n * d);
+    const double sigma = material.sigma_t[static_cast<int>(c)];
+    parallel_for(static_cast<long long>(d), threads, 1, [&](long long i0, long long i1) {
+      for (auto i = static_cast<size_t>(i0); i < static_cast<size_t>(i1); ++i)
+        for (size_t k = 0; k < n; ++k) {
+          const size_t at = i * n + static_cast<size_t>(v.order[i * n + k]);
+          t[i * n + k] = gap_transmittance(sigma, v.upstream[at], v.depth[at]);
+        }
+    });
+  }
+}
+
+void iterate(NetworkSolution& s, const NetworkSettings& settings) {
+  s.iterations = 0, s.changes.clear();
+  while (s.visibility.particles > 0 && s.iterations < settings.max_iterations) {
+    s.changes.push_back(iterate_network(s, settings.threads));
+    ++s.iterations;
+    if (settings.progress && !settings.progress(std::min(1.0, s.iterations / static_cast<double>(settings.max_iterations)))) throw Cancelled();
+    if (s.changes.back() < settings.tolerance) break;
+  }
+  for (auto c = static_cast<size_t>(s.channels); c < 3; ++c) s.incoming[c] = s.incoming[0];
+  s.converged = s.visibility.particles == 0 || (!s.changes.empty() && s.changes.back() < settings.tolerance);
+}
+
+void remember(NetworkSolution& s, const ParticleField& field, const std::vector<const Light*>& delta) {
+  s.gaussians.resize(field.size());
+  for (size_t p = 0; p < field.size(); ++p) s.gaussians[p] = {field.position(p), field.h(p), field.weight(p)};
+  s.lights.clear();
+  for (const Light* l : delta) s.lights.push_back(*l);
+  s.sigma_t = field.particles().material.sigma_t;
+}
+
+}  // namespace network_internal
+
+using namespace network_internal;
 
 int default_window(const ParticleField& field) {
   if (field.size() == 0 || !(field.radius() > 0.0)) return 1;
   return std::clamp(static_cast<int>(std::lround(std::sqrt(static_cast<double>(field.size()) * field.mean_h() / (2.0 * field.radius())))), 1, 4096);
 }
 
-VisibilityNetwork build_visibility(const ParticleField& field, const std::vector<float>& rho, const DirectionSet& directions, int window,
-                                   int threads) {
-  if (window < 1 || window > 65536) throw Error("window", to_text(window), "a window resolution M in [1, 65536]");
+NetworkWindow network_window(const ParticleField& field, int size) {
+  if (size < 1 || size > 65536) throw Error("window", to_text(size), "a window resolution M in [1, 65536]");
+  // Slightly larger than the bounding sphere, so that every particle lands inside.
+  return {size, field.centre(), std::max(field.radius(), 1e-6 * std::max(1.0, glm::length(field.centre()))) * (1.0 + 1e-6)};
+}
+
+VisibilityNetwork build_visibility(const ParticleField& field, const std::vector<float>& rho, const DirectionSet& directions,
+                                   const NetworkWindow& window, int threads) {
+  if (window.size < 1 || window.size > 65536) throw Error("window", to_text(window.size), "a window resolution M in [1, 65536]");
   VisibilityNetwork v;
   const auto n = static_cast<int>(field.size());
+  const size_t pixels = static_cast<size_t>(window.size) * static_cast<size_t>(window.size);
   v.particles = n, v.directions = directions.size(), v.window = window;
   const size_t total = static_cast<size_t>(n) * static_cast<size_t>(directions.size());
   v.upstream.assign(total, -1), v.depth.assign(total, 0.0f), v.order.resize(total);
+  v.column_start.assign((pixels + 1) * static_cast<size_t>(directions.size()), 0);
   if (n == 0) return v;
-  // A window slightly larger than the bounding sphere, so that every particle lands inside.
-  const double r = std::max(field.radius(), 1e-6 * std::max(1.0, glm::length(field.centre()))) * (1.0 + 1e-6);
-  const Vec3 c = field.centre();
   parallel_for(directions.size(), threads, 1, [&](long long i0, long long i1) {
-    std::vector<int> key(static_cast<size_t>(n)), sorted(static_cast<size_t>(n));
-    std::vector<double> depth(static_cast<size_t>(n));
-    std::vector<int> start(static_cast<size_t>(window) * static_cast<size_t>(window) + 1);
+    std::vector<int> key(static_cast<size_t>(n));
+    std::vector<std::pair<double, int>> members;
     for (auto i = static_cast<int>(i0); i < i1; ++i) {
-      const Vec3 w = directions[i];
-      const Frame frame = Frame::from_z(w);
-      const Vec3 t1 = frame.s, t2 = frame.t;
-      std::fill(start.begin(), start.end(), 0);
-      for (int p = 0; p < n; ++p) {
-        const Vec3 d = field.position(static_cast<size_t>(p)) - c;
-        const int px = std::clamp(static_cast<int>((glm::dot(d, t1) + r) / (2.0 * r) * window), 0, window - 1);
-        const int py = std::clamp(static_cast<int>((glm::dot(d, t2) + r) / (2.0 * r) * window), 0, window - 1);
-        key[static_cast<size_t>(p)] = py * window + px;
-        depth[static_cast<size_t>(p)] = glm::dot(d, w);
-        ++start[static_cast<size_t>(key[static_cast<size_t>(p)]) + 1];
+      const Projector project(window, directions[i]);
+      int* start = v.column_start.data() + static_cast<size_t>(i) * (pixels + 1);
+      int* order = v.order.data() + static_cast<size_t>(i) * static_cast<size_t>(n);
+      const size_t base = static_cast<size_t>(i) * static_cast<size_t>(n);
+      for (int p = 0; p < n; ++p) ++start[(key[static_cast<size_t>(p)] = project.pixel(field.position(static_cast<size_t>(p)))) + 1];
+      // Counting sort by pixel, then each column by depth.
+      std::partial_sum(start, start + pixels + 1, start);
+      std::vector<int> fill(start, start + pixels);
+      for (int p = 0; p < n; ++p) order[fill[static_cast<size_t>(key[static_cast<size_t>(p)])]++] = p;
+      for (size_t b = 0; b < pixels; ++b) {
+        members.clear();
+        for (int k = start[b]; k < start[b + 1]; ++k) members.emplace_back(project.depth(field.position(static_cast<size_t>(order[k]))), order[k]);
+        link_column(members, order + start[b], v.upstream.data() + base, v.depth.data() + base, rho);
       }
-      // Counting sort by pixel, then by depth (ties by index) within each pixel.
-      std::partial_sum(start.begin(), start.end(), start.begin());
-      std::vector<int> fill(start.begin(), start.end() - 1);
-      for (int p = 0; p < n; ++p) sorted[static_cast<size_t>(fill[static_cast<size_t>(key[static_cast<size_t>(p)])]++)] = p;
-      for (size_t b = 0; b + 1 < start.size(); ++b) {
-        auto* first = sorted.data() + start[b];
-        auto* last = sorted.data() + start[b + 1];
-        std::sort(first, last, [&](int a, int q) {
-          return depth[static_cast<size_t>(a)] < depth[static_cast<size_t>(q)] || (depth[static_cast<size_t>(a)] == depth[static_cast<size_t>(q)] && a < q);
-        });
-        for (auto* e = first + 1; e < last; ++e) {
-          const auto p = static_cast<size_t>(*e), up = static_cast<size_t>(*(e - 1));
-          const size_t at = static_cast<size_t>(i) * static_cast<size_t>(n) + p;
-          v.upstream[at] = *(e - 1);
-          // The gap's density integral by the trapezoid rule on the continuous density.
-          v.depth[at] = static_cast<float>(0.5 * (static_cast<double>(rho[p]) + static_cast<double>(rho[up])) * (depth[p] - depth[up]));
-        }
-      }
-      std::copy(sorted.begin(), sorted.end(), v.order.begin() + static_cast<long>(i) * n);
     }
   });
   return v;
@@ -90,73 +209,29 @@ NetworkSolution solve_network(const ParticleField& field, const std::vector<Ligh
   auto start = std::chrono::steady_clock::now();
   out.directions = std::make_shared<DirectionSet>(DirectionSet::fibonacci(settings.directions));
   out.matrix = std::make_shared<PhaseMatrix>(material.phase, *out.directions);
-  const DirectionSet& dirs = *out.directions;
-  const auto n = static_cast<size_t>(field.size()), d = static_cast<size_t>(dirs.size());
+  const auto n = field.size(), d = static_cast<size_t>(out.directions->size());
   out.rho = field.density_at_particles(settings.threads);
-  out.visibility = build_visibility(field, out.rho, dirs, settings.window ? settings.window : default_window(field), settings.threads);
+  out.visibility = build_visibility(field, out.rho, *out.directions, network_window(field, settings.window ? settings.window : default_window(field)),
+                                    settings.threads);
   out.build_seconds = seconds_since(start);
 
-  // Direct light at every particle, attenuated by the continuous density (a depth map per light);
-  // a light inside a particle gives it the irradiance at a quarter of its diameter, no more.
   start = std::chrono::steady_clock::now();
-  std::vector<const Light*> delta;
-  Rgb sky(0.0);
-  for (const Light& l : lights) {
-    if (const auto* s = std::get_if<SkyLight>(&l)) sky += s->radiance;
-    else delta.push_back(&l);
-  }
+  const std::vector<const Light*> delta = delta_lights(lights, out.sky);
   for (const Light* l : delta) out.light_maps.emplace_back(field, *l, settings.threads);
-  const bool grey = is_grey(material.sigma_t) && is_grey(material.albedo) && is_grey(sky) &&
-                    std::all_of(delta.begin(), delta.end(), [](const Light* l) { return is_grey(*l); });
-  out.channels = grey ? 1 : 3;
-  const auto channels = static_cast<size_t>(out.channels);
-  auto& source = out.source;  // S[c][i * n + p]: direct light scattered into w_i, per unit albedo
-  for (size_t c = 0; c < channels; ++c) source[c].assign(n * d, 0.0f);
-  parallel_for(static_cast<long long>(n), settings.threads, 16, [&](long long p0, long long p1) {
-    std::vector<float> cosines(d), phase(d);
-    for (auto p = static_cast<size_t>(p0); p < static_cast<size_t>(p1); ++p) {
-      const Vec3 x = field.position(p);
-      const double nearest = 0.25 * field.h(p);
-      for (size_t l = 0; l < delta.size(); ++l) {
-        const LightDepthMap& map = out.light_maps[l];
-        LightArrival a;
-        if (!arrival(*delta[l], x, a)) continue;
-        Rgb e(0.0);
-        if (a.distance > 0.0) {
-          // The particle's share of the light: E averaged over its Gaussian (2-point Gauss-Hermite
-          // per axis, nodes x +- h / sqrt(2)), not E at its centre, which misses the light its
-          // fringe gets near lit edges.
-          for (int corner = 0; corner < 8; ++corner) {
-            const Vec3 offset((corner & 1) ? 1.0 : -1.0, (corner & 2) ? 1.0 : -1.0, (corner & 4) ? 1.0 : -1.0);
-            LightArrival at;
-            if (map.arrival(x + field.h(p) * std::sqrt(0.5) * offset, material.sigma_t, nearest, at)) e += 0.125 * at.irradiance;
-          }
-        } else {  // the light at the centre: no direction; a point light's irradiance at `nearest`
-          const auto* point = std::get_if<PointLight>(delta[l]);
-          e = point ? point->intensity / (nearest * nearest) * glm::exp(-material.sigma_t * map.depth(x)) : Rgb(0.0);
-          a.to_light = Vec3(0.0);
-        }
-        if (e == Rgb(0.0)) continue;
-        for (size_t i = 0; i < d; ++i) cosines[i] = static_cast<float>(-glm::dot(a.to_light, dirs[static_cast<int>(i)]));
-        simd::eval_phase(material.phase, cosines.data(), phase.data(), d);
-        double sum = 0.0;
-        for (size_t i = 0; i < d; ++i) sum += static_cast<double>(phase[i]) * dirs.weight(static_cast<int>(i));
-        for (size_t c = 0; c < channels; ++c) {
-          const auto scale = static_cast<float>(e[static_cast<int>(c)] / sum);  // quadrature over directions gives back E exactly
-          for (size_t i = 0; i < d; ++i) source[c][i * n + p] += scale * phase[i];
-        }
-      }
-    }
-  });
+  out.channels = grey_scene(material, out.sky, delta) ? 1 : 3;
+  for (size_t c = 0; c < static_cast<size_t>(out.channels); ++c) out.source[c].assign(n * d, 0.0f);
+  std::vector<int> all(n);
+  std::iota(all.begin(), all.end(), 0);
+  direct_light(out, field, delta, all, settings.threads);
   out.direct_seconds = seconds_since(start);
 
-  // The iteration's state: each gap's transmittance, the in-scattering product, a warm start.
+  // The iteration's state: the in-scattering product, each gap's transmittance, a warm start.
   start = std::chrono::steady_clock::now();
-  out.albedo = material.albedo, out.sky = sky;
+  out.albedo = material.albedo;
   const int keep = settings.terms > 0 ? std::min(settings.terms, static_cast<int>(d)) : [&] {
-    const Eigen::VectorXd all = SeparablePhase(*out.matrix, 1).all_eigenvalues();
+    const Eigen::VectorXd eigenvalues = SeparablePhase(*out.matrix, 1).all_eigenvalues();
     int k = 0;
-    while (k < all.size() && std::abs(all[k]) >= 0.01 * std::abs(all[0])) ++k;
+    while (k < eigenvalues.size() && std::abs(eigenvalues[k]) >= 0.01 * std::abs(eigenvalues[0])) ++k;
     return 4 * k > static_cast<int>(d) ? static_cast<int>(d) : std::max(k, 1);
   }();
   out.terms = keep;
@@ -167,30 +242,13 @@ NetworkSolution solve_network(const ParticleField& field, const std::vector<Ligh
     out.scatter_a = separable.basis().cast<float>();
     out.scatter_b = (separable.eigenvalues().asDiagonal() * separable.basis().transpose()).cast<float>();
   }
-  const bool warm_fits = warm && warm->visibility.particles == static_cast<int>(n) && warm->directions && warm->directions->size() == dirs.size();
-  for (size_t c = 0; c < channels; ++c) {
-    auto& t = out.transmittance[c];
-    t.resize(n * d);
-    const double sigma = material.sigma_t[static_cast<int>(c)];
-    parallel_for(static_cast<long long>(d), settings.threads, 1, [&](long long i0, long long i1) {
-      for (auto i = static_cast<size_t>(i0); i < static_cast<size_t>(i1); ++i)
-        for (size_t k = 0; k < n; ++k) {
-          const size_t at = i * n + static_cast<size_t>(out.visibility.order[i * n + k]);
-          t[i * n + k] = out.visibility.upstream[at] < 0 ? -1.0f : static_cast<float>(std::exp(-sigma * static_cast<double>(out.visibility.depth[at])));
-        }
-    });
-    out.incoming[c] = warm_fits ? warm->incoming[c] : std::vector<float>(n * d, 0.0f);
-  }
-  while (n > 0 && out.iterations < settings.max_iterations) {
-    out.changes.push_back(iterate_network(out, settings.threads));
-    ++out.iterations;
-    if (settings.progress && !settings.progress(std::min(1.0, out.iterations / static_cast<double>(settings.max_iterations))))
-      throw Cancelled();
-    if (out.changes.back() < settings.tolerance) break;
-  }
-  for (size_t c = channels; c < 3; ++c) out.incoming[c] = out.incoming[0];
-  out.converged = n == 0 || (!out.changes.empty() && out.changes.back() < settings.tolerance);
+  all_transmittance(out, material, settings.threads);
+  const bool warm_fits = warm && warm->visibility.particles == static_cast<int>(n) && warm->directions && warm->directions->size() == out.directions->size();
+  for (size_t c = 0; c < static_cast<size_t>(out.channels); ++c)
+    out.incoming[c] = warm_fits && !warm->incoming[c].empty() ? warm->incoming[c] : std::vector<float>(n * d, 0.0f);
+  iterate(out, settings);
   out.iterate_seconds = seconds_since(start);
+  remember(out, field, delta);
   return out;
 }
 

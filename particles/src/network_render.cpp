@@ -216,7 +216,7 @@ class NetworkMethod final : public Method {
     RenderResult result{render_network(scene, field, solution, render_options), std::nullopt, {}};
     result.stats = {{"particles", field.size()},
                     {"directions", network.directions},
-                    {"window", solution.visibility.window},
+                    {"window", solution.visibility.window.size},
                     {"terms", solution.terms},
                     {"channels", solution.channels},
                     {"iterations", solution.iterations},

@@ -13,6 +13,7 @@ namespace haze {
 struct PointLight {
   Vec3 position{0.0};
   Rgb intensity{1.0};  // W/sr per channel
+  bool operator==(const PointLight&) const = default;
 };
 
 struct SpotLight {
@@ -21,15 +22,18 @@ struct SpotLight {
   Rgb intensity{1.0};              // I0, on the axis
   double exponent = 1.0;           // n in cos^n(theta)
   double cone_deg = 45.0;          // half-angle of the cone, degrees
+  bool operator==(const SpotLight&) const = default;
 };
 
 struct DirectionalLight {
   Vec3 direction{0.0, 0.0, -1.0};  // unit propagation direction of the light
   Rgb irradiance{1.0};             // on a plane perpendicular to it
+  bool operator==(const DirectionalLight&) const = default;
 };
 
 struct SkyLight {
   Rgb radiance{1.0};
+  bool operator==(const SkyLight&) const = default;
 };
 
 using Light = std::variant<PointLight, SpotLight, DirectionalLight, SkyLight>;

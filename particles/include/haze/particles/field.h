@@ -40,6 +40,8 @@ class ParticleField {
   Aabb bounds() const { return bounds_; }
 
   double density(const Vec3& x) const;
+  // The particles within `radius` of x (a FLANN radius query), in no particular order.
+  std::vector<size_t> within(const Vec3& x, double radius) const;
   std::vector<float> density_at_particles(int threads) const;
   // integral of rho from x along the unit direction over length (may be infinite): exact for the
   // Gaussians (erf), summed over the particles whose support the segment meets.

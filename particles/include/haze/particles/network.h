@@ -20,28 +20,41 @@
 #include <haze/particles/light_depth.h>
 
 #include <memory>
+#include <string>
 #include <vector>
 
 namespace haze::particles {
 
+// The window particles are projected onto for each direction: M x M pixels over the sphere
+// (centre, radius), which holds every particle.
+struct NetworkWindow {
+  int size = 1;
+  Vec3 centre{0.0};
+  double radius = 0.0;
+};
+
 // V[p, i] over D directions: for direction i (propagation direction w_i), particles are projected
-// orthographically onto an M x M window over the bounding sphere, binned per pixel and sorted by
-// depth along w_i (the paper's depth peeling, on the CPU); each particle's upstream particle is the
-// previous one in its pixel's column. Built threaded over directions.
+// orthographically onto the window, binned per pixel and sorted by depth along w_i (the paper's
+// depth peeling, on the CPU); each particle's upstream particle is the previous one in its pixel's
+// column. Built threaded over directions.
 struct VisibilityNetwork {
-  int particles = 0, directions = 0, window = 0;
+  int particles = 0, directions = 0;
+  NetworkWindow window;
   std::vector<int> upstream;   // [i * particles + p]: the particle light comes from, or -1 (sky)
   std::vector<float> depth;    // [i * particles + p]: integral of rho over the gap from upstream to p
   std::vector<int> order;      // [i * particles + k]: particles of direction i in upstream-first order
+  std::vector<int> column_start;  // [i * (M^2 + 1) + c]: where pixel c's column starts in direction i's order
 };
 
 // M from the paper's rule (section 3.2) would leave most columns with one particle at a thousand
 // particles; Haze picks the window so that a column's mean gap is the mean particle diameter:
 // M = sqrt(N mean(delta_s) / (2 R)), at least 1.
 int default_window(const ParticleField& field);
+// An M x M window over the field's bounding sphere (M = size).
+NetworkWindow network_window(const ParticleField& field, int size);
 // rho: the continuous density at each particle (ParticleField::density_at_particles).
-VisibilityNetwork build_visibility(const ParticleField& field, const std::vector<float>& rho, const DirectionSet& directions, int window,
-                                   int threads);
+VisibilityNetwork build_visibility(const ParticleField& field, const std::vector<float>& rho, const DirectionSet& directions,
+                                   const NetworkWindow& window, int threads);
 
 struct NetworkSettings {
   int directions = 128;   // D, spherical Fibonacci
@@ -78,6 +91,21 @@ struct NetworkSolution {
   bool converged = false;
   std::vector<double> changes;
   double build_seconds = 0.0, direct_seconds = 0.0, iterate_seconds = 0.0;  // direct: the light maps and E
+  // What the networks were built for, so that update_network can tell what changed: each
+  // particle's Gaussian, the delta lights, the extinction.
+  std::vector<Gaussian> gaussians;
+  std::vector<Light> lights;
+  Rgb sigma_t{0.0};
+  // What the last update_network did.
+  struct Update {
+    bool rebuilt = false;   // everything built again; `reason` says why
+    std::string reason;
+    size_t changed = 0;     // Gaussians moved, resized or re-weighted
+    size_t density = 0;     // particles whose rho changed
+    size_t direct = 0;      // particles whose direct light was computed again
+    double columns = 0.0;   // fraction of the columns sorted again, over all directions
+    int maps = 0;           // light depth maps built again (the others were updated in place)
+  } update;
 };
 
 // Emission is not modelled. `warm` (same particles and directions) starts from its I.
@@ -87,6 +115,24 @@ NetworkSolution solve_network(const ParticleField& field, const std::vector<Ligh
 // in-scattering product threaded over particles): updates solution.incoming for the solved
 // channels and returns the relative L2 change of I. solve_network calls it until converged.
 double iterate_network(NetworkSolution& solution, int threads);
+
+// The next frame of a simulation: the same particles, in the same order, some moved, resized or
+// re-weighted, and the lights, moved or not. `field` is the field over the new positions;
+// `previous` the last frame's solution (moved in: its arrays are reused). Instead of building
+// everything again, only what the changed Gaussians reach is redone:
+// - rho at the particles within their supports (old and new);
+// - in each direction, the columns a changed particle left, entered or sits in (sorted and linked
+//   again, with their transmittance); the other columns are copied;
+// - each light's depth map, by subtracting the old Gaussians and adding the new ones;
+// - the direct light of the particles whose depth-map texels changed;
+// then iterates from the previous I. The result is the network a full build with the previous
+// window would give (rho, V and the transmittance to float rounding). Everything is rebuilt (and
+// `update.reason` says why) when the particle count, D, M, the extinction or albedo changed, more
+// than a quarter of the Gaussians changed, or a changed one left the window's sphere; a light's
+// map alone is rebuilt when that light moved or a Gaussian left its map. Same settings as
+// solve_network; the phase function is assumed unchanged.
+NetworkSolution update_network(NetworkSolution previous, const ParticleField& field, const std::vector<Light>& lights,
+                               const NetworkSettings& settings);
 
 // Camera rays through the particles' Gaussians, front to back: each particle scatters
 // albedo sum_d c_d(w) I[p, d] toward the eye in proportion to its Gaussian's optical depth along
