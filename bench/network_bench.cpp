@@ -5,6 +5,9 @@
 // - LightMap: one light's depth map and the direct light at every particle;
 // - Iteration: one sweep of every direction (grey: one channel; coloured: three), with the
 //   separable phase (terms 0, automatic) or the full matrix (terms = D).
+// - Update: the next frame after a fraction of the particles moved (diameters given, as a
+//   simulation hands them over): update_network against solve_network over the new positions,
+//   both without iterating (the networks, the depth map and the direct light only).
 // Run: build/release/bench/haze_bench_network --benchmark_repetitions=3 --benchmark_report_aggregates_only=true
 // Counters: grind, seconds per particle (Field, LightMap), per particle and direction (Build), per particle,
 // direction and channel (Iteration), printed with SI prefixes (n: nanoseconds).
@@ -93,6 +96,47 @@ void BM_Iteration(benchmark::State& state) {
                                                   benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
 }
 
+// Args: particles, particles moved per 1000, 1: update_network, 0: solve_network (a full build).
+void BM_Update(benchmark::State& state) {
+  Cloud cloud(state.range(0));
+  const std::vector<double> sizes = ParticleField(cloud.view).diameters();
+  std::vector<float> diameters(sizes.begin(), sizes.end());
+  cloud.view.diameters = diameters;
+  std::vector<Vec3f> next = cloud.positions;
+  Rng rng(7);
+  const auto stride = static_cast<size_t>(1000 / state.range(1));
+  for (size_t p = 0; p < next.size(); p += stride) {  // moved by up to half a mean particle width
+    const Vec3 x = Vec3(next[p]) + 0.02 * Vec3(rng.uniform() - 0.5, rng.uniform() - 0.5, rng.uniform() - 0.5);
+    if (glm::length(x) < 0.99) next[p] = Vec3f(x);
+  }
+  ParticleView moved_view = cloud.view;
+  moved_view.positions = next;
+  const ParticleField field(cloud.view), moved(moved_view);
+  NetworkSettings settings;
+  settings.max_iterations = 0;
+  const NetworkSolution previous = solve_network(field, kSun, settings);
+  NetworkSolution::Update u;
+  for (auto _ : state) {
+    if (state.range(2)) {
+      state.PauseTiming();
+      NetworkSolution copy = previous;
+      state.ResumeTiming();
+      const NetworkSolution s = update_network(std::move(copy), moved, kSun, settings);
+      u = s.update;
+      state.PauseTiming();  // not the release of the arrays
+    } else {
+      benchmark::DoNotOptimize(solve_network(moved, kSun, settings).rho.data());
+      state.PauseTiming();
+    }
+    state.ResumeTiming();
+  }
+  const auto n = static_cast<double>(state.range(0));
+  state.counters["changed"] = static_cast<double>(u.changed);
+  state.counters["rho%"] = 100.0 * static_cast<double>(u.density) / n;
+  state.counters["columns%"] = 100.0 * u.columns;
+  state.counters["direct%"] = 100.0 * static_cast<double>(u.direct) / n;
+}
+
 }  // namespace
 
 BENCHMARK(BM_Field)->Arg(1024)->Arg(10000)->Arg(100000)->Unit(benchmark::kMillisecond)->UseRealTime();
@@ -114,5 +158,14 @@ BENCHMARK(BM_Iteration)
     ->Args({10000, 128, 0, 1})
     ->Args({100000, 128, 0, 1})
     ->Args({100000, 128, 0, 0})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK(BM_Update)
+    ->Args({10000, 1, 1})
+    ->Args({10000, 1, 0})
+    ->Args({100000, 1, 1})
+    ->Args({100000, 10, 1})
+    ->Args({100000, 100, 1})
+    ->Args({100000, 1, 0})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
