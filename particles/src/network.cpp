@@ -40,7 +40,7 @@ void link_column(std::vector<std::pair<double, int>>& members, int* out, int* up
     }
     const auto [up_depth, up] = members[k - 1];
     upstream[p] = up;
-    depth[p] = static_cast<float>(0.5 * (static_cast<double>(rho[p]) + static_cast<double>(rho[static_cast<size_t>(up)])) * (members[k].first - up_depth));
+    depth[p] = gap_depth(rho[p], rho[static_cast<size_t>(up)], members[k].first, up_depth);
   }
 }
 

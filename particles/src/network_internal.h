@@ -33,6 +33,12 @@ struct Projector {
 // first) and the gap's density integral (the trapezoid of rho at both ends).
 void link_column(std::vector<std::pair<double, int>>& members, int* out, int* upstream, float* depth, const std::vector<float>& rho);
 
+// The density integral over the gap between particles at depths `upstream` and `p` along a
+// direction: the trapezoid of rho at both ends.
+inline float gap_depth(float rho_p, float rho_upstream, double p, double upstream) {
+  return static_cast<float>(0.5 * (static_cast<double>(rho_p) + static_cast<double>(rho_upstream)) * (p - upstream));
+}
+
 // exp(-sigma_t depth) over a particle's gap, or -1 where nothing is upstream (the sweep's marker).
 inline float gap_transmittance(double sigma_t, int upstream, float depth) {
   return upstream < 0 ? -1.0f : static_cast<float>(std::exp(-sigma_t * static_cast<double>(depth)));
@@ -48,7 +54,7 @@ std::vector<const Light*> delta_lights(const std::vector<Light>& lights, Rgb& sk
 // Whether the medium, the sky and every light are grey (one channel serves three).
 bool grey_scene(const MaterialDesc& material, const Rgb& sky, const std::vector<const Light*>& delta);
 
-// S[c][i * n + p] for particles [p0, p1) (or the listed ones) from the solution's light maps:
+// S[c][i * n + p] for the listed particles p from the solution's light maps:
 // the direct light scattered into each direction, per unit albedo, overwriting what was there.
 void direct_light(NetworkSolution& s, const ParticleField& field, const std::vector<const Light*>& delta, const std::vector<int>& particles,
                   int threads);

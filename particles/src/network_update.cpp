@@ -105,10 +105,9 @@ NetworkSolution update_network(NetworkSolution s, const ParticleField& field, co
             const auto p = static_cast<size_t>(old_order[k]), c_at = static_cast<size_t>(cursor);
             order[c_at] = old_order[k];
             const int up = v.upstream[base + p];
-            if (up >= 0 && (dense[p] || dense[static_cast<size_t>(up)])) {  // as link_column
+            if (up >= 0 && (dense[p] || dense[static_cast<size_t>(up)])) {
               const auto q = static_cast<size_t>(up);
-              v.depth[base + p] = static_cast<float>(0.5 * (static_cast<double>(s.rho[p]) + static_cast<double>(s.rho[q])) *
-                                                     (project.depth(field.position(p)) - project.depth(field.position(q))));
+              v.depth[base + p] = gap_depth(s.rho[p], s.rho[q], project.depth(field.position(p)), project.depth(field.position(q)));
               for (size_t c = 0; c < channels; ++c) t[c][c_at] = gap_transmittance(material.sigma_t[static_cast<int>(c)], up, v.depth[base + p]);
             } else {
               for (size_t c = 0; c < channels; ++c) t[c][c_at] = s.transmittance[c][base + static_cast<size_t>(k)];

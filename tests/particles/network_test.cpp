@@ -175,7 +175,7 @@ TEST(NetworkUpdate, MatchesAFullBuild) {
   EXPECT_LT(u.columns, 0.25);
 
   const std::vector<float> rho = moved.density_at_particles(0);
-  for (size_t p = 0; p < rho.size(); ++p) ASSERT_NEAR(updated.rho[p], rho[p], 1e-6 * rho[p]) << p;
+  for (size_t p = 0; p < rho.size(); ++p) ASSERT_NEAR(updated.rho[p], rho[p], 1e-6 * static_cast<double>(rho[p])) << p;
   const VisibilityNetwork full = build_visibility(moved, rho, *updated.directions, updated.visibility.window, 0);
   const VisibilityNetwork& v = updated.visibility;
   EXPECT_EQ(v.order, full.order);
@@ -183,9 +183,9 @@ TEST(NetworkUpdate, MatchesAFullBuild) {
   EXPECT_EQ(v.column_start, full.column_start);
   const size_t n = rho.size();
   for (size_t e = 0; e < full.depth.size(); ++e) {
-    ASSERT_NEAR(v.depth[e], full.depth[e], 1e-5 * (1.0 + full.depth[e])) << e;
+    ASSERT_NEAR(v.depth[e], full.depth[e], 1e-5 * (1.0 + static_cast<double>(full.depth[e]))) << e;
     const size_t at = (e / n) * n + static_cast<size_t>(full.order[e]);
-    const double t = full.upstream[at] < 0 ? -1.0 : std::exp(-4.0 * full.depth[at]);
+    const double t = full.upstream[at] < 0 ? -1.0 : std::exp(-4.0 * static_cast<double>(full.depth[at]));
     ASSERT_NEAR(updated.transmittance[0][e], t, 1e-5) << e;
   }
 
