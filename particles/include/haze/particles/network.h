@@ -121,8 +121,9 @@ double iterate_network(NetworkSolution& solution, int threads);
 // `previous` the last frame's solution (moved in: its arrays are reused). Instead of building
 // everything again, only what the changed Gaussians reach is redone:
 // - rho at the particles within their supports (old and new);
-// - in each direction, the columns a changed particle left, entered or sits in (sorted and linked
-//   again, with their transmittance); the other columns are copied;
+// - in each direction, the columns a moved particle left or entered (sorted and linked again, with
+//   their transmittance); the other columns are copied, their gaps integrated again only where rho
+//   changed at either end;
 // - each light's depth map, by subtracting the old Gaussians and adding the new ones;
 // - the direct light of the particles whose depth-map texels changed;
 // then iterates from the previous I. The result is the network a full build with the previous
