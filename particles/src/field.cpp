@@ -47,14 +47,18 @@ ParticleField::ParticleField(const ParticleView& particles, int neighbours) : vi
 
 ParticleField::~ParticleField() = default;
 
-double ParticleField::density(const Vec3& x) const {
-  if (!tree_) return 0.0;
+void ParticleField::radius_query(const Vec3& x, double radius, std::vector<std::vector<size_t>>& found, std::vector<std::vector<float>>& dist2) const {
   float q[3] = {static_cast<float>(x.x), static_cast<float>(x.y), static_cast<float>(x.z)};
-  std::vector<std::vector<size_t>> found;
-  std::vector<std::vector<float>> dist2;
   flann::SearchParams params(flann::FLANN_CHECKS_UNLIMITED);
   params.sorted = false;
-  tree_->index.radiusSearch(flann::Matrix<float>(q, 1, 3), found, dist2, static_cast<float>(kCut * kCut * h_max_ * h_max_), params);
+  tree_->index.radiusSearch(flann::Matrix<float>(q, 1, 3), found, dist2, static_cast<float>(radius * radius), params);
+}
+
+double ParticleField::density(const Vec3& x) const {
+  if (!tree_) return 0.0;
+  std::vector<std::vector<size_t>> found;
+  std::vector<std::vector<float>> dist2;
+  radius_query(x, kCut * h_max_, found, dist2);
   double rho = 0.0;
   for (size_t j = 0; j < found[0].size(); ++j) {
     const size_t p = found[0][j];
@@ -66,12 +70,9 @@ double ParticleField::density(const Vec3& x) const {
 
 std::vector<size_t> ParticleField::within(const Vec3& x, double radius) const {
   if (!tree_) return {};
-  float q[3] = {static_cast<float>(x.x), static_cast<float>(x.y), static_cast<float>(x.z)};
   std::vector<std::vector<size_t>> found;
   std::vector<std::vector<float>> dist2;
-  flann::SearchParams params(flann::FLANN_CHECKS_UNLIMITED);
-  params.sorted = false;
-  tree_->index.radiusSearch(flann::Matrix<float>(q, 1, 3), found, dist2, static_cast<float>(radius * radius), params);
+  radius_query(x, radius, found, dist2);
   return std::move(found[0]);
 }
 

@@ -59,6 +59,9 @@ class ParticleField {
   double radius_ = 0.0;
   Aabb bounds_;
   std::unique_ptr<KdTree> tree_;
+
+  // FLANN's radius search around x (one query; unsorted), for density() and within().
+  void radius_query(const Vec3& x, double radius, std::vector<std::vector<size_t>>& found, std::vector<std::vector<float>>& dist2) const;
 };
 
 }  // namespace haze::particles
