@@ -78,21 +78,29 @@ HWY_INLINE void SweepVector(D d, const SweepVolume& v, int i, int j, int k, int 
   VI own = hn::Zero(di);
   for (int e = 0; e < 3; ++e) own = hn::Add(own, hn::Mul(cell[e], hn::Set(di, stride[e])));
   VI index = own;
+  VI walk[3] = {cell[0], cell[1], cell[2]};  // the walk's cell coordinates
+  const VI one_i = hn::Set(di, 1);
   V t = zero, result = zero;
   for (auto active = hn::Lt(t, seg); !hn::AllFalse(d, active); active = hn::Lt(t, seg)) {
     const auto cross_x = hn::And(hn::Le(t_next[0], t_next[1]), hn::Le(t_next[0], t_next[2]));
     const auto cross_y = hn::AndNot(cross_x, hn::Le(t_next[1], t_next[2]));
     const auto cross_z = hn::Not(hn::Or(cross_x, cross_y));
     const V t_end = hn::Min(hn::Min(hn::Min(t_next[0], t_next[1]), t_next[2]), seg);
-    // Finished lanes read their own cell: every index read is in the grid.
+    // Finished lanes read their own cell; active ones are inside the grid (see below).
     const V rho = hn::GatherIndex(d, v.density, hn::IfThenElse(hn::RebindMask(di, active), index, own));
     result = hn::Add(result, hn::IfThenElseZero(active, hn::Mul(rho, hn::Sub(t_end, t))));
     t = hn::IfThenElse(active, t_end, t);
     const decltype(cross_x) crossed[3] = {cross_x, cross_y, cross_z};
     for (int e = 0; e < 3; ++e) {
       const auto go = hn::And(active, crossed[e]);
-      index = hn::Add(index, hn::IfThenElseZero(hn::RebindMask(di, go), step[e]));
+      const auto go_i = hn::RebindMask(di, go);
+      index = hn::Add(index, hn::IfThenElseZero(go_i, step[e]));
+      walk[e] = hn::Add(walk[e], hn::IfThenElseZero(go_i, hn::IfThenElse(hn::RebindMask(di, hn::Gt(q[e], zero)), one_i, hn::Neg(one_i))));
       t_next[e] = hn::IfThenElse(go, hn::Add(t_next[e], t_delta[e]), t_next[e]);
+      // Rounding can leave t a hair short of len when the walk crosses the grid's face: the
+      // lane is done there (its next cell is outside, or a wrapped-around index).
+      const auto out = hn::Or(hn::Gt(hn::Zero(di), walk[e]), hn::Gt(walk[e], hn::Set(di, v.n[e] - 1)));
+      t = hn::IfThenElse(hn::And(go, hn::RebindMask(d, out)), seg, t);
     }
   }
   const auto lands = hn::Gt(len, s);

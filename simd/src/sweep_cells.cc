@@ -47,6 +47,7 @@ void sweep_cell(const SweepVolume& v, const int cell[3], float& depth, float& me
   float t_next[3];
   for (int e = 0; e < 3; ++e) t_next[e] = 0.5f * t_delta[e];
   int index = cell[0] * stride[0] + cell[1] * stride[1] + cell[2] * stride[2];
+  int walk[3] = {cell[0], cell[1], cell[2]};
   float t = 0.0f;
   depth = 0.0f;
   while (t < seg) {
@@ -55,7 +56,10 @@ void sweep_cell(const SweepVolume& v, const int cell[3], float& depth, float& me
     depth += v.density[index] * (t_end - t);
     t = t_end;
     index += q[e] > 0.0f ? stride[e] : -stride[e];
+    walk[e] += q[e] > 0.0f ? 1 : -1;
     t_next[e] += t_delta[e];
+    // Rounding can leave t a hair short of len when the walk crosses the grid's face: stop there.
+    if (walk[e] < 0 || walk[e] >= v.n[e]) break;
   }
   if (len > s) {
     const int b = a == 0 ? 1 : 0, c = a == 2 ? 1 : 2;

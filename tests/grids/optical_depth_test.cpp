@@ -140,3 +140,30 @@ TEST(OpticalDepth, LightAtACellCentreAndBadLights) {
 
 }  // namespace
 }  // namespace haze::grids
+
+namespace haze::grids {
+namespace {
+
+// A walk that reaches the grid's face a rounding error short of its length must stop there, not
+// read the cell after the face (the next row's first cell, or past the array). Only the x = 0
+// layer is dense; a light toward +x sees none of it from x >= 1, so every other depth is 0.
+TEST(OpticalDepth, SweepWalksStopAtTheGridFace) {
+  DenseGrid g({32, 28, 32}, {Vec3(-1), Vec3(1)});
+  for (int k = 0; k < 32; ++k)
+    for (int j = 0; j < 28; ++j) g.at(0, j, k) = 1e30f;
+  for (bool scalar : {true, false}) {
+    for (const Vec3& to_light : {Vec3(1.0, 0.3, 0.2), Vec3(0.9, -0.35, 0.3), Vec3(1.0, 0.1, -0.45)}) {
+      DepthOptions options;
+      options.scalar_kernel = scalar;
+      const DenseGrid depth = optical_depth(g, DirectionalLight{-glm::normalize(to_light), Rgb(1.0)}, options);
+      float worst = 0.0f;
+      for (int k = 0; k < 32; ++k)
+        for (int j = 0; j < 28; ++j)
+          for (int i = 1; i < 32; ++i) worst = std::max(worst, depth.at(i, j, k));
+      EXPECT_EQ(worst, 0.0f) << (scalar ? "scalar" : "simd") << " toward " << to_light.x << " " << to_light.y << " " << to_light.z;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace haze::grids
