@@ -37,7 +37,7 @@ nlohmann::json save_result(const RenderResult& result, const std::string& method
 namespace {
 
 struct RenderArgs {
-  std::string scene, method, out;
+  std::string scene, method, out, display = "cpu";
   int threads = 0;
   bool json = false, no_png = false, no_cache = false;
   std::vector<std::string> set;
@@ -73,7 +73,7 @@ int run(const RenderArgs& a) {
   ProgressBar bar(method);
   options.progress = bar.callback();
   auto start = std::chrono::steady_clock::now();
-  RenderResult result = render(scene, method, options);
+  RenderResult result = a.display == "gl" ? render_gl(scene, method, options) : render(scene, method, options);
   double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   std::filesystem::path out = a.out.empty() ? std::filesystem::path(a.scene).stem().string() + "_" + method + ".exr" : a.out;
   auto summary = save_result(result, method, seconds, out, !a.no_png);
@@ -95,6 +95,8 @@ Command add_render(CLI::App& app) {
   auto a = std::make_shared<RenderArgs>();
   sub->add_option("scene", a->scene, "Scene JSON file")->required()->check(CLI::ExistingFile);
   sub->add_option("--method", a->method, "Method (overrides the scene's; the scene's settings apply when names match)");
+  sub->add_option("--display", a->display, "cpu: the method's own renderer; gl: its fields through the GLSL ray-march display (propagation, dom)")
+      ->check(CLI::IsMember({"cpu", "gl"}));
   sub->add_option("--out", a->out, "Output EXR (default: <scene>_<method>.exr)");
   sub->add_option("--threads", a->threads, "Thread cap (0: all cores)")->check(CLI::NonNegativeNumber);
   sub->add_option("--set", a->set, "Method setting key=value (repeatable), e.g. --set steps=256");

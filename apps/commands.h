@@ -29,6 +29,11 @@ Command add_tables(CLI::App& app);
 nlohmann::json save_result(const RenderResult& result, const std::string& method, double seconds,
                            const std::filesystem::path& exr, bool png);
 
+// `haze render --display gl`: the method's fields computed on the CPU (methods propagation and
+// dom), shown by haze::gl's ray-march display in a headless context, read back. Throws
+// haze::Error for another method, or when the build has no GL (HAZE_WITH_GL=OFF).
+RenderResult render_gl(const Scene& scene, const std::string& method, const RenderOptions& options);
+
 // Registers every module's methods with core's registry (core's own are always there).
 void register_all_methods();
 

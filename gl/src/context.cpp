@@ -3,8 +3,9 @@
 
 #include <EGL/egl.h>
 #include <EGL/eglext.h>
-#include <GL/gl.h>
 #include <GL/osmesa.h>
+
+#include "loader.h"
 
 #include <vector>
 
@@ -15,6 +16,7 @@ struct HeadlessContext::Impl {
   EGLContext egl_context = EGL_NO_CONTEXT;
   OSMesaContext osmesa = nullptr;
   std::vector<unsigned char> osmesa_buffer;
+  std::shared_ptr<const internal::Api> api;
 
   // EGL_MESA_platform_surfaceless + EGL_KHR_surfaceless_context: no window system at all.
   std::string try_egl() {
@@ -63,13 +65,6 @@ struct HeadlessContext::Impl {
   }
 };
 
-namespace {
-std::string gl_string(GLenum name) {
-  const auto* s = reinterpret_cast<const char*>(glGetString(name));
-  return s ? s : "";
-}
-}  // namespace
-
 HeadlessContext::HeadlessContext() : impl_(std::make_unique<Impl>()) {
   std::string egl_error = impl_->try_egl();
   if (egl_error.empty()) {
@@ -83,13 +78,24 @@ HeadlessContext::HeadlessContext() : impl_(std::make_unique<Impl>()) {
     }
     info_.backend = "osmesa";
   }
+  try {
+    impl_->api = internal::load_api(info_.backend == "osmesa" ? internal::ProcLoader(&OSMesaGetProcAddress)
+                                                              : internal::ProcLoader(&eglGetProcAddress));
+  } catch (...) {
+    impl_->release();
+    throw;
+  }
+  internal::set_current(impl_->api.get());
   info_.available = true;
-  info_.vendor = gl_string(GL_VENDOR);
-  info_.renderer = gl_string(GL_RENDERER);
-  info_.version = gl_string(GL_VERSION);
+  info_.vendor = internal::gl_string(*impl_->api, internal::kVendor);
+  info_.renderer = internal::gl_string(*impl_->api, internal::kRenderer);
+  info_.version = internal::gl_string(*impl_->api, internal::kVersion);
 }
 
-HeadlessContext::~HeadlessContext() { impl_->release(); }
+HeadlessContext::~HeadlessContext() {
+  internal::set_current(nullptr);
+  impl_->release();
+}
 
 GlInfo probe() {
   try {

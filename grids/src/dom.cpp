@@ -126,65 +126,74 @@ namespace {
 class DomMethod final : public Method {
  public:
   RenderResult render(const Scene& scene, const RenderOptions& options) const override {
-    Settings settings(options.settings, "dom");
-    const int resolution = static_cast<int>(settings.integer("resolution", 64, 2, 1024));
-    DomSettings dom;
-    dom.directions = static_cast<int>(settings.integer("directions", dom.directions, 8, 4096));
-    dom.terms = static_cast<int>(settings.integer("terms", std::min(dom.terms, dom.directions), 0, dom.directions));
-    dom.scheme = dom_scheme_from_name(settings.choice("scheme", "sweep", {"paper", "sweep"}));
-    dom.accelerator = dom_accelerator_from_name(settings.choice("accelerator", "gmres", {"none", "gmres"}));
-    dom.max_iterations = static_cast<int>(settings.integer("iterations", dom.max_iterations, 1, 100000));
-    dom.tolerance = settings.number("tolerance", dom.tolerance, 1e-9, 1.0);
-    dom.delta_m = settings.integer("delta_m", 1, 0, 1) != 0;
-    dom.storage = dom_storage_from_name(settings.choice("storage", "float32", {"float32", "float16"}));
-    dom.threads = options.threads;
-    DepthOptions depth;
-    depth.scheme = depth_scheme_from_name(settings.choice("optical_depth", "exact", {"exact", "paper", "sweep"}));
-    depth.threads = options.threads;
-    const double step_cells = settings.number("step", 0.5, 0.01, 4.0);
-    settings.reject_unknown();
-
-    auto start = std::chrono::steady_clock::now();
-    const ExtinctionVolume volume = make_extinction_volume(scene, resolution, 0.0, options.threads);
-    // Delta lights get depth volumes; the sky enters the solver through the boundary and reaches
-    // the eye as background.
-    std::vector<DenseGrid> delta_depths;
-    for (const Light& l : scene.lights)
-      if (!std::holds_alternative<SkyLight>(l)) delta_depths.push_back(optical_depth(volume.density, l, depth));
-    const double depth_seconds = seconds_since(start);
-
-    start = std::chrono::steady_clock::now();
-    ProgressCallback progress = options.progress;
-    dom.progress = progress ? [&](double f) { return progress(0.8 * f); } : ProgressCallback();
-    const DomSolution solution = solve_dom(volume, scene.lights, delta_depths, dom);
-    const double solve_seconds = seconds_since(start);
-
-    start = std::chrono::steady_clock::now();
+    const ProgressCallback& progress = options.progress;
+    RenderOptions solve_options = options;
+    solve_options.progress = progress ? [&](double f) { return progress(0.8 * f); } : ProgressCallback();
+    DomFields fields = dom_fields(scene, solve_options);
+    const auto start = std::chrono::steady_clock::now();
     RenderOptions render_options = options;
     render_options.progress = progress ? [&](double f) { return progress(0.8 + 0.2 * f); } : ProgressCallback();
-    Image image = render_dom(scene, volume, delta_depths, solution, step_cells, render_options);
-    RenderResult result{std::move(image), std::nullopt, {}};
-    result.stats = {{"cells", volume.density.resolution()},
-                    {"directions", dom.directions},
-                    {"terms", solution.terms()},
-                    {"phase_relative_error", solution.separable->relative_error()},
-                    {"delta_m_fraction", solution.delta_m_fraction},
-                    {"scheme", name(dom.scheme)},
-                    {"accelerator", name(dom.accelerator)},
-                    {"storage", name(dom.storage)},
-                    {"channels", solution.channels},
-                    {"iterations", solution.iterations},
-                    {"converged", solution.converged},
-                    {"final_change", solution.changes.empty() ? 0.0 : solution.changes.back()},
-                    {"memory_bytes", solution.bytes},
-                    {"depth_seconds", depth_seconds},
-                    {"solve_seconds", solve_seconds},
-                    {"render_seconds", seconds_since(start)}};
+    Image image = render_dom(scene, fields.volume, fields.delta_depths, fields.solution, fields.step_cells, render_options);
+    RenderResult result{std::move(image), std::nullopt, std::move(fields.stats)};
+    result.stats["render_seconds"] = seconds_since(start);
     return result;
   }
 };
 
 }  // namespace
+
+DomFields dom_fields(const Scene& scene, const RenderOptions& options) {
+  Settings settings(options.settings, "dom");
+  const int resolution = static_cast<int>(settings.integer("resolution", 64, 2, 1024));
+  DomSettings dom;
+  dom.directions = static_cast<int>(settings.integer("directions", dom.directions, 8, 4096));
+  dom.terms = static_cast<int>(settings.integer("terms", std::min(dom.terms, dom.directions), 0, dom.directions));
+  dom.scheme = dom_scheme_from_name(settings.choice("scheme", "sweep", {"paper", "sweep"}));
+  dom.accelerator = dom_accelerator_from_name(settings.choice("accelerator", "gmres", {"none", "gmres"}));
+  dom.max_iterations = static_cast<int>(settings.integer("iterations", dom.max_iterations, 1, 100000));
+  dom.tolerance = settings.number("tolerance", dom.tolerance, 1e-9, 1.0);
+  dom.delta_m = settings.integer("delta_m", 1, 0, 1) != 0;
+  dom.storage = dom_storage_from_name(settings.choice("storage", "float32", {"float32", "float16"}));
+  dom.threads = options.threads;
+  DepthOptions depth;
+  depth.scheme = depth_scheme_from_name(settings.choice("optical_depth", "exact", {"exact", "paper", "sweep"}));
+  depth.threads = options.threads;
+  const double step_cells = settings.number("step", 0.5, 0.01, 4.0);
+  settings.reject_unknown();
+
+  auto start = std::chrono::steady_clock::now();
+  ExtinctionVolume volume = make_extinction_volume(scene, resolution, 0.0, options.threads);
+  // Delta lights get depth volumes; the sky enters the solver through the boundary and reaches
+  // the eye as background.
+  std::vector<DenseGrid> delta_depths;
+  for (const Light& l : scene.lights)
+    if (!std::holds_alternative<SkyLight>(l)) delta_depths.push_back(optical_depth(volume.density, l, depth));
+  const double depth_seconds = seconds_since(start);
+
+  start = std::chrono::steady_clock::now();
+  dom.progress = options.progress;
+  DomSolution solution = solve_dom(volume, scene.lights, delta_depths, dom);
+  const double solve_seconds = seconds_since(start);
+  DomFields fields{std::move(volume), std::move(delta_depths), std::move(solution), step_cells, {}};
+  const ExtinctionVolume& v = fields.volume;
+  const DomSolution& solved = fields.solution;
+  fields.stats = {{"cells", v.density.resolution()},
+                  {"directions", dom.directions},
+                  {"terms", solved.terms()},
+                  {"phase_relative_error", solved.separable->relative_error()},
+                  {"delta_m_fraction", solved.delta_m_fraction},
+                  {"scheme", name(dom.scheme)},
+                  {"accelerator", name(dom.accelerator)},
+                  {"storage", name(dom.storage)},
+                  {"channels", solved.channels},
+                  {"iterations", solved.iterations},
+                  {"converged", solved.converged},
+                  {"final_change", solved.changes.empty() ? 0.0 : solved.changes.back()},
+                  {"memory_bytes", solved.bytes},
+                  {"depth_seconds", depth_seconds},
+                  {"solve_seconds", solve_seconds}};
+  return fields;
+}
 
 std::unique_ptr<Method> make_dom_method() { return std::make_unique<DomMethod>(); }
 

@@ -23,44 +23,46 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
 class PropagationMethod final : public Method {
  public:
   RenderResult render(const Scene& scene, const RenderOptions& options) const override {
-    Settings settings(options.settings, "propagation");
-    const int resolution = static_cast<int>(settings.integer("resolution", 64, 2, 1024));
-    DepthOptions depth;
-    depth.scheme = depth_scheme_from_name(settings.choice("optical_depth", "sweep", {"exact", "paper", "sweep"}));
-    depth.sweep_layers = static_cast<int>(settings.integer("sweep_layers", depth.sweep_layers, 1, 64));
-    depth.threads = options.threads;
-    const double step_cells = settings.number("step", 0.5, 0.01, 4.0);
-    const double cutoff = settings.number("cutoff", 0.0, 0.0, 1e30);
-    settings.reject_unknown();
-
-    for (size_t i = 0; i < scene.lights.size(); ++i)
-      if (std::holds_alternative<SkyLight>(scene.lights[i]))
-        throw Error("lights[" + std::to_string(i) + "].type", "sky", "point, spot or directional lights for the propagation method");
-    auto start = std::chrono::steady_clock::now();
-    VolumeReport report;
-    const ExtinctionVolume volume = make_extinction_volume(scene, resolution, cutoff, options.threads, &report);
-    const double inject_seconds = seconds_since(start);
-    start = std::chrono::steady_clock::now();
-    DepthStats depth_stats;
-    const std::vector<DenseGrid> depths = optical_depths(volume.density, scene.lights, depth, &depth_stats);
-    const double propagate_seconds = seconds_since(start);
-
-    start = std::chrono::steady_clock::now();
-    MarchSettings march{step_cells};
-    RenderResult result{march_image(scene, volume, depths, march, options), std::nullopt, {}};
-    result.stats = {{"cells", volume.density.resolution()},
-                    {"optical_depth", name(depth.scheme)},
-                    {"sweep_layers", depth.sweep_layers},
-                    {"paper_iterations", depth.scheme == DepthScheme::paper ? depth_stats.iterations : 0},
-                    {"truncation_bound", report.truncation_bound},
-                    {"inject_seconds", inject_seconds},
-                    {"propagate_seconds", propagate_seconds},
-                    {"march_seconds", seconds_since(start)}};
+    PropagationFields fields = propagation_fields(scene, options);
+    const auto start = std::chrono::steady_clock::now();
+    RenderResult result{march_image(scene, fields.volume, fields.depths, fields.march, options), std::nullopt, std::move(fields.stats)};
+    result.stats["march_seconds"] = seconds_since(start);
     return result;
   }
 };
 
 }  // namespace
+
+PropagationFields propagation_fields(const Scene& scene, const RenderOptions& options) {
+  Settings settings(options.settings, "propagation");
+  const int resolution = static_cast<int>(settings.integer("resolution", 64, 2, 1024));
+  DepthOptions depth;
+  depth.scheme = depth_scheme_from_name(settings.choice("optical_depth", "sweep", {"exact", "paper", "sweep"}));
+  depth.sweep_layers = static_cast<int>(settings.integer("sweep_layers", depth.sweep_layers, 1, 64));
+  depth.threads = options.threads;
+  const double step_cells = settings.number("step", 0.5, 0.01, 4.0);
+  const double cutoff = settings.number("cutoff", 0.0, 0.0, 1e30);
+  settings.reject_unknown();
+
+  for (size_t i = 0; i < scene.lights.size(); ++i)
+    if (std::holds_alternative<SkyLight>(scene.lights[i]))
+      throw Error("lights[" + std::to_string(i) + "].type", "sky", "point, spot or directional lights for the propagation method");
+  auto start = std::chrono::steady_clock::now();
+  VolumeReport report;
+  PropagationFields fields{make_extinction_volume(scene, resolution, cutoff, options.threads, &report), {}, MarchSettings{step_cells}, {}};
+  const double inject_seconds = seconds_since(start);
+  start = std::chrono::steady_clock::now();
+  DepthStats depth_stats;
+  fields.depths = optical_depths(fields.volume.density, scene.lights, depth, &depth_stats);
+  fields.stats = {{"cells", fields.volume.density.resolution()},
+                  {"optical_depth", name(depth.scheme)},
+                  {"sweep_layers", depth.sweep_layers},
+                  {"paper_iterations", depth.scheme == DepthScheme::paper ? depth_stats.iterations : 0},
+                  {"truncation_bound", report.truncation_bound},
+                  {"inject_seconds", inject_seconds},
+                  {"propagate_seconds", seconds_since(start)}};
+  return fields;
+}
 
 std::unique_ptr<Method> make_propagation_method() { return std::make_unique<PropagationMethod>(); }
 

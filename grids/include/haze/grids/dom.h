@@ -116,6 +116,19 @@ Eigen::VectorXd inscatter_weights(const DomSolution& solution, const Vec3& w);
 Image render_dom(const Scene& scene, const ExtinctionVolume& volume, const std::vector<DenseGrid>& delta_depths,
                  const DomSolution& solution, double step_cells = 0.5, const RenderOptions& options = {});
 
+// Everything method "dom" computes before it renders, from the scene and the method's settings in
+// options.settings (resolution, directions, terms, scheme, accelerator, iterations, tolerance,
+// delta_m, storage, optical_depth, step; unknown keys are an error), with the stats it reports.
+// options.progress follows the solve. The GL display (haze::gl) shows the same fields.
+struct DomFields {
+  ExtinctionVolume volume;
+  std::vector<DenseGrid> delta_depths;  // per point, spot or directional light, in order
+  DomSolution solution;
+  double step_cells = 0.5;
+  nlohmann::json stats;
+};
+DomFields dom_fields(const Scene& scene, const RenderOptions& options);
+
 // The memory a solve with these settings needs, in bytes (what solve_dom checks).
 size_t dom_memory_bytes(const std::array<int, 3>& resolution, int channels, const DomSettings& settings);
 

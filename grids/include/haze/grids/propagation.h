@@ -48,6 +48,17 @@ struct MarchSettings {
 Image march_image(const Scene& scene, const ExtinctionVolume& volume, const std::vector<DenseGrid>& depths,
                   const MarchSettings& settings, const RenderOptions& options);
 
+// Everything method "propagation" computes before it marches, from the scene and the method's
+// settings in options.settings (resolution, optical_depth, sweep_layers, step, cutoff; unknown
+// keys are an error), with the stats it reports. The GL display (haze::gl) shows the same fields.
+struct PropagationFields {
+  ExtinctionVolume volume;
+  std::vector<DenseGrid> depths;  // one per light
+  MarchSettings march;
+  nlohmann::json stats;
+};
+PropagationFields propagation_fields(const Scene& scene, const RenderOptions& options);
+
 std::unique_ptr<Method> make_propagation_method();
 
 }  // namespace haze::grids
