@@ -54,6 +54,8 @@ const Api& api() {
 
 void set_current(const Api* api) { current = api; }
 
+void finish(const Api& api) { api.Finish(); }
+
 void check(const Api& gl, const char* what) {
   const GLenum e = gl.GetError();
   if (e != GL_NO_ERROR) throw Error(what, error_name(e), "no OpenGL error");

@@ -97,6 +97,8 @@ HeadlessContext::~HeadlessContext() {
   impl_->release();
 }
 
+void HeadlessContext::finish() const { internal::finish(*impl_->api); }
+
 GlInfo probe() {
   try {
     HeadlessContext context;

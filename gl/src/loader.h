@@ -18,6 +18,9 @@ std::shared_ptr<const Api> load_api(ProcLoader loader);
 std::string gl_string(const Api& api, int which);
 enum : int { kVendor, kRenderer, kVersion };
 
+// glFinish on the current context.
+void finish(const Api& api);
+
 // Makes `api` the table api() returns on this thread (nullptr: none).
 void set_current(const Api* api);
 

@@ -22,6 +22,8 @@ class HeadlessContext {
   HeadlessContext(const HeadlessContext&) = delete;
   HeadlessContext& operator=(const HeadlessContext&) = delete;
   const GlInfo& info() const { return info_; }
+  // Waits until GL has executed every command issued so far (benchmarks time uploads with it).
+  void finish() const;
 
  private:
   struct Impl;
