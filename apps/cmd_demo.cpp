@@ -28,6 +28,8 @@ int run(const DemoArgs& a) {
   if (scenes.empty()) throw Error("--examples", a.examples, "at least one .json scene");
 
   auto methods = registered_methods();
+  // auto is a chooser, not a method of its own: the demo shows the methods it chooses from.
+  std::erase_if(methods, [](const MethodInfo& m) { return m.name == "auto"; });
   bool has_reference = std::any_of(methods.begin(), methods.end(), [](const auto& m) { return m.name == "reference"; });
   // The reference renders first so the others can be compared with it.
   std::stable_partition(methods.begin(), methods.end(), [](const auto& m) { return m.name == "reference"; });

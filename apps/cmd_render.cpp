@@ -39,7 +39,8 @@ namespace {
 struct RenderArgs {
   std::string scene, method, out, display = "cpu";
   int threads = 0;
-  bool json = false, no_png = false, no_cache = false;
+  bool json = false, no_png = false, no_cache = false, explain = false;
+  std::optional<double> tolerance;
   std::vector<std::string> set;
   // Shortcuts for the reference path tracer's settings; unset unless given.
   std::optional<long long> spp, max_scattering, max_bounces, seed;
@@ -70,12 +71,22 @@ int run(const RenderArgs& a) {
   if (a.max_scattering) options.settings["max_scattering"] = *a.max_scattering;
   if (a.max_bounces) options.settings["max_bounces"] = *a.max_bounces;
   if (a.seed) options.settings["seed"] = *a.seed;
+  if (a.tolerance) {
+    if (method != "auto") throw Error("--tolerance", std::to_string(*a.tolerance), "--method auto (the only method that takes a tolerance)");
+    options.settings["tolerance"] = *a.tolerance;
+  }
+  if (a.explain && method != "auto") throw Error("--explain", "method " + method, "--method auto (the choice it explains)");
   ProgressBar bar(method);
   options.progress = bar.callback();
   auto start = std::chrono::steady_clock::now();
   RenderResult result = a.display == "gl" ? render_gl(scene, method, options) : render(scene, method, options);
   double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   std::filesystem::path out = a.out.empty() ? std::filesystem::path(a.scene).stem().string() + "_" + method + ".exr" : a.out;
+  if (a.explain) {
+    const auto& choice = result.stats["auto"];
+    std::cout << "auto chose " << choice["method"].get<std::string>() << " " << choice["settings"].dump() << "\n";
+    for (const auto& line : choice["why"]) std::cout << "  - " << line.get<std::string>() << "\n";
+  }
   auto summary = save_result(result, method, seconds, out, !a.no_png);
   summary["scene"] = a.scene;
   if (a.json) {
@@ -104,6 +115,9 @@ Command add_render(CLI::App& app) {
   sub->add_option("--max-scattering", a->max_scattering, "Medium scattering events per path: -1 unlimited, 1 single, 0 none (reference)");
   sub->add_option("--max-bounces", a->max_bounces, "Surface reflections per path: -1 unlimited (reference)");
   sub->add_option("--seed", a->seed, "Random seed (reference); the same seed gives the same image on any thread count");
+  sub->add_option("--tolerance", a->tolerance, "With --method auto: the relative error to stay under (default 0.05)")
+      ->check(CLI::Range(1e-4, 0.99));
+  sub->add_flag("--explain", a->explain, "With --method auto: print the method and settings chosen and why");
   sub->add_flag("--json", a->json, "Print a JSON summary");
   sub->add_flag("--no-png", a->no_png, "Do not write the PNG preview");
   sub->add_flag("--no-cache", a->no_cache, "Rebuild precomputed tables instead of reading them from the cache");

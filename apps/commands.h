@@ -23,6 +23,7 @@ Command add_render(CLI::App& app);
 Command add_demo(CLI::App& app);
 Command add_compare(CLI::App& app);
 Command add_tables(CLI::App& app);
+Command add_bench(CLI::App& app);
 
 // Writes the result's EXR (with its standard-error layer, if any) and a PNG preview beside it;
 // returns the JSON summary `haze render --json` prints.

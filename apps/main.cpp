@@ -11,7 +11,8 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", std::string("haze ") + HAZE_VERSION);
   const haze::app::Command commands[] = {haze::app::add_info(app), haze::app::add_phase(app),
                                           haze::app::add_render(app), haze::app::add_demo(app),
-                                          haze::app::add_compare(app), haze::app::add_tables(app)};
+                                          haze::app::add_compare(app), haze::app::add_tables(app),
+                                          haze::app::add_bench(app)};
   CLI11_PARSE(app, argc, argv);
   try {
     haze::app::register_all_methods();

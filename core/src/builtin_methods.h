@@ -11,5 +11,7 @@ std::unique_ptr<Method> make_quadrature_method();
 std::unique_ptr<Method> make_reference_method();
 // Closed-form single scattering in homogeneous media from point lights (analytic.cpp).
 std::unique_ptr<Method> make_analytic_method();
+// The cheapest method expected to meet a tolerance, chosen from the scene (auto.cpp).
+std::unique_ptr<Method> make_auto_method();
 
 }  // namespace haze::internal

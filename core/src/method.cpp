@@ -26,6 +26,9 @@ struct Registry {
     methods["analytic"] = {"analytic",
                            "closed-form single scattering, homogeneous medium, point and spot lights (seed 002; no shadows)",
                            internal::make_analytic_method};
+    methods["auto"] = {"auto",
+                       "the cheapest method and settings expected to meet --set tolerance=T (0.05), chosen from the scene alone",
+                       internal::make_auto_method, true};
   }
 };
 

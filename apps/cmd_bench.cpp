@@ -1,0 +1,387 @@
+// haze bench trade: the speed/accuracy trade of every method on a fixed suite of scenes, measured
+// against the reference path tracer; CSV, per-method plot data and docs/TRADEOFFS.md.
+#include "commands.h"
+#include "progress_bar.h"
+
+#include <haze/core/error.h>
+
+#include <algorithm>
+#include <cmath>
+#include <chrono>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <map>
+
+namespace haze::app {
+
+namespace {
+
+struct TradeArgs {
+  std::string suite = HAZE_TRADE_SUITE_DIR, out = "build/trade", method;
+  long long spp = 16384;
+  int threads = 0;
+  std::vector<double> tolerances{0.05, 0.02, 0.01};
+  bool report_only = false;
+  std::vector<std::string> only;  // --scene: these scenes only
+};
+
+struct Config {
+  std::string method;
+  nlohmann::json settings;
+};
+
+// What each method's sweep varies: the settings that trade time for error.
+std::vector<Config> sweep() {
+  std::vector<Config> c;
+  for (int spp : {16, 64, 256, 1024, 4096}) c.push_back({"reference", {{"spp", spp}, {"seed", 7}}});
+  for (int steps : {32, 64, 128, 256}) c.push_back({"quadrature", {{"steps", steps}, {"sky_directions", 64}}});
+  for (auto [a, eta] : {std::pair{64, 128}, {128, 256}, {256, 512}}) c.push_back({"analytic", {{"table_a", a}, {"table_eta", eta}}});
+  for (int resolution : {16, 32, 64, 96})
+    for (double step : {1.0, 0.5}) c.push_back({"propagation", {{"resolution", resolution}, {"step", step}}});
+  for (auto [resolution, directions, terms] : {std::tuple{16, 32, 9}, {24, 48, 16}, {32, 80, 25}, {48, 128, 25}, {64, 128, 25}, {96, 128, 25}})
+    c.push_back({"dom", {{"resolution", resolution}, {"directions", directions}, {"terms", terms}}});
+  for (int directions : {32, 64, 128}) c.push_back({"network", {{"directions", directions}}});
+  return c;
+}
+
+struct Row {
+  std::string scene, method;
+  nlohmann::json settings;
+  double seconds = 0.0;
+  LitPixelError error;
+  bool pareto = false;
+  std::string chosen;  // auto: the method and settings it chose
+  double measure() const { return error.rms_noise_removed; }
+};
+
+std::string compact(const nlohmann::json& settings) {
+  std::string s;
+  for (const auto& [key, value] : settings.items()) {
+    if (key == "seed" || key == "sky_directions") continue;
+    s += (s.empty() ? "" : " ") + key + "=" + value.dump();
+  }
+  return s;
+}
+
+// Times a render: once, and when that took under a second, three more (tables cached, caches
+// warm), their median.
+RenderResult timed(const Scene& scene, const std::string& method, const RenderOptions& options, double& seconds) {
+  auto once = [&](RenderResult& result) {
+    const auto start = std::chrono::steady_clock::now();
+    result = render(scene, method, options);
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  };
+  RenderResult result;
+  seconds = once(result);
+  if (seconds < 1.0) {
+    double t[3];
+    for (double& v : t) v = once(result);
+    std::sort(t, t + 3);
+    seconds = t[1];
+  }
+  return result;
+}
+
+std::string percent(double e) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.2f%%", 100.0 * e);
+  return b;
+}
+
+std::string secs(double s) {
+  char b[32];
+  std::snprintf(b, sizeof b, s < 0.1 ? "%.4f s" : "%.3g s", s);
+  return b;
+}
+
+
+// "k=v k=v" (compact()) back to settings.
+nlohmann::json parse_compact(const std::string& text) {
+  nlohmann::json settings = nlohmann::json::object();
+  size_t at = 0;
+  while (at < text.size()) {
+    size_t end = text.find(' ', at);
+    if (end == std::string::npos) end = text.size();
+    const std::string pair = text.substr(at, end - at);
+    const size_t eq = pair.find('=');
+    if (eq != std::string::npos) settings[pair.substr(0, eq)] = nlohmann::json::parse(pair.substr(eq + 1));
+    at = end + 1;
+  }
+  return settings;
+}
+
+// The rows of an earlier trade.csv (so that --method reruns one method and keeps the others).
+std::vector<Row> read_rows(const std::filesystem::path& file) {
+  std::vector<Row> rows;
+  std::ifstream in(file);
+  std::string line;
+  std::getline(in, line);  // header
+  while (std::getline(in, line)) {
+    std::vector<std::string> f;
+    std::string cell;
+    bool quoted = false;
+    for (char ch : line) {
+      if (ch == '"') quoted = !quoted;
+      else if (ch == ',' && !quoted) f.push_back(cell), cell.clear();
+      else cell += ch;
+    }
+    f.push_back(cell);
+    if (f.size() < 11) continue;
+    Row r{f[0], f[1], parse_compact(f[2]), std::stod(f[3]), {}, f[9] == "1", f[10]};
+    r.error.rms_noise_removed = std::stod(f[4]), r.error.mean_abs = std::stod(f[5]), r.error.signed_mean = std::stod(f[6]);
+    r.error.noise_rms = std::stod(f[7]), r.error.pixels = std::stoi(f[8]);
+    rows.push_back(r);
+  }
+  return rows;
+}
+
+const Row* fastest_within(const std::vector<Row>& rows, const std::string& scene, double tolerance) {
+  const Row* best = nullptr;
+  for (const Row& r : rows)
+    if (r.scene == scene && r.method != "auto" && r.measure() < tolerance && (!best || r.seconds < best->seconds)) best = &r;
+  return best;
+}
+
+// docs/TRADEOFFS.md, from the rows: what was measured and how, the plots, the recommended settings
+// per error level and how method auto did.
+void write_tradeoffs(const std::filesystem::path& file, const std::vector<std::string>& scenes, const std::vector<Row>& rows,
+                     const nlohmann::json& references, const TradeArgs& a) {
+  std::ofstream md(file);
+  md << "# Speed against accuracy: the trade suite\n\n"
+        "<!-- Generated by scripts/trade (haze bench trade); edit apps/cmd_bench.cpp, not this file. -->\n\n"
+        "Every method renders five scenes (bench/trade/README.md) with the settings that trade time for\n"
+        "error, and each image is compared with the reference path tracer's. Use this page to pick a\n"
+        "method and settings for an error budget, or let `haze render --method auto --tolerance T` pick.\n\n"
+        "**Error** is the RMS relative error over the lit pixels (luminance above 1% of the reference's\n"
+        "peak) with the reference's own noise removed: `sqrt(max(0, mean(d^2 - se^2)))`, d the per-pixel\n"
+        "relative difference and se the reference's relative standard error (`lit_pixel_error`,\n"
+        "`rms_noise_removed`). A noisy method (the path tracer at few samples) counts its own noise as error.\n"
+        "**Time** is the whole render (setup, tables, solve, image) on this 2-core machine, every core: the median\n"
+        "of three runs after a first one when that first took under a second, else the first run; method\n"
+        "auto is timed once, its choice included.\n\n"
+        "## The references\n\nThe reference's noise limits the smallest error the comparison resolves: about\n"
+        "noise (2 / pixels)^(1/4), the spread of the noise-removed estimate.\n\n"
+        "| scene | spp | seconds | reference noise (RMS relative, lit pixels) | lit pixels | smallest error resolved |\n|---|---|---|---|---|---|\n";
+  for (const auto& scene : scenes) {
+    const auto& r = references[scene];
+    md << "| " << scene << " | " << r["spp"].get<long long>() << " | " << secs(r["seconds"].get<double>()) << " | "
+       << percent(r["noise_rms"].get<double>()) << " | " << r["pixels"].get<int>() << " | "
+       << percent(r["noise_rms"].get<double>() * std::pow(2.0 / std::max(1, r["pixels"].get<int>()), 0.25)) << " |\n";
+  }
+  md << "\n## At a glance\n\n";
+  for (const auto& scene : scenes) {
+    const Row* fast = nullptr;  // the most accurate measurement of a method other than the reference
+    for (const Row& r : rows)
+      if (r.scene == scene && r.method != "auto" && r.method != "reference" && (!fast || r.measure() < fast->measure())) fast = &r;
+    const Row* five = fastest_within(rows, scene, 0.05);
+    md << "- **" << scene << "**: the most accurate fast method is "
+       << (fast ? fast->method + " (" + compact(fast->settings) + ") at " + percent(fast->measure()) + " in " + secs(fast->seconds) : std::string("none"))
+       << "; under 5% the fastest is " << (five ? five->method + " at " + secs(five->seconds) : std::string("nothing the sweep measured")) << ".\n";
+  }
+  md << "\nThe single-scattering methods (analytic, quadrature, propagation) miss the light scattered more than\n"
+        "once, and every method but the reference lights surfaces with unscattered light only. On scenes\n"
+        "where either matters, the path tracer itself is the fastest way under a tight tolerance.\n";
+  md << "\n## Recommended settings per error level\n\nThe fastest measured method and settings under each error level, per scene (- : none of\n"
+        "the sweep reached it).\n\n| scene | under 10% | under 5% | under 2% | under 1% |\n|---|---|---|---|---|\n";
+  for (const auto& scene : scenes) {
+    md << "| " << scene;
+    for (double t : {0.10, 0.05, 0.02, 0.01}) {
+      const Row* best = fastest_within(rows, scene, t);
+      md << " | " << (best ? best->method + " " + compact(best->settings) + ", " + secs(best->seconds) + " (" + percent(best->measure()) + ")" : "-");
+    }
+    md << " |\n";
+  }
+  md << "\n## Method auto\n\n`--method auto --tolerance T` chooses from the scene alone (core/src/auto.cpp says which\n"
+        "measurement each rule rests on; `--explain` prints the choice and why). Here it is checked against the\n"
+        "reference, and its time against the fastest swept method and settings under the same T.\n\n"
+        "| scene | T | auto chose | seconds | error | under T | fastest under T | auto / fastest |\n|---|---|---|---|---|---|---|---|\n";
+  for (const Row& r : rows) {
+    if (r.method != "auto") continue;
+    const double t = r.settings["tolerance"].get<double>();
+    const Row* best = fastest_within(rows, r.scene, t);
+    char ratio[32] = "-";
+    if (best) std::snprintf(ratio, sizeof ratio, "%.2fx", r.seconds / best->seconds);
+    md << "| " << r.scene << " | " << percent(t) << " | " << r.chosen << " | " << secs(r.seconds) << " | " << percent(r.measure()) << " | "
+       << (r.measure() < t ? "yes" : "**no**") << " | "
+       << (best ? best->method + " " + compact(best->settings) + ", " + secs(best->seconds) : std::string("none in the sweep")) << " | " << ratio
+       << " |\n";
+  }
+  md << "\n## Each scene\n\nError against time, log-log, one curve per method; the black line joins the Pareto front (no other\n"
+        "measurement is both faster and more accurate). The tables list every measurement, the front's in bold.\n";
+  for (const auto& scene : scenes) {
+    md << "\n### " << scene << "\n\n![" << scene << "](trade_" << scene << ".png)\n\n| method | settings | seconds | error | signed mean |\n|---|---|---|---|---|\n";
+    for (const Row& r : rows) {
+      if (r.scene != scene || r.method == "auto") continue;
+      const std::string b = r.pareto ? "**" : "";
+      md << "| " << b << r.method << b << " | " << compact(r.settings) << " | " << secs(r.seconds) << " | " << b << percent(r.measure()) << b
+         << " | " << percent(r.error.signed_mean) << " |\n";
+    }
+  }
+  md << "\nRegenerate everything (references are kept in build/trade/reference and reused):\n\n```sh\nscripts/trade\n```\n\n"
+        "It builds `haze`, runs `haze bench trade --out build/trade --spp " << a.spp << "` and plots with gnuplot into docs/.\n";
+}
+
+int run(const TradeArgs& a) {
+  std::vector<std::filesystem::path> scenes;
+  if (!std::filesystem::is_directory(a.suite)) throw Error("--suite", a.suite, "a directory of scene files");
+  for (const auto& entry : std::filesystem::directory_iterator(a.suite))
+    if (entry.path().extension() == ".json") scenes.push_back(entry.path());
+  std::sort(scenes.begin(), scenes.end());
+  const std::filesystem::path out = a.out;
+  std::filesystem::create_directories(out / "plot");
+  std::filesystem::create_directories(out / "reference");
+
+  // With --method, the other methods' rows of an earlier run stay.
+  std::vector<Row> all;
+  if (a.report_only) {
+    // Rewrite the outputs from an earlier run's rows and references, rendering nothing.
+    if (!std::filesystem::exists(out / "trade.csv")) throw Error("--report-only", (out / "trade.csv").string() + " missing", "an earlier run's output in --out");
+    all = read_rows(out / "trade.csv");
+    std::ifstream summary(out / "trade.json");
+    const nlohmann::json references = nlohmann::json::parse(summary)["references"];
+    std::vector<std::string> names;
+    for (const auto& path : scenes) names.push_back(path.stem().string());
+    write_tradeoffs(out / "TRADEOFFS.md", names, all, references, a);
+    return 0;
+  }
+  auto selected = [&](const std::string& scene) { return a.only.empty() || std::find(a.only.begin(), a.only.end(), scene) != a.only.end(); };
+  if ((!a.method.empty() || !a.only.empty()) && std::filesystem::exists(out / "trade.csv"))
+    for (Row& r : read_rows(out / "trade.csv"))
+      if (!((a.method.empty() || r.method == a.method) && selected(r.scene))) all.push_back(std::move(r));
+  nlohmann::json references = nlohmann::json::object();
+  if (!a.only.empty() && std::filesystem::exists(out / "trade.json")) {
+    std::ifstream previous(out / "trade.json");
+    references = nlohmann::json::parse(previous)["references"];
+  }
+  for (const auto& path : scenes) {
+    const std::string name = path.stem().string();
+    if (!selected(name)) continue;
+    const Scene scene = Scene::load(path);
+    // The reference, kept between runs: its spp and seed are in the file name.
+    const auto ref_path = out / "reference" / (name + "_" + std::to_string(a.spp) + "spp.exr");
+    std::optional<Image> se;
+    Image reference;
+    double ref_seconds = 0.0;
+    if (std::filesystem::exists(ref_path)) {
+      reference = read_exr(ref_path, &se);
+      std::ifstream meta(std::filesystem::path(ref_path).replace_extension(".json"));
+      ref_seconds = nlohmann::json::parse(meta).value("seconds", 0.0);
+    } else {
+      RenderOptions options;
+      options.threads = a.threads;
+      options.settings = {{"spp", a.spp}, {"seed", 1}};
+      ProgressBar bar(name + " reference");
+      options.progress = bar.callback();
+      const auto start = std::chrono::steady_clock::now();
+      RenderResult r = render(scene, "reference", options);
+      ref_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      write_exr(ref_path, r.radiance, &*r.std_error);
+      std::ofstream(std::filesystem::path(ref_path).replace_extension(".json")) << nlohmann::json{{"seconds", ref_seconds}}.dump();
+      reference = r.radiance, se = *r.std_error;
+    }
+    const LitPixelError self = lit_pixel_error(reference, reference, &*se);
+    references[name] = {{"spp", a.spp}, {"seconds", ref_seconds}, {"noise_rms", self.noise_rms}, {"pixels", self.pixels}};
+
+    std::vector<Row> rows;
+    for (const Config& c : sweep()) {
+      if (!a.method.empty() && c.method != a.method) continue;
+      RenderOptions options;
+      options.threads = a.threads;
+      options.cache_dir = default_cache_dir();
+      options.settings = c.settings;
+      Row row{name, c.method, c.settings, 0.0, {}, false, {}};
+      try {
+        const RenderResult r = timed(scene, c.method, options, row.seconds);
+        row.error = lit_pixel_error(r.radiance, reference, &*se);
+      } catch (const Cancelled&) {
+        throw;
+      } catch (const Error& e) {
+        std::fprintf(stderr, "%-15s %-12s %-40s not applicable: %s\n", name.c_str(), c.method.c_str(), compact(c.settings).c_str(), e.what());
+        continue;
+      }
+      std::printf("%-15s %-12s %-40s %10s %8s\n", name.c_str(), c.method.c_str(), compact(c.settings).c_str(), secs(row.seconds).c_str(),
+                  percent(row.measure()).c_str());
+      std::fflush(stdout);
+      rows.push_back(row);
+    }
+    all.insert(all.end(), rows.begin(), rows.end());
+    if (!a.method.empty() && a.method != "auto") continue;
+    for (double tolerance : a.tolerances) {
+      RenderOptions options;
+      options.threads = a.threads;
+      options.cache_dir = default_cache_dir();
+      options.settings = {{"tolerance", tolerance}};
+      Row row{name, "auto", options.settings, 0.0, {}, false, {}};
+      const auto start = std::chrono::steady_clock::now();
+      const RenderResult r = render(scene, "auto", options);  // once: its choice may be a long reference render
+      row.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      row.error = lit_pixel_error(r.radiance, reference, &*se);
+      row.chosen = r.stats["auto"]["method"].get<std::string>() + " " + compact(r.stats["auto"]["settings"]);
+      std::printf("%-15s %-12s %-40s %10s %8s  chose %s\n", name.c_str(), "auto", compact(row.settings).c_str(), secs(row.seconds).c_str(),
+                  percent(row.measure()).c_str(), row.chosen.c_str());
+      std::fflush(stdout);
+      all.push_back(row);
+    }
+  }
+
+  // The Pareto front per scene, over every method but auto (a chooser, not a point of the trade).
+  std::stable_sort(all.begin(), all.end(), [](const Row& x, const Row& y) { return x.scene < y.scene; });
+  for (const auto& path : scenes) {
+    std::vector<Row*> scene_rows;
+    for (Row& r : all)
+      if (r.scene == path.stem().string() && r.method != "auto") scene_rows.push_back(&r);
+    for (Row* r : scene_rows)
+      r->pareto = std::none_of(scene_rows.begin(), scene_rows.end(), [&](const Row* o) {
+        return o != r && o->seconds <= r->seconds && o->measure() <= r->measure() && (o->seconds < r->seconds || o->measure() < r->measure());
+      });
+  }
+  std::ofstream csv(out / "trade.csv");
+  csv << "scene,method,settings,seconds,error_rms_noise_removed,mean_abs,signed_mean,reference_noise_rms,lit_pixels,pareto,auto_chose\n";
+  for (const Row& r : all)
+    csv << r.scene << "," << r.method << ",\"" << compact(r.settings) << "\"," << r.seconds << "," << r.measure() << "," << r.error.mean_abs << ","
+        << r.error.signed_mean << "," << r.error.noise_rms << "," << r.error.pixels << "," << r.pareto << ",\"" << r.chosen << "\"\n";
+  // Plot data: one file per scene and method (seconds, error), and the scene's Pareto front.
+  std::map<std::string, std::ofstream> files;
+  for (const Row& r : all) {
+    if (r.method == "auto") continue;
+    auto& f = files[r.scene + "__" + r.method];
+    if (!f.is_open()) f.open(out / "plot" / (r.scene + "__" + r.method + ".dat"));
+    f << r.seconds << " " << std::max(r.measure(), 1e-4) << "\n";
+  }
+  for (const auto& path : scenes) {
+    std::vector<Row> front;
+    for (const Row& r : all)
+      if (r.scene == path.stem().string() && r.pareto) front.push_back(r);
+    std::sort(front.begin(), front.end(), [](const Row& x, const Row& y) { return x.seconds < y.seconds; });
+    std::ofstream f(out / "plot" / (path.stem().string() + "__pareto.dat"));
+    for (const Row& r : front) f << r.seconds << " " << std::max(r.measure(), 1e-4) << "\n";
+  }
+  std::vector<std::string> names;
+  for (const auto& path : scenes) names.push_back(path.stem().string());
+  write_tradeoffs(out / "TRADEOFFS.md", names, all, references, a);
+  nlohmann::json summary = {{"references", references}, {"rows", all.size()}};
+  std::ofstream(out / "trade.json") << summary.dump(2) << "\n";
+  std::printf("wrote %s (%zu rows)\n", (out / "trade.csv").string().c_str(), all.size());
+  return 0;
+}
+
+}  // namespace
+
+Command add_bench(CLI::App& app) {
+  auto* bench = app.add_subcommand("bench", "Measurements: the speed/accuracy trade of every method");
+  bench->require_subcommand(1);
+  auto* sub = bench->add_subcommand("trade", "Time and error against the reference for every method and setting on the trade suite");
+  auto a = std::make_shared<TradeArgs>();
+  sub->add_option("--method", a->method, "Only this method's sweep");
+  sub->add_option("--out", a->out, "Output directory (CSV, plot data, cached references)")->capture_default_str();
+  sub->add_option("--suite", a->suite, "Directory of the suite's scene files")->capture_default_str();
+  sub->add_option("--spp", a->spp, "The reference's samples per pixel")->capture_default_str()->check(CLI::PositiveNumber);
+  sub->add_option("--threads", a->threads, "Thread cap (0: all cores)")->check(CLI::NonNegativeNumber);
+  sub->add_option("--tolerances", a->tolerances, "The tolerances method auto is run at")->capture_default_str();
+  sub->add_option("--scene", a->only, "Only these scenes of the suite (by file stem); the others' rows stay");
+  sub->add_flag("--report-only", a->report_only, "Rewrite TRADEOFFS.md from the rows in --out, rendering nothing");
+  return {bench, [a] { return run(*a); }};
+}
+
+}  // namespace haze::app

@@ -1,0 +1,275 @@
+// Every SIMD kernel on every Highway target this build carries, beside its scalar reference, and a
+// STREAM-like copy and triad that measure the machine's memory bandwidth in the same run (1 and 2
+// threads). With --markdown FILE it writes docs/PERFORMANCE.md's tables (scripts/perf).
+// Run: build/dev/bench/haze_bench_kernels --benchmark_repetitions=3 --benchmark_report_aggregates_only=true
+#include <haze/core/phase.h>
+#include <haze/simd/dom_sweep.h>
+#include <haze/simd/half.h>
+#include <haze/simd/march_rays.h>
+#include <haze/simd/phase_batch.h>
+#include <haze/simd/sweep_cells.h>
+
+#include <benchmark/benchmark.h>
+#include <hwy/targets.h>
+#include <oneapi/tbb/parallel_for.h>
+#include <oneapi/tbb/task_arena.h>
+
+#include <cmath>
+#include <cstring>
+#include <ctime>
+#include <fstream>
+#include <functional>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace {
+
+using namespace haze;
+
+// ---- STREAM (McCalpin): copy a[i] = b[i] and triad a[i] = b[i] + s c[i] over 3 x 128 MB arrays.
+constexpr size_t kStream = size_t{32} << 20;  // floats per array
+
+void BM_Stream(benchmark::State& state) {
+  const bool triad = state.range(0) == 1;
+  const int threads = static_cast<int>(state.range(1));
+  static std::vector<float> a(kStream, 1.0f), b(kStream, 2.0f), c(kStream, 3.0f);
+  tbb::task_arena arena(threads);
+  const size_t chunk = kStream / 64;
+  for (auto _ : state) {
+    arena.execute([&] {
+      tbb::parallel_for(size_t{0}, size_t{64}, [&](size_t part) {
+        float* __restrict out = a.data() + part * chunk;
+        const float* __restrict x = b.data() + part * chunk;
+        const float* __restrict y = c.data() + part * chunk;
+        if (triad) {
+          for (size_t i = 0; i < chunk; ++i) out[i] = x[i] + 3.0f * y[i];
+        } else {
+          std::memcpy(out, x, chunk * sizeof(float));
+        }
+      });
+    });
+    benchmark::DoNotOptimize(a.data());
+  }
+  // STREAM's convention: copy moves 2 arrays, triad 3 (read, read, write).
+  state.SetBytesProcessed(static_cast<int64_t>(state.iterations() * kStream * sizeof(float) * (triad ? 3 : 2)));
+  state.SetLabel(std::to_string(threads) + " thread" + (threads > 1 ? "s" : ""));
+}
+BENCHMARK(BM_Stream)->Name("stream/copy")->Args({0, 1})->Args({0, 2})->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Stream)->Name("stream/triad")->Args({1, 1})->Args({1, 2})->UseRealTime()->Unit(benchmark::kMillisecond);
+
+// ---- Kernels. Each is registered once per compiled target (the dispatch forced to it) and once
+// as its scalar reference. The kernel reports its own items and bytes per call.
+struct Work {
+  std::function<void()> run;
+  double items = 0.0, bytes = 0.0;  // per call; bytes only for memory-bound kernels
+  std::vector<std::shared_ptr<void>> keep = {};  // buffers the kernel's views point into
+};
+
+std::string target_name(int64_t target) { return hwy::TargetName(target); }
+
+void register_kernel(const std::string& name, const std::function<Work(bool scalar)>& make, bool has_scalar = true) {
+  const std::vector<int64_t> targets = hwy::SupportedAndGeneratedTargets();
+  auto body = [make](benchmark::State& state, int64_t target) {
+    if (target != 0) {
+      hwy::SetSupportedTargetsForTest(target);
+      hwy::GetChosenTarget().Update(hwy::SupportedTargets());
+    }
+    Work work = make(target == 0);
+    for (auto _ : state) work.run();
+    hwy::SetSupportedTargetsForTest(0);
+    hwy::GetChosenTarget().Update(hwy::SupportedTargets());
+    state.SetItemsProcessed(static_cast<int64_t>(static_cast<double>(state.iterations()) * work.items));
+    if (work.bytes > 0.0) state.SetBytesProcessed(static_cast<int64_t>(static_cast<double>(state.iterations()) * work.bytes));
+    state.SetLabel(target == 0 ? "scalar reference" : target_name(target));
+  };
+  for (int64_t t : targets) benchmark::RegisterBenchmark((name + "/" + target_name(t)).c_str(), body, t)->UseRealTime();
+  if (has_scalar) benchmark::RegisterBenchmark((name + "/scalar").c_str(), body, int64_t{0})->UseRealTime();
+}
+
+// HG phase at 4096 cosines (compute-bound: a division, a square root per value).
+Work phase_work(bool scalar) {
+  auto mu = std::make_shared<std::vector<float>>(4096), out = std::make_shared<std::vector<float>>(4096);
+  for (size_t i = 0; i < mu->size(); ++i) (*mu)[i] = -1.0f + 2.0f * static_cast<float>(i) / 4095.0f;
+  const PhaseFunction phase = PhaseFunction::henyey_greenstein(0.7);
+  return {[=] {
+            scalar ? simd::eval_phase_reference(phase, mu->data(), out->data(), mu->size()) : simd::eval_phase(phase, mu->data(), out->data(), mu->size());
+            benchmark::DoNotOptimize(out->data());
+          },
+          4096.0, 0.0};
+}
+
+// float32 -> float16 over 16M values (memory-bound: 4 bytes read, 2 written per value).
+Work half_work(bool scalar) {
+  const size_t n = size_t{16} << 20;
+  auto from = std::make_shared<std::vector<float>>(n, 0.37f);
+  auto to = std::make_shared<std::vector<simd::Half>>(n);
+  return {[=] {
+            scalar ? simd::to_half_reference(from->data(), to->data(), n) : simd::to_half(from->data(), to->data(), n);
+            benchmark::DoNotOptimize(to->data());
+          },
+          static_cast<double>(n), 6.0 * static_cast<double>(n)};
+}
+
+// A 64^3 cloud-like density.
+std::shared_ptr<std::vector<float>> density64() {
+  auto d = std::make_shared<std::vector<float>>(64 * 64 * 64);
+  for (int k = 0; k < 64; ++k)
+    for (int j = 0; j < 64; ++j)
+      for (int i = 0; i < 64; ++i) {
+        const double x = (i - 31.5) / 32.0, y = (j - 31.5) / 32.0, z = (k - 31.5) / 32.0;
+        (*d)[static_cast<size_t>((k * 64 + j) * 64 + i)] = static_cast<float>(std::exp(-3.0 * (x * x + y * y + z * z)) * (1.0 + 0.3 * std::sin(7.0 * x + 5.0 * y)));
+      }
+  return d;
+}
+
+// The optical-depth sweep for a directional light over every x-row of 64^3 cells, in order.
+Work sweep_work(bool scalar) {
+  auto density = density64();
+  auto depth = std::make_shared<std::vector<float>>(density->size()), mean = std::make_shared<std::vector<float>>(density->size());
+  auto v = std::make_shared<simd::SweepVolume>();
+  for (int e = 0; e < 3; ++e) v->n[e] = 64, v->lo[e] = -1.0f, v->h[e] = 2.0f / 64.0f;
+  v->density = density->data(), v->mean = mean->data(), v->directional = true;
+  const float to_light[3] = {0.3f, 0.9f, 0.3f};
+  const float norm = std::sqrt(0.99f);
+  for (int e = 0; e < 3; ++e) v->light[e] = to_light[e] / norm;
+  return {[=] {
+            for (int layer = 63; layer >= 0; --layer)  // y is the dominant axis toward the light
+              for (int k = 0; k < 64; ++k) {
+                const size_t at = static_cast<size_t>((k * 64 + layer) * 64);
+                (scalar ? simd::sweep_cells_reference : simd::sweep_cells)(*v, 0, layer, k, 0, 64, depth->data() + at, mean->data() + at);
+              }
+            benchmark::DoNotOptimize(depth->data());
+          },
+          64.0 * 64.0 * 64.0, 0.0, {density}};
+}
+
+// 256 rays through the 64^3 volume, 2 point lights, step half a cell (items: ray steps).
+Work march_work(bool scalar) {
+  auto density = density64();
+  auto depths = std::make_shared<std::vector<float>>(2 * density->size(), 0.5f);
+  auto lights = std::make_shared<std::vector<simd::MarchLight>>(2);
+  (*lights)[0].position[0] = 1.5f, (*lights)[1].position[1] = 1.5f;
+  auto v = std::make_shared<simd::MarchVolume>();
+  for (int e = 0; e < 3; ++e) v->n[e] = 64, v->lo[e] = -1.0f, v->h[e] = 2.0f / 64.0f;
+  v->density = density->data(), v->depths = depths->data(), v->lights = lights->data(), v->light_count = 2;
+  const size_t n = 256;
+  auto in = std::make_shared<std::vector<float>>(9 * n), out = std::make_shared<std::vector<float>>(6 * n);
+  for (size_t r = 0; r < n; ++r) {
+    const float y = -0.9f + 1.8f * static_cast<float>(r) / static_cast<float>(n);
+    const float values[9] = {-3.0f, y, 0.1f, 1.0f, 0.0f, 0.0f, 2.0f, 1.0f / 64.0f, 128.0f};
+    for (size_t a = 0; a < 9; ++a) (*in)[a * n + r] = values[a];
+  }
+  auto row = [](std::vector<float>& b, size_t a, size_t count) { return b.data() + a * count; };
+  auto packet = std::make_shared<simd::RayPacket>(simd::RayPacket{row(*in, 0, n), row(*in, 1, n), row(*in, 2, n), row(*in, 3, n), row(*in, 4, n),
+                                                                   row(*in, 5, n), row(*in, 6, n), row(*in, 7, n), row(*in, 8, n), n,
+                                                                   {row(*out, 0, n), row(*out, 1, n), row(*out, 2, n)},
+                                                                   {row(*out, 3, n), row(*out, 4, n), row(*out, 5, n)}});
+  const PhaseFunction phase = PhaseFunction::henyey_greenstein(0.4);
+  (void)scalar;  // its reference is the float64 marcher in grids (MarchSettings::scalar), not a kernel
+  return {[=] {
+            simd::march_rays(*v, phase, *packet);
+            benchmark::DoNotOptimize(out->data());
+          },
+          128.0 * static_cast<double>(n), 0.0, {density, depths, lights, in}};
+}
+
+// One DOM row of 64 cells, one octant of 16 directions, 25 terms (items: cell-directions).
+Work dom_work(bool scalar) {
+  const int p = 16, terms = 25, padded = 32, count = 64;
+  auto a = std::make_shared<std::vector<float>>(4 * p), lq = std::make_shared<std::vector<float>>(static_cast<size_t>(terms * p)),
+       q = std::make_shared<std::vector<float>>(static_cast<size_t>(p * padded), 0.0f);
+  for (int d = 0; d < p; ++d) {
+    float sum = 0.0f;
+    for (int e = 0; e < 3; ++e) sum += (*a)[static_cast<size_t>(e * p + d)] = 10.0f + static_cast<float>((d + e) % 5);
+    (*a)[static_cast<size_t>(3 * p + d)] = sum;
+    for (int k = 0; k < terms; ++k) {
+      (*lq)[static_cast<size_t>(k * p + d)] = 0.01f * static_cast<float>((k + d) % 7);
+      (*q)[static_cast<size_t>(d * padded + k)] = 0.02f * static_cast<float>((k * d) % 5);
+    }
+  }
+  auto octant = std::make_shared<simd::DomOctant>(simd::DomOctant{p, terms, padded, a->data(), lq->data(), q->data()});
+  auto density = std::make_shared<std::vector<float>>(count, 1.0f), first = std::make_shared<std::vector<float>>(static_cast<size_t>(count * p), 0.1f);
+  auto m_in = std::make_shared<std::vector<float>>(static_cast<size_t>(count * terms), 0.05f),
+       m_out = std::make_shared<std::vector<float>>(static_cast<size_t>(count * terms));
+  auto x = std::make_shared<std::vector<float>>(p), y = std::make_shared<std::vector<float>>(static_cast<size_t>(count * p)),
+       z = std::make_shared<std::vector<float>>(static_cast<size_t>(count * p)), scratch = std::make_shared<std::vector<float>>(p + padded);
+  auto row = std::make_shared<simd::DomRow>();
+  row->count = count, row->density = density->data(), row->sigma_t_scale = 2.0f, row->albedo = 0.9f;
+  row->first = first->data(), row->first_stride = static_cast<size_t>(p), row->m_in = m_in->data(), row->m_out = m_out->data();
+  row->x_run = x->data(), row->y_row = y->data(), row->z_row = z->data(), row->scratch = scratch->data();
+  return {[=] {
+            (scalar ? simd::dom_sweep_row_reference : simd::dom_sweep_row)(*octant, *row);
+            benchmark::DoNotOptimize(m_out->data());
+          },
+          static_cast<double>(count * p), 0.0, {a, lq, q, density, first, m_in, x, y, z, scratch}};
+}
+
+// ---- --markdown: the medians (or single runs) as tables.
+class Collector : public benchmark::ConsoleReporter {
+ public:
+  struct Entry {
+    std::string name, label;
+    double seconds = 0.0, items = 0.0, bytes = 0.0;
+  };
+  std::vector<Entry> entries;
+  void ReportRuns(const std::vector<Run>& runs) override {
+    ConsoleReporter::ReportRuns(runs);
+    for (const Run& r : runs) {
+      if (r.run_type == Run::RT_Aggregate && r.aggregate_name != "median") continue;
+      Entry e{r.run_name.function_name + (r.run_name.args.empty() ? "" : "/" + r.run_name.args), r.report_label,
+              r.GetAdjustedRealTime() * 1e-9 * (r.time_unit == benchmark::kMillisecond ? 1e6 : r.time_unit == benchmark::kMicrosecond ? 1e3 : 1.0)};
+      if (auto it = r.counters.find("items_per_second"); it != r.counters.end()) e.items = it->second.value;
+      if (auto it = r.counters.find("bytes_per_second"); it != r.counters.end()) e.bytes = it->second.value;
+      entries.push_back(e);
+    }
+  }
+};
+
+std::string fmt(const char* f, double v) {
+  char b[64];
+  std::snprintf(b, sizeof b, f, v);
+  return b;
+}
+
+void write_markdown(const std::string& file, const std::vector<Collector::Entry>& entries) {
+  std::map<int, double> copy;  // threads -> bytes/s
+  for (const auto& e : entries)
+    if (e.name.rfind("stream/copy", 0) == 0) copy[e.label[0] - '0'] = e.bytes;
+  std::ofstream md(file);
+  md << "| benchmark | target | time per call | throughput | bandwidth | of STREAM copy (1 thread) |\n|---|---|---|---|---|---|\n";
+  for (const auto& e : entries) {
+    const double t = e.seconds;
+    const std::string time = t < 1e-3 ? fmt("%.1f us", t * 1e6) : fmt("%.2f ms", t * 1e3);
+    const std::string items = e.items > 0 ? fmt("%.3g items/s", e.items) : "";
+    const std::string bytes = e.bytes > 0 ? fmt("%.1f GB/s", e.bytes * 1e-9) : "";
+    const std::string share = e.bytes > 0 && copy.count(1) && e.name.rfind("stream", 0) != 0 ? fmt("%.0f%%", 100.0 * e.bytes / copy[1]) : "";
+    md << "| " << e.name << " | " << e.label << " | " << time << " | " << items << " | " << bytes << " | " << share << " |\n";
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string markdown;
+  std::vector<char*> args;
+  for (int i = 0; i < argc; ++i) {
+    if (std::string(argv[i]) == "--markdown" && i + 1 < argc) {
+      markdown = argv[++i];
+      continue;
+    }
+    args.push_back(argv[i]);
+  }
+  int count = static_cast<int>(args.size());
+  register_kernel("phase_eval/hg", phase_work);
+  register_kernel("to_half", half_work);
+  register_kernel("sweep_cells/64^3", sweep_work);
+  register_kernel("march_rays/256_rays", march_work, false);
+  register_kernel("dom_sweep_row/64_cells", dom_work);
+  benchmark::Initialize(&count, args.data());
+  Collector collector;
+  benchmark::RunSpecifiedBenchmarks(&collector);
+  if (!markdown.empty()) write_markdown(markdown, collector.entries);
+  benchmark::Shutdown();
+  return 0;
+}

@@ -1,0 +1,89 @@
+// Method auto: the scene features it reads (a closed-form optical diameter), the rules they drive,
+// its refusal of a bad tolerance, and that the render follows the choice.
+#include <haze/core/auto.h>
+#include <haze/core/error.h>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace haze {
+namespace {
+
+// A box of constant density 1, 4 wide along x, 2 along y and z, with sigma_t and albedo given.
+Scene box_scene(double sigma_t, double albedo) {
+  Scene scene;
+  scene.camera.position = Vec3(0.0, 0.0, 6.0);
+  scene.camera.width_px = scene.camera.height_px = 12;
+  MediumDesc medium;
+  medium.bounds = {Vec3(-2.0, -1.0, -1.0), Vec3(2.0, 1.0, 1.0)};
+  medium.sigma_t = Rgb(sigma_t * 0.5, sigma_t, sigma_t * 0.8);
+  medium.albedo = Rgb(albedo);
+  scene.medium = medium;
+  scene.lights.push_back(PointLight{Vec3(0.0, 2.0, 0.0), Rgb(5.0)});
+  return scene;
+}
+
+TEST(AutoMethod, OpticalDiameterAndMultipleShareAreTheClosedForms) {
+  const SceneFeatures f = scene_features(box_scene(0.5, 0.8));
+  EXPECT_TRUE(f.homogeneous && f.bounded && !f.particles && !f.surfaces);
+  EXPECT_NEAR(f.optical_diameter, 4.0 * 0.5, 1e-9);  // the longest axis (x) times the largest sigma_t
+  EXPECT_NEAR(f.multiple_share, 0.8 * (1.0 - std::exp(-1.0)), 1e-9);
+}
+
+TEST(AutoMethod, ThinMediaGetSingleScatteringByTheirLights) {
+  Scene scene = box_scene(0.002, 0.5);  // share 0.2%: under half of any tolerance >= 0.4%
+  EXPECT_EQ(choose_method(scene, 0.01).method, "analytic");
+  scene.lights.push_back(DirectionalLight{});
+  EXPECT_EQ(choose_method(scene, 0.01).method, "propagation");
+  scene.lights.push_back(SkyLight{});
+  EXPECT_EQ(choose_method(scene, 0.01).method, "quadrature");
+  // The same medium at a tolerance under twice its share needs multiple scattering: a grid solve.
+  EXPECT_EQ(choose_method(box_scene(0.05, 0.9), 0.05).method, "dom");
+}
+
+TEST(AutoMethod, DomResolutionGrowsAsTheToleranceShrinksThenTheReferenceTakesOver) {
+  const Scene scene = box_scene(3.0, 0.99);
+  const AutoChoice loose = choose_method(scene, 0.1), mid = choose_method(scene, 0.03), tight = choose_method(scene, 0.02);
+  ASSERT_EQ(loose.method, "dom");
+  ASSERT_EQ(mid.method, "dom");
+  EXPECT_GT(mid.settings["resolution"].get<int>(), loose.settings["resolution"].get<int>());
+  // Under dom's measured 2.0% floor: the path tracer.
+  EXPECT_EQ(tight.method, "reference");
+}
+
+TEST(AutoMethod, SurfacesInAScatteringMediumGetTheReferenceWithMoreSamplesForLessError) {
+  Scene scene = box_scene(0.5, 0.8);
+  scene.surfaces.push_back(Surface{Plane{Vec3(0.0, -1.0, 0.0), Vec3(0.0, 1.0, 0.0)}, Rgb(0.5), Rgb(0.0), 1.0});
+  const AutoChoice loose = choose_method(scene, 0.1), tight = choose_method(scene, 0.02);
+  ASSERT_EQ(loose.method, "reference");
+  ASSERT_EQ(tight.method, "reference");
+  // Noise falls as 1 / sqrt(spp): 5x less error needs about 25x the samples (powers of two: 16 to 32).
+  const double ratio = tight.settings["spp"].get<double>() / loose.settings["spp"].get<double>();
+  EXPECT_GE(ratio, 16.0);
+  EXPECT_LE(ratio, 32.0);
+  EXPECT_FALSE(tight.why.empty());
+}
+
+TEST(AutoMethod, RendersWithItsChoiceAndRefusesABadTolerance) {
+  const Scene scene = box_scene(0.002, 0.5);
+  RenderOptions options;
+  options.settings = {{"tolerance", 0.02}};
+  const RenderResult r = render(scene, "auto", options);
+  EXPECT_EQ(r.stats["auto"]["method"], "analytic");
+  RenderOptions chosen;
+  chosen.settings = choose_method(scene, 0.02).settings;
+  const RenderResult direct = render(scene, "analytic", chosen);
+  EXPECT_EQ(r.radiance.data(), direct.radiance.data());
+  try {
+    choose_method(scene, 0.0);
+    FAIL() << "accepted tolerance 0";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.field(), "tolerance");
+  }
+  options.settings = {{"tolerance", 2.0}};
+  EXPECT_THROW(render(scene, "auto", options), Error);
+}
+
+}  // namespace
+}  // namespace haze
