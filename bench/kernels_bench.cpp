@@ -3,6 +3,9 @@
 // threads). With --markdown FILE it writes docs/PERFORMANCE.md's tables (scripts/perf).
 // Run: build/dev/bench/haze_bench_kernels --benchmark_repetitions=3 --benchmark_report_aggregates_only=true
 #include <haze/core/phase.h>
+#include <haze/grids/dom.h>
+#include <haze/grids/optical_depth.h>
+#include <haze/grids/propagation.h>
 #include <haze/simd/dom_sweep.h>
 #include <haze/simd/half.h>
 #include <haze/simd/march_rays.h>
@@ -204,6 +207,67 @@ Work dom_work(bool scalar) {
           },
           static_cast<double>(count * p), 0.0, {a, lq, q, density, first, m_in, x, y, z, scratch}};
 }
+
+// ---- Solver steps at 1 and 2 threads, on the 64^3 density with 2 point lights and the sun.
+struct Solver {
+  Scene scene;
+  grids::ExtinctionVolume volume{grids::DenseGrid({64, 64, 64}, {Vec3(-1.0), Vec3(1.0)}), Rgb(4.0), Rgb(0.9), PhaseFunction::henyey_greenstein(0.5)};
+  std::vector<grids::DenseGrid> depths;
+  Solver() {
+    volume.density.values() = *density64();
+    scene.camera.position = Vec3(0.3, 0.4, 3.5);
+    scene.camera.width_px = scene.camera.height_px = 256;
+    scene.lights = {PointLight{Vec3(1.5, 0.5, 0.2), Rgb(3.0)}, PointLight{Vec3(-0.4, 1.6, 0.9), Rgb(2.0)},
+                    DirectionalLight{glm::normalize(Vec3(0.3, -0.9, -0.3)), Rgb(1.0)}};
+    depths = grids::optical_depths(volume.density, scene.lights);
+  }
+};
+const Solver& solver() {
+  static const Solver s;
+  return s;
+}
+
+// The three lights' optical-depth volumes by the SIMD sweep (items: cells x lights).
+void BM_OpticalDepths(benchmark::State& state) {
+  grids::DepthOptions options;
+  options.threads = static_cast<int>(state.range(0));
+  for (auto _ : state) benchmark::DoNotOptimize(grids::optical_depths(solver().volume.density, solver().scene.lights, options));
+  state.SetItemsProcessed(static_cast<int64_t>(state.iterations()) * 64 * 64 * 64 * 3);
+  state.SetLabel(std::to_string(options.threads) + " thread" + (options.threads > 1 ? "s" : ""));
+}
+BENCHMARK(BM_OpticalDepths)->Name("solver/optical_depths_64^3_3_lights")->Arg(1)->Arg(2)->UseRealTime()->Unit(benchmark::kMillisecond);
+
+// The SIMD ray march of a 256 x 256 image through the same fields (items: pixels).
+void BM_MarchImage(benchmark::State& state) {
+  RenderOptions options;
+  options.threads = static_cast<int>(state.range(0));
+  for (auto _ : state) benchmark::DoNotOptimize(grids::march_image(solver().scene, solver().volume, solver().depths, {}, options));
+  state.SetItemsProcessed(static_cast<int64_t>(state.iterations()) * 256 * 256);
+  state.SetLabel(std::to_string(options.threads) + " thread" + (options.threads > 1 ? "s" : ""));
+}
+BENCHMARK(BM_MarchImage)->Name("solver/march_image_256^2")->Arg(1)->Arg(2)->UseRealTime()->Unit(benchmark::kMillisecond);
+
+// Ten DOM source iterations on a 32^3 grid, 128 directions, 25 terms (items: cell-directions swept).
+void BM_DomIterations(benchmark::State& state) {
+  static const grids::ExtinctionVolume coarse = [] {
+    grids::ExtinctionVolume v = solver().volume;
+    v.density = grids::DenseGrid({32, 32, 32}, v.density.bounds());
+    for (int k = 0; k < 32; ++k)
+      for (int j = 0; j < 32; ++j)
+        for (int i = 0; i < 32; ++i) v.density.at(i, j, k) = solver().volume.density.at(2 * i, 2 * j, 2 * k);
+    return v;
+  }();
+  static const std::vector<grids::DenseGrid> depths = grids::optical_depths(coarse.density, solver().scene.lights);
+  grids::DomSettings settings;
+  settings.threads = static_cast<int>(state.range(0));
+  settings.accelerator = grids::DomAccelerator::none;
+  settings.max_iterations = 10;
+  settings.tolerance = 1e-9;
+  for (auto _ : state) benchmark::DoNotOptimize(grids::solve_dom(coarse, solver().scene.lights, depths, settings));
+  state.SetItemsProcessed(static_cast<int64_t>(state.iterations()) * 32 * 32 * 32 * 128 * 10);
+  state.SetLabel(std::to_string(settings.threads) + " thread" + (settings.threads > 1 ? "s" : "") + ", phase matrix and first collision included");
+}
+BENCHMARK(BM_DomIterations)->Name("solver/dom_10_iterations_32^3_D128")->Arg(1)->Arg(2)->UseRealTime()->Unit(benchmark::kMillisecond);
 
 // ---- --markdown: the medians (or single runs) as tables.
 class Collector : public benchmark::ConsoleReporter {
