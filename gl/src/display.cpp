@@ -3,6 +3,7 @@
 
 #include <haze/core/error.h>
 #include <haze/core/progress.h>
+#include <haze/simd/phase_params.h>
 
 #include "api.h"
 #include "march_shader.h"
@@ -145,47 +146,26 @@ struct VolumeDisplay::Impl {
     set("background", scene.background);
   }
 
-  // The phase function as the SIMD kernels write it (simd/src/phase_params.h), or its table.
+  // The phase function in the SIMD kernels' constants (haze/simd/phase_params.h), or its table.
   void set_phase() {
-    int lobes = 0;
-    float c0 = f(kInv4Pi), c2 = 0.0f, k[2] = {0, 0}, a[2] = {1, 1}, b[2] = {0, 0}, s[2] = {1, 1};
-    auto lobe = [&](int l, double g, double weight) {
-      k[l] = f(weight * (1.0 - g * g) * kInv4Pi), a[l] = f((1.0 - std::abs(g)) * (1.0 - std::abs(g)));
-      b[l] = f(2.0 * std::abs(g)), s[l] = g < 0.0 ? -1.0f : 1.0f;
-    };
-    switch (phase.type()) {
-      case PhaseType::isotropic: break;
-      case PhaseType::rayleigh: c0 = c2 = f(3.0 / (16.0 * kPi)); break;
-      case PhaseType::henyey_greenstein:
-        lobes = 1, c0 = 1.0f, lobe(0, phase.parameters<PhaseFunction::HenyeyGreenstein>()->g, 1.0);
-        break;
-      case PhaseType::cornette_shanks: {
-        const double g = phase.parameters<PhaseFunction::CornetteShanks>()->g;
-        lobes = 1, lobe(0, g, 1.0), c0 = c2 = f(1.5 / (2.0 + g * g));
-        break;
-      }
-      case PhaseType::double_hg: {
-        const auto* m = phase.parameters<PhaseFunction::DoubleHg>();
-        lobes = 2, c0 = 1.0f, lobe(0, m->g1, m->w), lobe(1, m->g2, 1.0 - m->w);
-        break;
-      }
-      case PhaseType::tabulated: {
-        const std::vector<double>& table = phase.parameters<PhaseFunction::Tabulated>()->values;
-        std::vector<float> values(table.begin(), table.end());
-        phase_table.emplace(Texture::plane(static_cast<int>(values.size()), 1, 1, TexelFormat::float32));
-        phase_table->upload(values);
-        lobes = -1;
-        gl.Uniform1i(at("phase_table_size"), static_cast<int>(values.size()));
-        break;
-      }
+    simd::PhaseParams p;
+    int lobes = -1;
+    if (simd::params_for(phase, p)) {
+      lobes = p.lobes;
+    } else {
+      const std::vector<double>& table = phase.parameters<PhaseFunction::Tabulated>()->values;
+      std::vector<float> values(table.begin(), table.end());
+      phase_table.emplace(Texture::plane(static_cast<int>(values.size()), 1, 1, TexelFormat::float32));
+      phase_table->upload(values);
+      gl.Uniform1i(at("phase_table_size"), static_cast<int>(values.size()));
     }
     gl.Uniform1i(at("phase_lobes"), lobes);
-    gl.Uniform1f(at("phase_c0"), c0);
-    gl.Uniform1f(at("phase_c2"), c2);
-    gl.Uniform2f(at("phase_k"), k[0], k[1]);
-    gl.Uniform2f(at("phase_a"), a[0], a[1]);
-    gl.Uniform2f(at("phase_b"), b[0], b[1]);
-    gl.Uniform2f(at("phase_s"), s[0], s[1]);
+    gl.Uniform1f(at("phase_c0"), p.c0);
+    gl.Uniform1f(at("phase_c2"), p.c2);
+    gl.Uniform2f(at("phase_k"), p.k[0], p.k[1]);
+    gl.Uniform2f(at("phase_a"), p.a[0], p.a[1]);
+    gl.Uniform2f(at("phase_b"), p.b[0], p.b[1]);
+    gl.Uniform2f(at("phase_s"), p.s[0], p.s[1]);
   }
 
   void set_lights() {

@@ -1,5 +1,5 @@
 // Per-target ray-march kernel (Highway: included once per target by foreach_target.h).
-#include "phase_params.h"
+#include <haze/simd/phase_params.h>
 
 #if defined(HAZE_SIMD_MARCH_RAYS_INL_H_) == defined(HWY_TARGET_TOGGLE)
 #ifdef HAZE_SIMD_MARCH_RAYS_INL_H_
@@ -23,7 +23,7 @@ namespace hn = hwy::HWY_NAMESPACE;
 
 // One vector of rays starting at ray `first` (lanes past the end repeat the last ray), `C` channels.
 template <int C, class D>
-HWY_INLINE void MarchVector(D d, const MarchVolume& v, const internal::PhaseParams& phase, const RayPacket& rays, size_t first,
+HWY_INLINE void MarchVector(D d, const MarchVolume& v, const PhaseParams& phase, const RayPacket& rays, size_t first,
                             size_t last, float* HWY_RESTRICT radiance_out, float* HWY_RESTRICT transmittance_out) {
   using V = hn::Vec<D>;
   const hn::RebindToSigned<D> di;
@@ -115,7 +115,7 @@ HWY_INLINE void MarchVector(D d, const MarchVolume& v, const internal::PhasePara
 }
 
 template <int C>
-HWY_INLINE void MarchAll(const MarchVolume& v, const internal::PhaseParams& phase, const RayPacket& rays) {
+HWY_INLINE void MarchAll(const MarchVolume& v, const PhaseParams& phase, const RayPacket& rays) {
   const hn::ScalableTag<float> d;
   const size_t lanes = hn::Lanes(d);
   HWY_ALIGN float radiance[3 * hn::MaxLanes(d)], transmittance[3 * hn::MaxLanes(d)];
@@ -129,7 +129,7 @@ HWY_INLINE void MarchAll(const MarchVolume& v, const internal::PhaseParams& phas
   }
 }
 
-HWY_NOINLINE void MarchRays(const MarchVolume& v, const internal::PhaseParams& phase, const RayPacket& rays) {
+HWY_NOINLINE void MarchRays(const MarchVolume& v, const PhaseParams& phase, const RayPacket& rays) {
   if (v.channels == 1) {
     MarchAll<1>(v, phase, rays);
   } else {

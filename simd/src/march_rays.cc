@@ -15,13 +15,13 @@ namespace haze::simd {
 HWY_EXPORT(MarchRays);
 
 bool march_supported(const PhaseFunction& phase) {
-  internal::PhaseParams p;
-  return internal::params_for(phase, p);
+  PhaseParams p;
+  return params_for(phase, p);
 }
 
 void march_rays(const MarchVolume& volume, const PhaseFunction& phase, const RayPacket& rays) {
-  internal::PhaseParams p;
-  if (!internal::params_for(phase, p)) throw Error("phase", phase.name(), "an analytic phase function for the SIMD marcher");
+  PhaseParams p;
+  if (!params_for(phase, p)) throw Error("phase", phase.name(), "an analytic phase function for the SIMD marcher");
   HWY_DYNAMIC_DISPATCH(MarchRays)(volume, p, rays);
 }
 

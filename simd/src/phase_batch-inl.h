@@ -1,5 +1,5 @@
 // Per-target phase evaluation (Highway: included once per target by foreach_target.h).
-#include "phase_params.h"
+#include <haze/simd/phase_params.h>
 
 #if defined(HAZE_SIMD_PHASE_BATCH_INL_H_) == defined(HWY_TARGET_TOGGLE)
 #ifdef HAZE_SIMD_PHASE_BATCH_INL_H_
@@ -17,7 +17,7 @@ namespace haze::simd::HWY_NAMESPACE {
 namespace hn = hwy::HWY_NAMESPACE;
 
 template <class D, class V>
-HWY_INLINE V EvalPhase(D d, const internal::PhaseParams& p, V mu) {
+HWY_INLINE V EvalPhase(D d, const PhaseParams& p, V mu) {
   V poly = hn::MulAdd(hn::Set(d, p.c2), hn::Mul(mu, mu), hn::Set(d, p.c0));
   if (p.lobes == 0) return poly;
   V sum = hn::Zero(d);
@@ -30,7 +30,7 @@ HWY_INLINE V EvalPhase(D d, const internal::PhaseParams& p, V mu) {
 }
 
 // inline: march_rays-inl.h includes this header too.
-inline HWY_NOINLINE void EvalPhaseBatch(const internal::PhaseParams& p, const float* HWY_RESTRICT mu, float* HWY_RESTRICT out,
+inline HWY_NOINLINE void EvalPhaseBatch(const PhaseParams& p, const float* HWY_RESTRICT mu, float* HWY_RESTRICT out,
                                  size_t count) {
   const hn::ScalableTag<float> d;
   const size_t lanes = hn::Lanes(d);

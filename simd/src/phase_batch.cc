@@ -17,7 +17,7 @@ HWY_EXPORT(EvalPhaseBatch);
 
 namespace {
 
-void set_lobe(internal::PhaseParams& p, int l, double g, double weight) {
+void set_lobe(PhaseParams& p, int l, double g, double weight) {
   p.k[l] = static_cast<float>(weight * (1.0 - g * g) * kInv4Pi);
   p.a[l] = static_cast<float>((1.0 - std::abs(g)) * (1.0 - std::abs(g)));
   p.b[l] = static_cast<float>(2.0 * std::abs(g));
@@ -26,7 +26,7 @@ void set_lobe(internal::PhaseParams& p, int l, double g, double weight) {
 
 }  // namespace
 
-bool internal::params_for(const PhaseFunction& phase, internal::PhaseParams& p) {
+bool params_for(const PhaseFunction& phase, PhaseParams& p) {
   switch (phase.type()) {
     case PhaseType::isotropic:
       p.c0 = static_cast<float>(kInv4Pi);
@@ -64,8 +64,8 @@ void eval_phase_reference(const PhaseFunction& phase, const float* cos_theta, fl
 }
 
 void eval_phase(const PhaseFunction& phase, const float* cos_theta, float* out, size_t count) {
-  internal::PhaseParams p;
-  if (!internal::params_for(phase, p)) return eval_phase_reference(phase, cos_theta, out, count);
+  PhaseParams p;
+  if (!params_for(phase, p)) return eval_phase_reference(phase, cos_theta, out, count);
   HWY_DYNAMIC_DISPATCH(EvalPhaseBatch)(p, cos_theta, out, count);
 }
 

@@ -1,9 +1,10 @@
-// Float constants of an analytic phase function, shared by every SIMD target (internal).
+// Float constants of an analytic phase function: shared by every SIMD target, and by the GL
+// display's shader uniforms (gl/src/display.cpp).
 #pragma once
 
 #include <haze/core/phase.h>
 
-namespace haze::simd::internal {
+namespace haze::simd {
 
 // Every analytic phase function is written as
 // p = [c0 + c2 mu^2] * [w1 k1 / d1^(3/2) + w2 k2 / d2^(3/2)] with d = a + b (1 - s mu), or a
@@ -22,4 +23,4 @@ struct PhaseParams {
 // Float constants for an analytic phase function; false for a tabulated one (phase_batch.cc).
 bool params_for(const PhaseFunction& phase, PhaseParams& p);
 
-}  // namespace haze::simd::internal
+}  // namespace haze::simd
