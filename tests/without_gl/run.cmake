@@ -1,12 +1,6 @@
 # HAZE_WITH_GL=OFF: configures the source tree without the GL module (and without benchmarks),
 # builds it and runs its own test suite. Arguments: -DSOURCE_DIR -DWORK_DIR -DJOBS.
-function(run)
-  execute_process(COMMAND ${ARGN} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
-  if(NOT rc EQUAL 0)
-    message(FATAL_ERROR "failed (${rc}): ${ARGN}\n${out}\n${err}")
-  endif()
-  set(last_output "${out}" PARENT_SCOPE)
-endfunction()
+include(${CMAKE_CURRENT_LIST_DIR}/../run_step.cmake)
 run(${CMAKE_COMMAND} -S ${SOURCE_DIR} -B ${WORK_DIR} -DCMAKE_BUILD_TYPE=Release -DHAZE_WITH_GL=OFF
     -DHAZE_BUILD_BENCH=OFF -DHAZE_WERROR=ON)
 run(${CMAKE_COMMAND} --build ${WORK_DIR} -j ${JOBS})
