@@ -223,16 +223,13 @@ void write_tradeoffs(const std::filesystem::path& file, const std::vector<std::s
 }
 
 int run(const TradeArgs& a) {
-  std::vector<std::filesystem::path> scenes;
-  if (!std::filesystem::is_directory(a.suite)) throw Error("--suite", a.suite, "a directory of scene files");
-  for (const auto& entry : std::filesystem::directory_iterator(a.suite))
-    if (entry.path().extension() == ".json") scenes.push_back(entry.path());
-  std::sort(scenes.begin(), scenes.end());
+  const std::vector<std::filesystem::path> scenes = scene_files(a.suite, "--suite");
+  std::vector<std::string> names;
+  for (const auto& path : scenes) names.push_back(path.stem().string());
   const std::filesystem::path out = a.out;
   std::filesystem::create_directories(out / "plot");
   std::filesystem::create_directories(out / "reference");
 
-  // With --method, the other methods' rows of an earlier run stay.
   std::vector<Row> all;
   if (a.report_only) {
     // Rewrite the outputs from an earlier run's rows and references, rendering nothing.
@@ -240,11 +237,10 @@ int run(const TradeArgs& a) {
     all = read_rows(out / "trade.csv");
     std::ifstream summary(out / "trade.json");
     const nlohmann::json references = nlohmann::json::parse(summary)["references"];
-    std::vector<std::string> names;
-    for (const auto& path : scenes) names.push_back(path.stem().string());
     write_tradeoffs(out / "TRADEOFFS.md", names, all, references, a);
     return 0;
   }
+  // With --method or --scene, the other rows of an earlier run stay.
   auto selected = [&](const std::string& scene) { return a.only.empty() || std::find(a.only.begin(), a.only.end(), scene) != a.only.end(); };
   if ((!a.method.empty() || !a.only.empty()) && std::filesystem::exists(out / "trade.csv"))
     for (Row& r : read_rows(out / "trade.csv"))
@@ -327,10 +323,10 @@ int run(const TradeArgs& a) {
 
   // The Pareto front per scene, over every method but auto (a chooser, not a point of the trade).
   std::stable_sort(all.begin(), all.end(), [](const Row& x, const Row& y) { return x.scene < y.scene; });
-  for (const auto& path : scenes) {
+  for (const std::string& name : names) {
     std::vector<Row*> scene_rows;
     for (Row& r : all)
-      if (r.scene == path.stem().string() && r.method != "auto") scene_rows.push_back(&r);
+      if (r.scene == name && r.method != "auto") scene_rows.push_back(&r);
     for (Row* r : scene_rows)
       r->pareto = std::none_of(scene_rows.begin(), scene_rows.end(), [&](const Row* o) {
         return o != r && o->seconds <= r->seconds && o->measure() <= r->measure() && (o->seconds < r->seconds || o->measure() < r->measure());
@@ -349,16 +345,14 @@ int run(const TradeArgs& a) {
     if (!f.is_open()) f.open(out / "plot" / (r.scene + "__" + r.method + ".dat"));
     f << r.seconds << " " << std::max(r.measure(), 1e-4) << "\n";
   }
-  for (const auto& path : scenes) {
+  for (const std::string& name : names) {
     std::vector<Row> front;
     for (const Row& r : all)
-      if (r.scene == path.stem().string() && r.pareto) front.push_back(r);
+      if (r.scene == name && r.pareto) front.push_back(r);
     std::sort(front.begin(), front.end(), [](const Row& x, const Row& y) { return x.seconds < y.seconds; });
-    std::ofstream f(out / "plot" / (path.stem().string() + "__pareto.dat"));
+    std::ofstream f(out / "plot" / (name + "__pareto.dat"));
     for (const Row& r : front) f << r.seconds << " " << std::max(r.measure(), 1e-4) << "\n";
   }
-  std::vector<std::string> names;
-  for (const auto& path : scenes) names.push_back(path.stem().string());
   write_tradeoffs(out / "TRADEOFFS.md", names, all, references, a);
   nlohmann::json summary = {{"references", references}, {"rows", all.size()}};
   std::ofstream(out / "trade.json") << summary.dump(2) << "\n";

@@ -5,11 +5,22 @@
 
 #include <haze/core/error.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <iostream>
 
 namespace haze::app {
+
+std::vector<std::filesystem::path> scene_files(const std::string& directory, const std::string& option) {
+  std::vector<std::filesystem::path> scenes;
+  if (!std::filesystem::is_directory(directory)) throw Error(option, directory, "a directory of scene files");
+  for (const auto& entry : std::filesystem::directory_iterator(directory))
+    if (entry.path().extension() == ".json") scenes.push_back(entry.path());
+  std::sort(scenes.begin(), scenes.end());
+  if (scenes.empty()) throw Error(option, directory, "at least one .json scene");
+  return scenes;
+}
 
 namespace {
 
@@ -20,12 +31,7 @@ struct DemoArgs {
 };
 
 int run(const DemoArgs& a) {
-  std::vector<std::filesystem::path> scenes;
-  if (!std::filesystem::is_directory(a.examples)) throw Error("--examples", a.examples, "a directory of scene files");
-  for (const auto& entry : std::filesystem::directory_iterator(a.examples))
-    if (entry.path().extension() == ".json") scenes.push_back(entry.path());
-  std::sort(scenes.begin(), scenes.end());
-  if (scenes.empty()) throw Error("--examples", a.examples, "at least one .json scene");
+  const std::vector<std::filesystem::path> scenes = scene_files(a.examples, "--examples");
 
   auto methods = registered_methods();
   // auto is a chooser, not a method of its own: the demo shows the methods it chooses from.

@@ -7,6 +7,8 @@
 #include <nlohmann/json.hpp>
 
 #include <filesystem>
+#include <string>
+#include <vector>
 
 #include <functional>
 
@@ -34,6 +36,10 @@ nlohmann::json save_result(const RenderResult& result, const std::string& method
 // dom), shown by haze::gl's ray-march display in a headless context, read back. Throws
 // haze::Error for another method, or when the build has no GL (HAZE_WITH_GL=OFF).
 RenderResult render_gl(const Scene& scene, const std::string& method, const RenderOptions& options);
+
+// The .json scene files in a directory, sorted; throws haze::Error naming `option` when it is not
+// a directory or holds none.
+std::vector<std::filesystem::path> scene_files(const std::string& directory, const std::string& option);
 
 // Registers every module's methods with core's registry (core's own are always there).
 void register_all_methods();
