@@ -1,6 +1,7 @@
 #include "builtin_methods.h"
 
 #include <haze/core/error.h>
+#include <haze/core/light_culling.h>
 #include <haze/core/method.h>
 
 #include <algorithm>
@@ -79,6 +80,27 @@ std::filesystem::path default_cache_dir() {
   return std::filesystem::temp_directory_path() / "haze";
 }
 
+namespace {
+
+// The method on the scene without the lights that reach nothing (light_culling.h), which the
+// stats list. A scene whose lights all reach nothing renders as it is.
+RenderResult render_culled(const Method& method, const Scene& scene, const RenderOptions& options) {
+  const std::vector<CulledLight> culled = culled_lights(scene);
+  if (culled.empty() || culled.size() == scene.lights.size()) return method.render(scene, options);
+  Scene kept = scene;
+  kept.lights.clear();
+  nlohmann::json listed = nlohmann::json::array();
+  for (size_t i = 0, c = 0; i < scene.lights.size(); ++i) {
+    if (c < culled.size() && culled[c].index == i) listed.push_back({{"index", i}, {"why", culled[c++].why}});
+    else kept.lights.push_back(scene.lights[i]);
+  }
+  RenderResult result = method.render(kept, options);
+  result.stats["culled_lights"] = listed;
+  return result;
+}
+
+}  // namespace
+
 RenderResult render(const Scene& scene, const std::string& method_name, RenderOptions options) {
   std::string name = method_name.empty() ? scene.method_name() : method_name;
   if (name.empty()) throw Error("method.name", "missing", "a method named by the scene or the caller");
@@ -103,11 +125,11 @@ RenderResult render(const Scene& scene, const std::string& method_name, RenderOp
       Scene converted = scene;
       converted.medium = factory(scene, settings);
       options.settings = std::move(settings);
-      return method->render(converted, options);
+      return render_culled(*method, converted, options);
     }
   }
   options.settings = std::move(settings);
-  return method->render(scene, options);
+  return render_culled(*method, scene, options);
 }
 
 }  // namespace haze

@@ -189,6 +189,7 @@ DomFields dom_fields(const Scene& scene, const RenderOptions& options) {
                   {"iterations", solved.iterations},
                   {"converged", solved.converged},
                   {"final_change", solved.changes.empty() ? 0.0 : solved.changes.back()},
+                  {"skipped_fraction", solved.skipped_fraction},
                   {"memory_bytes", solved.bytes},
                   {"depth_seconds", depth_seconds},
                   {"solve_seconds", solve_seconds}};

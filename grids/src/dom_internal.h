@@ -65,6 +65,8 @@ class Transport {
 
   // Wall time spent in sweep() and paper() so far.
   double seconds() const { return seconds_; }
+  // The share of cell-octant visits sweep() skipped so far (empty cells no radiance reaches yet).
+  double skipped_fraction() const { return cells_visited_ > 0 ? static_cast<double>(cells_skipped_) / static_cast<double>(cells_visited_) : 0.0; }
 
  private:
   std::array<int, 3> n_;
@@ -74,6 +76,7 @@ class Transport {
   std::vector<float> matrix_;       // [i * D + j]: P between regrouped directions i and j, when full_
   mutable std::vector<float> scratch_;  // the second half's sweep output
   mutable double seconds_ = 0.0;
+  mutable long long cells_skipped_ = 0, cells_visited_ = 0;
   bool scalar_kernel_;
   std::vector<Vec3> directions_;    // regrouped
   std::array<int, 9> start_{};      // octant o holds regrouped directions [start_[o], start_[o + 1])

@@ -319,6 +319,7 @@ DomSolution solve_dom(const ExtinctionVolume& volume, const std::vector<Light>& 
   }
   out.converged = !out.changes.empty() && out.changes.back() < settings.tolerance;
   out.sweep_seconds = transport.seconds();
+  out.skipped_fraction = transport.skipped_fraction();
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return out;
 }

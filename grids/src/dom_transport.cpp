@@ -85,6 +85,7 @@ void Transport::sweep(const Channel& ch, const FirstCollision* first, const floa
   const size_t size = cells_ * static_cast<size_t>(n_terms_);
   scratch_.resize(size);
   const auto row_kernel = scalar_kernel_ ? simd::dom_sweep_row_reference : simd::dom_sweep_row;
+  long long skipped[2] = {0, 0};
   parallel_for(2, threads, 1, [&](long long h0, long long h1) {
     for (long long half = h0; half < h1; ++half) {
       float* out = half == 0 ? m_out : scratch_.data();
@@ -95,10 +96,12 @@ void Transport::sweep(const Channel& ch, const FirstCollision* first, const floa
         if (p == 0) continue;
         std::vector<float> z_plane(static_cast<size_t>(nx) * static_cast<size_t>(ny) * p, boundary), y_row(static_cast<size_t>(nx) * p),
             x_run(p), scratch(p + static_cast<size_t>(oc.view.terms_padded));
+        // Which upwind faces still carry exactly zero radiance (per x of the z plane and of the y
+        // row): an empty cell between such faces stays dark, so a row's leading run of them is
+        // skipped. Exact; nothing is skipped when radiance enters through the boundary.
+        std::vector<char> z_dark(static_cast<size_t>(nx) * static_cast<size_t>(ny), boundary == 0.0f), y_dark(static_cast<size_t>(nx));
         simd::DomRow row;
-        row.count = nx;
         row.step = o & 1 ? -1 : 1;
-        row.x0 = o & 1 ? nx - 1 : 0;
         row.density = ch.density, row.sigma_t_scale = ch.sigma_t_scale, row.albedo = ch.albedo;
         if (first && first->half.empty()) row.first = first->values.data() + oc.offset;
         if (first && !first->half.empty()) row.first_half = first->half.data() + oc.offset, row.first_scale = first->scale.data();
@@ -108,19 +111,36 @@ void Transport::sweep(const Channel& ch, const FirstCollision* first, const floa
         for (int kk = 0; kk < nz; ++kk) {
           const int k = o & 4 ? nz - 1 - kk : kk;
           std::fill(y_row.begin(), y_row.end(), boundary);
+          std::fill(y_dark.begin(), y_dark.end(), boundary == 0.0f);
           for (int jj = 0; jj < ny; ++jj) {
             const int j = o & 2 ? ny - 1 - jj : jj;
             std::fill(x_run.begin(), x_run.end(), boundary);
-            row.cell0 = (static_cast<size_t>(k) * static_cast<size_t>(ny) + static_cast<size_t>(j)) * static_cast<size_t>(nx) +
-                        static_cast<size_t>(row.x0);
+            const size_t row_start = (static_cast<size_t>(k) * static_cast<size_t>(ny) + static_cast<size_t>(j)) * static_cast<size_t>(nx);
+            char* z_dark_row = z_dark.data() + static_cast<size_t>(j) * static_cast<size_t>(nx);
+            int skip = 0;
+            for (; skip < nx; ++skip) {
+              const auto x = static_cast<size_t>(o & 1 ? nx - 1 - skip : skip);
+              if (!(y_dark[x] && z_dark_row[x] && ch.density[row_start + x] == 0.0f)) break;
+            }
+            skipped[half] += skip;
+            if (skip == nx) continue;
+            row.count = nx - skip;
+            row.x0 = o & 1 ? nx - 1 - skip : skip;
+            row.cell0 = row_start + static_cast<size_t>(row.x0);
             row.z_row = z_plane.data() + static_cast<size_t>(j) * static_cast<size_t>(nx) * p;
             row_kernel(oc.view, row);
+            for (int m = skip; m < nx; ++m) {
+              const auto x = static_cast<size_t>(o & 1 ? nx - 1 - m : m);
+              y_dark[x] = z_dark_row[x] = 0;
+            }
           }
         }
       }
     }
   });
   for (size_t i = 0; i < size; ++i) m_out[i] += scratch_[i];
+  cells_skipped_ += skipped[0] + skipped[1];
+  cells_visited_ += 8 * static_cast<long long>(cells_);
   seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
@@ -143,6 +163,10 @@ FirstCollision Transport::first_collision(const ExtinctionVolume& volume, const 
       for (int j = 0; j < ny; ++j)
         for (int i = 0; i < nx; ++i) {
           const size_t c = grid.index(i, j, k);
+          if (grid.values()[c] == 0.0f) {  // an empty cell scatters nothing: no source
+            if (half) first.scale[c] = 0.0f, std::fill_n(first.half.data() + c * padded_, padded_, simd::Half(0.0f));
+            continue;
+          }
           const Vec3 x = grid.cell_center(i, j, k);
           float* f = half ? cell.data() : first.values.data() + c * padded_;
           if (half) std::fill(cell.begin(), cell.end(), 0.0f);

@@ -37,9 +37,11 @@ void DomSweepRow(const DomOctant& o, const DomRow& r) {
     const V sigma_t = hn::Set(d, sigma_t_value), sigma_s = hn::Set(d, r.albedo * sigma_t_value);
     float* HWY_RESTRICT y = r.y_row + x * p;
     float* HWY_RESTRICT z = r.z_row + x * p;
-    const float* HWY_RESTRICT m_in = r.m_in ? r.m_in + c * n : nullptr;
-    const float* HWY_RESTRICT first = r.first ? r.first + c * r.first_stride : nullptr;
-    const Half* HWY_RESTRICT first_half = !r.first && r.first_half ? r.first_half + c * r.first_stride : nullptr;
+    // An empty cell scatters nothing (sigma_s = 0): its source is not needed.
+    const bool empty = sigma_t_value == 0.0f;
+    const float* HWY_RESTRICT m_in = r.m_in && !empty ? r.m_in + c * n : nullptr;
+    const float* HWY_RESTRICT first = r.first && !empty ? r.first + c * r.first_stride : nullptr;
+    const Half* HWY_RESTRICT first_half = !r.first && r.first_half && !empty ? r.first_half + c * r.first_stride : nullptr;
     for (size_t i = 0; i < p; i += 4 * lanes) {
       const size_t count = std::min<size_t>(4, (p - i) / lanes);
       // Source: the first-collision term plus lambda Q m_in, one term (a broadcast) at a time.

@@ -21,10 +21,12 @@ void dom_sweep_row_reference(const DomOctant& o, const DomRow& r) {
     const float sigma_t = r.sigma_t_scale * r.density[c], sigma_s = r.albedo * sigma_t;
     float* y = r.y_row + x * p;
     float* z = r.z_row + x * p;
+    const bool empty = sigma_t == 0.0f;  // scatters nothing: no source needed
     for (size_t d = 0; d < p; ++d) {
-      float s = r.first ? r.first[c * r.first_stride + d]
+      float s = empty ? 0.0f
+                : r.first ? r.first[c * r.first_stride + d]
                 : r.first_half ? r.first_scale[c] * static_cast<float>(r.first_half[c * r.first_stride + d]) : 0.0f;
-      if (r.m_in)
+      if (r.m_in && !empty)
         for (size_t k = 0; k < n; ++k) s += o.lq[k * p + d] * r.m_in[c * n + k];
       const float l = (sigma_s * s + o.a[d] * r.x_run[d] + o.a[p + d] * y[d] + o.a[2 * p + d] * z[d]) / (sigma_t + o.a[3 * p + d]);
       r.x_run[d] = y[d] = z[d] = light[d] = l;

@@ -172,6 +172,38 @@ TEST(DomSolver, ThreadIndependent) {
   EXPECT_EQ(one.moments, two.moments);
 }
 
+// Empty cells that no radiance has reached yet are skipped, exactly: the same cloud with its empty
+// cells at density 1e-30 instead of 0 (nothing skippable) gives the same moments to float
+// rounding, with and without sky light entering through the boundary (whose first sweep skips
+// nothing).
+TEST(DomSolver, EmptyCellsSkippedExactly) {
+  Small s;
+  DenseGrid& d = s.volume.density;
+  DenseGrid tiny = d;
+  for (int k = 0; k < 10; ++k)
+    for (int j = 0; j < 12; ++j)
+      for (int i = 0; i < 16; ++i)
+        if (glm::length(d.cell_center(i, j, k)) > 0.6) d.at(i, j, k) = 0.0f, tiny.at(i, j, k) = 1e-30f;
+  s.depths.clear();
+  for (const Light& l : s.lights) s.depths.push_back(optical_depth(d, l, {DepthScheme::exact}));
+  DomSettings settings;
+  settings.directions = 48;
+  settings.tolerance = 1e-6;
+  ExtinctionVolume full = s.volume;
+  full.density = tiny;
+  for (bool sky : {false, true}) {
+    if (sky) s.lights.push_back(SkyLight{Rgb(0.2)});
+    const DomSolution skipped = solve_dom(s.volume, s.lights, s.depths, settings);
+    const DomSolution swept = solve_dom(full, s.lights, s.depths, settings);
+    const double difference = relative_difference(skipped.moments[0], swept.moments[0]);
+    std::printf("%s: skipped %.1f%% of cell visits; moments differ by %.2e\n", sky ? "sky" : "no sky", 100.0 * skipped.skipped_fraction,
+                difference);
+    EXPECT_GT(skipped.skipped_fraction, sky ? 0.0 : 0.15);
+    EXPECT_EQ(swept.skipped_fraction, 0.0);
+    EXPECT_LT(difference, 1e-6);
+  }
+}
+
 // float16 storage (first-collision source and GMRES basis) changes the converged moments by about
 // float16's rounding (2^-11 = 4.9e-4 relative), not more, needs no more than a few extra sweeps,
 // and takes less memory.

@@ -85,7 +85,8 @@ std::unique_ptr<Method> create_method(const std::string& name);
 // Renders with `method_name`, or the scene's method when empty. The scene's method settings
 // apply when its name matches; options.settings override them key by key. A scene with particles
 // and no medium renders with a method that does not read particles through the registered
-// ParticleMediumFactory.
+// ParticleMediumFactory. Lights that reach nothing are left out first (light_culling.h); the
+// result's stats list them under "culled_lights".
 RenderResult render(const Scene& scene, const std::string& method_name, RenderOptions options = {});
 
 }  // namespace haze

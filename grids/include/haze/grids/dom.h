@@ -89,6 +89,9 @@ struct DomSolution {
   std::vector<double> changes;     // the relative change after each iteration
   size_t bytes = 0;                // peak memory the solver held for its fields
   double sweep_seconds = 0.0;      // wall time in transport sweeps (paper: in its iterations)
+  // The share of cell visits the sweeps skipped: empty cells that no radiance had reached yet
+  // (exact; the sweep scheme without sky light only).
+  double skipped_fraction = 0.0;
   double seconds = 0.0;            // wall time of the whole solve (phase matrix, first collision, sweeps)
 
   int terms() const { return separable ? separable->terms() : 0; }

@@ -8,6 +8,7 @@
 //   L_d = (sigma_s S_d + a_x,d x_d + a_y,d y_d + a_z,d z_d) / (sigma_t + a_x,d + a_y,d + a_z,d)
 //   x_d = y_d = z_d = L_d                    (the upwind values the next cells read)
 //   m_out[c][k] += sum_d Q[d][k] L_d          (eq. 10)
+// A cell of zero density (sigma_s = 0) reads no source: first and m_in are not touched there.
 #pragma once
 
 #include <haze/simd/half.h>

@@ -1,0 +1,24 @@
+// Lights that cannot reach anything in a scene, found before a render so that no method spends
+// time (optical-depth volumes, first-collision sources, light samples) on them.
+#pragma once
+
+#include <haze/core/scene.h>
+
+#include <string>
+#include <vector>
+
+namespace haze {
+
+struct CulledLight {
+  size_t index = 0;  // in scene.lights
+  std::string why;
+};
+
+// The lights of `scene` whose light reaches neither the medium nor any surface, so that they add
+// nothing to any image, whatever the method or camera: lights of zero power, and spot lights
+// whose cone misses the medium's bounds (a bounding sphere around them) and every surface. Light
+// that reaches nothing escapes, so culling is exact. With particles (bounds unknown to the core)
+// or an unbounded medium no spot light is culled.
+std::vector<CulledLight> culled_lights(const Scene& scene);
+
+}  // namespace haze
