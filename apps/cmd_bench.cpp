@@ -195,6 +195,9 @@ void write_tradeoffs(const std::filesystem::path& file, const std::vector<std::s
         "**Time** is the whole render (setup, tables, solve, image) on this 2-core machine, every core: the median\n"
         "of three runs after a first one when that first took under a second, else the first run; method\n"
         "auto is timed once, its choice included.\n\n"
+        "**The reference is swept too**, at 16 to 4096 spp (another seed than the reference's), then doubling\n"
+        "until it meets the smallest tolerance (at most 2^19 spp) unless another measurement already meets it\n"
+        "faster than the next doubling would take: those rows are what auto's reference choices are compared with.\n\n"
         "## The references\n\nThe reference's noise limits the smallest error the comparison resolves: about\n"
         "noise (2 / pixels)^(1/4), the spread of the noise-removed estimate.\n\n"
         "| scene | spp | seconds | reference noise (RMS relative, lit pixels) | lit pixels | smallest error resolved |\n|---|---|---|---|---|---|\n";

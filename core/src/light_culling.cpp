@@ -1,7 +1,8 @@
-// Lights that reach nothing (core/light_culling.h): zero power, or a spot cone that misses the
-// medium and every surface.
+// Lights that reach nothing (core/light_culling.h): zero power, a spot cone that misses the
+// medium and every surface, or (single scattering) one that misses the view.
 #include <haze/core/light_culling.h>
 
+#include <haze/core/camera.h>
 #include <haze/core/medium.h>
 
 #include <algorithm>
@@ -35,9 +36,42 @@ bool cone_meets_plane(const Vec3& p, const Vec3& a, double theta, const Vec3& q,
   return angle - theta < 0.5 * kPi - 1e-9;
 }
 
+// Is the cone entirely outside the half-space n . x >= d (n unit)? Its apex is outside and none of
+// its rays turns toward the inside: angle(a, n) >= 90 degrees + theta.
+bool cone_outside(const Vec3& p, const Vec3& a, double theta, const Vec3& n, double d) {
+  if (glm::dot(n, p) >= d) return false;
+  const double angle = std::acos(std::clamp(glm::dot(a, n), -1.0, 1.0));
+  return angle >= 0.5 * kPi + theta + 1e-9;
+}
+
+// Does the cone miss the camera's view: outside the half-space in front of the camera, or outside
+// one of the four that hold the film's edges (planes through the eye for a pinhole camera,
+// parallel to the view for an orthographic one)?
+bool cone_misses_view(const Vec3& p, const Vec3& a, double theta, const Camera& camera) {
+  const Vec3 forward = glm::normalize(camera.look_at - camera.position);
+  const Vec3 right = glm::normalize(glm::cross(forward, camera.up));
+  const Vec3 up = glm::cross(right, forward);
+  const double aspect = static_cast<double>(camera.width_px) / camera.height_px;
+  const Vec3& c = camera.position;
+  if (cone_outside(p, a, theta, forward, glm::dot(forward, c))) return true;
+  if (camera.type == Camera::Type::orthographic) {
+    const double half_h = 0.5 * camera.height, half_w = aspect * half_h;
+    for (const auto& [n, half] : {std::pair{right, half_w}, {-right, half_w}, {up, half_h}, {-up, half_h}})
+      if (cone_outside(p, a, theta, n, glm::dot(n, c) - half)) return true;
+    return false;
+  }
+  const double t = std::tan(0.5 * camera.fov_y_deg * kPi / 180.0);
+  // Inward normals of the side planes through the eye: f t_edge -+ e for edge directions f + e t_edge.
+  for (const auto& [edge, t_edge] : {std::pair{right, aspect * t}, {-right, aspect * t}, {up, t}, {-up, t}}) {
+    const Vec3 n = glm::normalize(forward * t_edge - edge);
+    if (cone_outside(p, a, theta, n, glm::dot(n, c))) return true;
+  }
+  return false;
+}
+
 }  // namespace
 
-std::vector<CulledLight> culled_lights(const Scene& scene) {
+std::vector<CulledLight> culled_lights(const Scene& scene, bool single_scattering) {
   std::vector<CulledLight> culled;
   std::optional<Aabb> medium_bounds;  // built on the first spot light that needs it
   for (size_t i = 0; i < scene.lights.size(); ++i) {
@@ -53,11 +87,15 @@ std::vector<CulledLight> culled_lights(const Scene& scene) {
         culled.push_back({i, "spot light of zero intensity"});
         continue;
       }
-      if (!scene.particles.is_null()) continue;
       const double length = glm::length(spot->direction);
       if (!(length > 0.0) || !std::isfinite(length)) continue;  // the methods report it
       const Vec3 axis = spot->direction / length;
       const double theta = std::clamp(spot->cone_deg, 0.0, 180.0) * kPi / 180.0;
+      if (single_scattering && cone_misses_view(spot->position, axis, theta, scene.camera)) {
+        culled.push_back({i, "spot light whose cone misses the view (the method sees single scattering only)"});
+        continue;
+      }
+      if (!scene.particles.is_null()) continue;
       if (scene.medium) {
         if (!medium_bounds) medium_bounds = make_medium(*scene.medium)->bounds();
         if (!medium_bounds->bounded()) continue;

@@ -20,13 +20,13 @@ struct Registry {
   Registry() {
     methods["quadrature"] = {"quadrature",
                              "single scattering by deterministic numerical quadrature (any medium; a yardstick, not fast)",
-                             internal::make_quadrature_method};
+                             internal::make_quadrature_method, false, true};
     methods["reference"] = {"reference",
                             "unbiased volumetric path tracer with a standard-error image (the yardstick for every method)",
                             internal::make_reference_method};
     methods["analytic"] = {"analytic",
                            "closed-form single scattering, homogeneous medium, point and spot lights (seed 002; no shadows)",
-                           internal::make_analytic_method};
+                           internal::make_analytic_method, false, true};
     methods["auto"] = {"auto",
                        "the cheapest method and settings expected to meet --set tolerance=T (0.05), chosen from the scene alone",
                        internal::make_auto_method, true};
@@ -82,10 +82,10 @@ std::filesystem::path default_cache_dir() {
 
 namespace {
 
-// The method on the scene without the lights that reach nothing (light_culling.h), which the
-// stats list. A scene whose lights all reach nothing renders as it is.
-RenderResult render_culled(const Method& method, const Scene& scene, const RenderOptions& options) {
-  const std::vector<CulledLight> culled = culled_lights(scene);
+// The method on the scene without the lights that reach nothing it shows (light_culling.h), which
+// the stats list. A scene whose lights all reach nothing renders as it is.
+RenderResult render_culled(const Method& method, bool single_scattering, const Scene& scene, const RenderOptions& options) {
+  const std::vector<CulledLight> culled = culled_lights(scene, single_scattering);
   if (culled.empty() || culled.size() == scene.lights.size()) return method.render(scene, options);
   Scene kept = scene;
   kept.lights.clear();
@@ -109,15 +109,16 @@ RenderResult render(const Scene& scene, const std::string& method_name, RenderOp
   if (scene.method_name() == name) settings = scene.method;
   for (const auto& [key, value] : options.settings.items()) settings[key] = value;
   settings.erase("name");
+  auto& r = registry();
+  ParticleMediumFactory factory;
+  bool reads_particles = false, single_scattering = false;
+  {
+    std::lock_guard lock(r.mutex);
+    factory = r.particle_medium;
+    reads_particles = r.methods.at(name).reads_particles;
+    single_scattering = r.methods.at(name).single_scattering;
+  }
   if (!scene.particles.is_null()) {
-    auto& r = registry();
-    ParticleMediumFactory factory;
-    bool reads_particles = false;
-    {
-      std::lock_guard lock(r.mutex);
-      factory = r.particle_medium;
-      reads_particles = r.methods.at(name).reads_particles;
-    }
     if (!reads_particles) {
       if (scene.medium)
         throw Error("particles", "given with a medium", "one of `medium` and `particles` for method " + name + ", which renders one medium");
@@ -125,11 +126,11 @@ RenderResult render(const Scene& scene, const std::string& method_name, RenderOp
       Scene converted = scene;
       converted.medium = factory(scene, settings);
       options.settings = std::move(settings);
-      return render_culled(*method, converted, options);
+      return render_culled(*method, single_scattering, converted, options);
     }
   }
   options.settings = std::move(settings);
-  return render_culled(*method, scene, options);
+  return render_culled(*method, single_scattering, scene, options);
 }
 
 }  // namespace haze

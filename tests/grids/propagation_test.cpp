@@ -9,6 +9,8 @@
 #include "cloud_scene.h"
 
 #include <gtest/gtest.h>
+
+#include <algorithm>
 #include <hwy/tests/hwy_gtest.h>
 
 #include <cstdio>
@@ -87,6 +89,25 @@ TEST(Propagation, DoesNotDependOnTheThreadCount) {
     one.settings = two.settings = {{"optical_depth", scheme}, {"resolution", 24}};
     EXPECT_EQ(render(scene, "propagation", one).radiance.data(), render(scene, "propagation", two).radiance.data()) << scheme;
   }
+}
+
+// A spot light that lights the cloud only out of view adds nothing to propagation's single
+// scattering: haze::render culls it (no optical-depth volume) and the image is the one the method
+// gives with it.
+TEST(Propagation, SpotsOutOfViewAreCulledWithoutChangingTheImage) {
+  register_methods();
+  Scene scene = cloud_scene(24, 16);
+  scene.camera.fov_y_deg = 10;
+  SpotLight spot;
+  spot.position = Vec3(-0.8, 0.6, 0.0), spot.direction = glm::normalize(Vec3(-1.0, 0.3, 0.0)), spot.cone_deg = 15, spot.intensity = Rgb(5.0);
+  scene.lights.push_back(spot);
+  RenderOptions options;
+  options.settings = {{"resolution", 24}};
+  const RenderResult culled = render(scene, "propagation", options);
+  ASSERT_EQ(culled.stats["culled_lights"].size(), 1u);
+  EXPECT_EQ(culled.stats["culled_lights"][0]["index"], 2);
+  EXPECT_GT(*std::max_element(culled.radiance.data().begin(), culled.radiance.data().end()), 0.01f);
+  EXPECT_EQ(culled.radiance.data(), create_method("propagation")->render(scene, options).radiance.data());
 }
 
 // Seed 003 table 1: the stages kept apart. Moving a light re-propagates only its depth volume over

@@ -49,6 +49,9 @@ struct MethodInfo {
   // The method reads the scene's `particles` block itself; any other method is given the
   // particles' continuous density as the scene's medium (register_particle_medium).
   bool reads_particles = false;
+  // The image holds light scattered or reflected once only, at points the camera sees: a light
+  // that reaches none of the view is left out too (light_culling.h).
+  bool single_scattering = false;
 };
 
 // Turns a scene's `particles` block into a medium (the particle module registers one when its
@@ -85,8 +88,8 @@ std::unique_ptr<Method> create_method(const std::string& name);
 // Renders with `method_name`, or the scene's method when empty. The scene's method settings
 // apply when its name matches; options.settings override them key by key. A scene with particles
 // and no medium renders with a method that does not read particles through the registered
-// ParticleMediumFactory. Lights that reach nothing are left out first (light_culling.h); the
-// result's stats list them under "culled_lights".
+// ParticleMediumFactory. Lights that reach nothing (for a single-scattering method: nothing in
+// view) are left out first (light_culling.h); the result's stats list them under "culled_lights".
 RenderResult render(const Scene& scene, const std::string& method_name, RenderOptions options = {});
 
 }  // namespace haze
