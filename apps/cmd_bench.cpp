@@ -197,7 +197,9 @@ void write_tradeoffs(const std::filesystem::path& file, const std::vector<std::s
         "auto is timed once, its choice included.\n\n"
         "**The reference is swept too**, at 16 to 4096 spp (another seed than the reference's), then doubling\n"
         "until it meets the smallest tolerance (at most 2^19 spp) unless another measurement already meets it\n"
-        "faster than the next doubling would take: those rows are what auto's reference choices are compared with.\n\n"
+        "faster than the next doubling would take: those rows are what auto's reference choices are compared with.\n"
+        "Where their error stops falling as spp doubles, it has met the floor of the reference's own noise, whose\n"
+        "tail is heavier than its standard error says: errors near that floor are not resolved by this reference.\n\n"
         "## The references\n\nThe reference's noise limits the smallest error the comparison resolves: about\n"
         "noise (2 / pixels)^(1/4), the spread of the noise-removed estimate.\n\n"
         "| scene | spp | seconds | reference noise (RMS relative, lit pixels) | lit pixels | smallest error resolved |\n|---|---|---|---|---|---|\n";
@@ -232,16 +234,22 @@ void write_tradeoffs(const std::filesystem::path& file, const std::vector<std::s
   }
   md << "\n## Method auto\n\n`--method auto --tolerance T` chooses from the scene alone (core/src/auto.cpp says which\n"
         "measurement each rule rests on; `--explain` prints the choice and why). Here it is checked against the\n"
-        "reference, and its time against the fastest swept method and settings under the same T.\n\n"
-        "| scene | T | auto chose | seconds | error | under T | fastest under T | auto / fastest |\n|---|---|---|---|---|---|---|---|\n";
+        "reference, and its time against the fastest swept method and settings under the same T. When the sweep\n"
+        "measured the same choice (for the reference: the same spp, another seed), its error is shown too: the\n"
+        "spread between seeds is the measurement's own uncertainty.\n\n"
+        "| scene | T | auto chose | seconds | error | the same, swept | under T | fastest under T | auto / fastest |\n"
+        "|---|---|---|---|---|---|---|---|---|\n";
   for (const Row& r : rows) {
     if (r.method != "auto") continue;
     const double t = r.settings["tolerance"].get<double>();
     const Row* best = fastest_within(rows, r.scene, t);
+    const auto same = std::find_if(rows.begin(), rows.end(), [&](const Row& o) {
+      return o.scene == r.scene && o.method != "auto" && o.method + " " + compact(o.settings) == r.chosen;
+    });
     char ratio[32] = "-";
     if (best) std::snprintf(ratio, sizeof ratio, "%.2fx", r.seconds / best->seconds);
     md << "| " << r.scene << " | " << percent(t) << " | " << r.chosen << " | " << secs(r.seconds) << " | " << percent(r.measure()) << " | "
-       << (r.measure() < t ? "yes" : "**no**") << " | "
+       << (same != rows.end() ? percent(same->measure()) : std::string("-")) << " | " << (r.measure() < t ? "yes" : "**no**") << " | "
        << (best ? best->method + " " + compact(best->settings) + ", " + secs(best->seconds) : std::string("none in the sweep")) << " | " << ratio
        << " |\n";
   }

@@ -28,11 +28,22 @@ int run(const CompareArgs& a) {
   out["reference_mean"] = {mr.r, mr.g, mr.b};
   // The reference's own noise: the RMS of its per-pixel standard errors.
   if (ref_error) out["reference_noise_rms"] = rms(*ref_error);
+  // The trade suite's measure (docs/TRADEOFFS.md): relative error over the lit pixels, with the
+  // reference's noise removed when its standard-error layer is present.
+  const LitPixelError lit = lit_pixel_error(image, reference, ref_error ? &*ref_error : nullptr);
+  out["lit_pixels"] = lit.pixels;
+  out["lit_mean_abs_relative"] = lit.mean_abs;
+  out["lit_signed_mean_relative"] = lit.signed_mean;
+  if (ref_error) out["lit_rms_relative_noise_removed"] = lit.rms_noise_removed, out["lit_reference_noise_rms"] = lit.noise_rms;
   if (a.json) {
     std::cout << out.dump(2) << "\n";
   } else {
     std::cout << "RMSE " << out["rmse"].get<double>() << ", relative RMSE " << out["relative_rmse"].get<double>();
     if (ref_error) std::cout << " (reference noise RMS " << out["reference_noise_rms"].get<double>() << ")";
+    std::cout << "\nlit pixels " << lit.pixels << ": mean |relative error| " << lit.mean_abs << ", signed mean " << lit.signed_mean;
+    if (ref_error)
+      std::cout << ", RMS relative error with the reference's noise removed " << lit.rms_noise_removed << " (reference noise "
+                << lit.noise_rms << ")";
     std::cout << "\n";
   }
   return 0;

@@ -73,7 +73,11 @@ class AutoMethod final : public Method {
     Settings settings(options.settings, "auto");
     const double tolerance = settings.number("tolerance", 0.05, 1e-4, 0.99);
     settings.reject_unknown();
-    const AutoChoice choice = choose_method(scene, tolerance);
+    AutoChoice choice = choose_method(scene, tolerance);
+    if (!available(choice.method)) {  // a consumer that registered core only: the reference is always there
+      choice.why.push_back("but " + choice.method + " is not registered (its module's register_methods() was not called)");
+      choice = reference_for(scene, tolerance, choice);
+    }
     RenderOptions delegated = options;
     delegated.settings = choice.settings;
     RenderResult result = haze::render(scene, choice.method, delegated);
@@ -126,8 +130,10 @@ SceneFeatures scene_features(const Scene& scene) {
   return f;
 }
 
-AutoChoice choose_method(const Scene& scene, double tolerance) {
-  if (!(tolerance > 0.0 && tolerance < 1.0)) throw Error("tolerance", format("%g", tolerance), "a relative error in (0, 1), e.g. 0.05");
+namespace {
+
+// The rules (docs/METHODS.md), from the scene's features.
+AutoChoice choose(const Scene& scene, double tolerance) {
   const SceneFeatures f = scene_features(scene);
   AutoChoice c;
   c.why.push_back(format("tolerance %.1f%%", 100.0 * tolerance));
@@ -135,7 +141,7 @@ AutoChoice choose_method(const Scene& scene, double tolerance) {
     c.why.push_back("particles, no grid medium");
     // Trade suite, particle_cloud: network 5.5% in 0.46 s at any D; dom on the particles'
     // density, 16^3 cells and 32 directions, 0.8% in 3.6 s.
-    if (tolerance >= 0.06 && available("network")) {
+    if (tolerance >= 0.06) {
       c.method = "network", c.settings = {{"directions", 64}};
       c.why.push_back("network: the illumination network is measured at 5.5% on the suite's particle cloud");
     } else {
@@ -184,6 +190,13 @@ AutoChoice choose_method(const Scene& scene, double tolerance) {
   c.why.push_back(format("dom at %.0f^3 cells, 128 directions: multiple scattering matters, no surfaces; the suite's dense cloud measured 4.6%% at 48^3 and 3.2%% at 64^3",
                          resolution));
   return c;
+}
+
+}  // namespace
+
+AutoChoice choose_method(const Scene& scene, double tolerance) {
+  if (!(tolerance > 0.0 && tolerance < 1.0)) throw Error("tolerance", format("%g", tolerance), "a relative error in (0, 1), e.g. 0.05");
+  return choose(scene, tolerance);
 }
 
 namespace internal {

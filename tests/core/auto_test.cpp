@@ -85,5 +85,17 @@ TEST(AutoMethod, RendersWithItsChoiceAndRefusesABadTolerance) {
   EXPECT_THROW(render(scene, "auto", options), Error);
 }
 
+// This test program registers core's methods only: a choice of dom (a grids method) renders with the
+// reference instead, and says so.
+TEST(AutoMethod, AnUnregisteredChoiceGivesWayToTheReference) {
+  const Scene scene = box_scene(0.05, 0.9);
+  ASSERT_EQ(choose_method(scene, 0.1).method, "dom");
+  RenderOptions options;
+  options.settings = {{"tolerance", 0.1}};
+  const RenderResult r = render(scene, "auto", options);
+  EXPECT_EQ(r.stats["auto"]["method"], "reference");
+  EXPECT_NE(r.stats["auto"]["why"].dump().find("dom is not registered"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace haze

@@ -32,7 +32,8 @@ struct AutoChoice {
   std::vector<std::string> why;  // the features and the rule that decided, one line each
 };
 
-// Throws haze::Error for a tolerance outside (0, 1).
+// Throws haze::Error for a tolerance outside (0, 1). The choice may name a method of a module that
+// is not registered; method "auto" then renders with the reference instead.
 AutoChoice choose_method(const Scene& scene, double tolerance);
 
 }  // namespace haze
