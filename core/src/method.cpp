@@ -89,14 +89,29 @@ RenderResult render_culled(const Method& method, bool single_scattering, const S
   if (culled.empty() || culled.size() == scene.lights.size()) return method.render(scene, options);
   Scene kept = scene;
   kept.lights.clear();
+  std::vector<size_t> original;  // kept light -> its index in scene.lights
   nlohmann::json listed = nlohmann::json::array();
   for (size_t i = 0, c = 0; i < scene.lights.size(); ++i) {
     if (c < culled.size() && culled[c].index == i) listed.push_back({{"index", i}, {"why", culled[c++].why}});
-    else kept.lights.push_back(scene.lights[i]);
+    else kept.lights.push_back(scene.lights[i]), original.push_back(i);
   }
-  RenderResult result = method.render(kept, options);
-  result.stats["culled_lights"] = listed;
-  return result;
+  try {
+    RenderResult result = method.render(kept, options);
+    result.stats["culled_lights"] = listed;
+    return result;
+  } catch (const Cancelled&) {
+    throw;
+  } catch (const Error& e) {
+    // An error about "lights[k]..." names the caller's light, not the k-th one kept.
+    const std::string& field = e.field();
+    const size_t close = field.find(']');
+    if (field.rfind("lights[", 0) != 0 || close == std::string::npos || close == 7) throw;
+    const std::string digits = field.substr(7, close - 7);
+    if (!std::all_of(digits.begin(), digits.end(), [](char ch) { return ch >= '0' && ch <= '9'; })) throw;
+    const size_t k = std::stoul(digits);
+    if (k >= original.size()) throw;
+    throw Error("lights[" + std::to_string(original[k]) + field.substr(close), e.value(), e.expected());
+  }
 }
 
 }  // namespace

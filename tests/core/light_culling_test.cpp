@@ -1,5 +1,6 @@
 // Lights that reach nothing (core/light_culling.h): which are culled, and that culling changes no
 // image.
+#include <haze/core/error.h>
 #include <haze/core/light_culling.h>
 #include <haze/core/method.h>
 
@@ -113,6 +114,18 @@ TEST(LightCulling, ChangesNoImage) {
   RenderOptions options;
   options.settings = {{"spp", 1}};
   EXPECT_EQ(render(scene, "reference", options).stats["culled_lights"].size(), 2u);
+}
+
+// An error about a light names it by its index in the caller's scene, culled lights counted.
+TEST(LightCulling, ErrorsNameTheCallersLight) {
+  Scene scene = fog_box(false);
+  scene.lights = {PointLight{Vec3(0, 3, 0), Rgb(0.0)}, DirectionalLight{Vec3(0, -1, 0), Rgb(1.0)}};
+  try {
+    render(scene, "analytic");
+    FAIL() << "analytic accepted a directional light";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.field(), "lights[1].type");
+  }
 }
 
 }  // namespace
