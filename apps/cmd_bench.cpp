@@ -54,8 +54,14 @@ struct Row {
   LitPixelError error;
   bool pareto = false;
   std::string chosen;  // auto: the method and settings it chose
+  double worst = -1.0;  // a reference row re-rendered on kRecheckSeeds: the largest error of all its seeds
   double measure() const { return error.rms_noise_removed; }
+  // What "meets T" is judged by: every seed measured.
+  double robust() const { return std::max(measure(), worst); }
 };
+
+constexpr int kRecheckSeeds[] = {8, 9};
+constexpr double kRecheckSeconds = 60.0;  // reference rows that take longer are judged on one seed
 
 std::string compact(const nlohmann::json& settings) {
   std::string s;
@@ -133,6 +139,7 @@ std::vector<Row> read_rows(const std::filesystem::path& file) {
     Row r{f[0], f[1], parse_compact(f[2]), std::stod(f[3]), {}, f[9] == "1", f[10]};
     r.error.rms_noise_removed = std::stod(f[4]), r.error.mean_abs = std::stod(f[5]), r.error.signed_mean = std::stod(f[6]);
     r.error.noise_rms = std::stod(f[7]), r.error.pixels = std::stoi(f[8]);
+    if (f.size() > 11 && !f[11].empty()) r.worst = std::stod(f[11]);
     rows.push_back(r);
   }
   return rows;
@@ -174,8 +181,32 @@ void deepen_reference(const Scene& scene, const std::string& name, const Image& 
 const Row* fastest_within(const std::vector<Row>& rows, const std::string& scene, double tolerance) {
   const Row* best = nullptr;
   for (const Row& r : rows)
-    if (r.scene == scene && r.method != "auto" && r.measure() < tolerance && (!best || r.seconds < best->seconds)) best = &r;
+    if (r.scene == scene && r.method != "auto" && r.robust() < tolerance && (!best || r.seconds < best->seconds)) best = &r;
   return best;
+}
+
+// The path tracer's error at a given spp varies from seed to seed by more than its standard error
+// says (heavy tails), so a reference row that would be the fastest under a tolerance is rendered on
+// kRecheckSeeds too (when a render takes under kRecheckSeconds) and counts only if every seed meets
+// the tolerance; otherwise the next fastest is checked.
+void recheck_seeds(const Scene& scene, const std::string& name, const Image& reference, const Image& se, const TradeArgs& a,
+                   std::vector<Row>& all) {
+  for (double tolerance : a.tolerances) {
+    for (;;) {
+      Row* best = const_cast<Row*>(fastest_within(all, name, tolerance));
+      if (!best || best->method != "reference" || best->worst >= 0.0 || best->seconds > kRecheckSeconds) break;
+      best->worst = best->measure();
+      for (int seed : kRecheckSeeds) {
+        RenderOptions options;
+        options.threads = a.threads;
+        options.settings = {{"spp", best->settings["spp"]}, {"seed", seed}};
+        const double error = lit_pixel_error(render(scene, "reference", options).radiance, reference, &se).rms_noise_removed;
+        best->worst = std::max(best->worst, error);
+        std::printf("%-15s %-12s %-40s seed %d: %8s\n", name.c_str(), "reference", compact(best->settings).c_str(), seed, percent(error).c_str());
+        std::fflush(stdout);
+      }
+    }
+  }
 }
 
 // docs/TRADEOFFS.md, from the rows: what was measured and how, the plots, the recommended settings
@@ -199,7 +230,10 @@ void write_tradeoffs(const std::filesystem::path& file, const std::vector<std::s
         "until it meets the smallest tolerance (at most 2^19 spp) unless another measurement already meets it\n"
         "faster than the next doubling would take: those rows are what auto's reference choices are compared with.\n"
         "Where their error stops falling as spp doubles, it has met the floor of the reference's own noise, whose\n"
-        "tail is heavier than its standard error says: errors near that floor are not resolved by this reference.\n\n"
+        "tail is heavier than its standard error says: errors near that floor are not resolved by this reference.\n"
+        "For the same reason a reference row counts as meeting a tolerance (in the recommendations and auto's\n"
+        "comparison) only if two more seeds (8 and 9) meet it too, when a render takes under a minute; the error\n"
+        "shown in the recommendations is then the largest of the three.\n\n"
         "## The references\n\nThe reference's noise limits the smallest error the comparison resolves: about\n"
         "noise (2 / pixels)^(1/4), the spread of the noise-removed estimate.\n\n"
         "| scene | spp | seconds | reference noise (RMS relative, lit pixels) | lit pixels | smallest error resolved |\n|---|---|---|---|---|---|\n";
@@ -228,7 +262,7 @@ void write_tradeoffs(const std::filesystem::path& file, const std::vector<std::s
     md << "| " << scene;
     for (double t : {0.10, 0.05, 0.02, 0.01}) {
       const Row* best = fastest_within(rows, scene, t);
-      md << " | " << (best ? best->method + " " + compact(best->settings) + ", " + secs(best->seconds) + " (" + percent(best->measure()) + ")" : "-");
+      md << " | " << (best ? best->method + " " + compact(best->settings) + ", " + secs(best->seconds) + " (" + percent(best->robust()) + ")" : "-");
     }
     md << " |\n";
   }
@@ -349,6 +383,7 @@ int run(const TradeArgs& a) {
     }
     if (a.method.empty() || a.method == "reference") deepen_reference(scene, name, reference, *se, a, all, rows);
     all.insert(all.end(), rows.begin(), rows.end());
+    recheck_seeds(scene, name, reference, *se, a, all);
     if (!a.method.empty() && a.method != "auto") continue;
     for (double tolerance : a.tolerances) {
       RenderOptions options;
@@ -380,10 +415,14 @@ int run(const TradeArgs& a) {
       });
   }
   std::ofstream csv(out / "trade.csv");
-  csv << "scene,method,settings,seconds,error_rms_noise_removed,mean_abs,signed_mean,reference_noise_rms,lit_pixels,pareto,auto_chose\n";
-  for (const Row& r : all)
+  csv << "scene,method,settings,seconds,error_rms_noise_removed,mean_abs,signed_mean,reference_noise_rms,lit_pixels,pareto,auto_chose,"
+         "worst_of_seeds\n";
+  for (const Row& r : all) {
     csv << r.scene << "," << r.method << ",\"" << compact(r.settings) << "\"," << r.seconds << "," << r.measure() << "," << r.error.mean_abs << ","
-        << r.error.signed_mean << "," << r.error.noise_rms << "," << r.error.pixels << "," << r.pareto << ",\"" << r.chosen << "\"\n";
+        << r.error.signed_mean << "," << r.error.noise_rms << "," << r.error.pixels << "," << r.pareto << ",\"" << r.chosen << "\",";
+    if (r.worst >= 0.0) csv << r.worst;
+    csv << "\n";
+  }
   // Plot data: one file per scene and method (seconds, error), and the scene's Pareto front.
   std::map<std::string, std::ofstream> files;
   for (const Row& r : all) {
