@@ -72,19 +72,21 @@ std::string compact(const nlohmann::json& settings) {
   return s;
 }
 
+// One render and its wall time.
+RenderResult timed_once(const Scene& scene, const std::string& method, const RenderOptions& options, double& seconds) {
+  const auto start = std::chrono::steady_clock::now();
+  RenderResult result = render(scene, method, options);
+  seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return result;
+}
+
 // Times a render: once, and when that took under a second, three more (tables cached, caches
 // warm), their median.
 RenderResult timed(const Scene& scene, const std::string& method, const RenderOptions& options, double& seconds) {
-  auto once = [&](RenderResult& result) {
-    const auto start = std::chrono::steady_clock::now();
-    result = render(scene, method, options);
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  };
-  RenderResult result;
-  seconds = once(result);
+  RenderResult result = timed_once(scene, method, options, seconds);
   if (seconds < 1.0) {
     double t[3];
-    for (double& v : t) v = once(result);
+    for (double& v : t) result = timed_once(scene, method, options, v);
     std::sort(t, t + 3);
     seconds = t[1];
   }
@@ -101,6 +103,13 @@ std::string secs(double s) {
   char b[32];
   std::snprintf(b, sizeof b, s < 0.1 ? "%.4f s" : "%.3g s", s);
   return b;
+}
+
+// A measured row on stdout, as it comes.
+void print_row(const Row& r) {
+  std::printf("%-15s %-12s %-40s %10s %8s%s\n", r.scene.c_str(), r.method.c_str(), compact(r.settings).c_str(), secs(r.seconds).c_str(),
+              percent(r.measure()).c_str(), r.chosen.empty() ? "" : ("  chose " + r.chosen).c_str());
+  std::fflush(stdout);
 }
 
 
@@ -166,13 +175,9 @@ void deepen_reference(const Scene& scene, const std::string& name, const Image& 
     ProgressBar bar(name + " reference " + std::to_string(spp) + " spp");
     options.progress = bar.callback();
     Row row{name, "reference", options.settings, 0.0, {}, false, {}};
-    const auto start = std::chrono::steady_clock::now();
-    const RenderResult r = render(scene, "reference", options);
-    row.seconds = seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    row.error = lit_pixel_error(r.radiance, reference, &se);
-    std::printf("%-15s %-12s %-40s %10s %8s\n", name.c_str(), "reference", compact(row.settings).c_str(), secs(row.seconds).c_str(),
-                percent(row.measure()).c_str());
-    std::fflush(stdout);
+    row.error = lit_pixel_error(timed_once(scene, "reference", options, row.seconds).radiance, reference, &se);
+    seconds = row.seconds;
+    print_row(row);
     met = row.measure() < smallest;
     rows.push_back(row);
   }
@@ -349,9 +354,7 @@ int run(const TradeArgs& a) {
       options.settings = {{"spp", a.spp}, {"seed", 1}};
       ProgressBar bar(name + " reference");
       options.progress = bar.callback();
-      const auto start = std::chrono::steady_clock::now();
-      RenderResult r = render(scene, "reference", options);
-      ref_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      RenderResult r = timed_once(scene, "reference", options, ref_seconds);
       write_exr(ref_path, r.radiance, &*r.std_error);
       std::ofstream(std::filesystem::path(ref_path).replace_extension(".json")) << nlohmann::json{{"seconds", ref_seconds}}.dump();
       reference = r.radiance, se = *r.std_error;
@@ -376,9 +379,7 @@ int run(const TradeArgs& a) {
         std::fprintf(stderr, "%-15s %-12s %-40s not applicable: %s\n", name.c_str(), c.method.c_str(), compact(c.settings).c_str(), e.what());
         continue;
       }
-      std::printf("%-15s %-12s %-40s %10s %8s\n", name.c_str(), c.method.c_str(), compact(c.settings).c_str(), secs(row.seconds).c_str(),
-                  percent(row.measure()).c_str());
-      std::fflush(stdout);
+      print_row(row);
       rows.push_back(row);
     }
     if (a.method.empty() || a.method == "reference") deepen_reference(scene, name, reference, *se, a, all, rows);
@@ -391,14 +392,10 @@ int run(const TradeArgs& a) {
       options.cache_dir = default_cache_dir();
       options.settings = {{"tolerance", tolerance}};
       Row row{name, "auto", options.settings, 0.0, {}, false, {}};
-      const auto start = std::chrono::steady_clock::now();
-      const RenderResult r = render(scene, "auto", options);  // once: its choice may be a long reference render
-      row.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      const RenderResult r = timed_once(scene, "auto", options, row.seconds);  // once: its choice may be a long reference render
       row.error = lit_pixel_error(r.radiance, reference, &*se);
       row.chosen = r.stats["auto"]["method"].get<std::string>() + " " + compact(r.stats["auto"]["settings"]);
-      std::printf("%-15s %-12s %-40s %10s %8s  chose %s\n", name.c_str(), "auto", compact(row.settings).c_str(), secs(row.seconds).c_str(),
-                  percent(row.measure()).c_str(), row.chosen.c_str());
-      std::fflush(stdout);
+      print_row(row);
       all.push_back(row);
     }
   }

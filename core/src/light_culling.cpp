@@ -7,7 +7,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <optional>
 
 namespace haze {
 
@@ -73,7 +72,6 @@ bool cone_misses_view(const Vec3& p, const Vec3& a, double theta, const Camera& 
 
 std::vector<CulledLight> culled_lights(const Scene& scene, bool single_scattering) {
   std::vector<CulledLight> culled;
-  std::optional<Aabb> medium_bounds;  // built on the first spot light that needs it
   for (size_t i = 0; i < scene.lights.size(); ++i) {
     const Light& light = scene.lights[i];
     if (const auto* point = std::get_if<PointLight>(&light)) {
@@ -97,10 +95,9 @@ std::vector<CulledLight> culled_lights(const Scene& scene, bool single_scatterin
       }
       if (!scene.particles.is_null()) continue;
       if (scene.medium) {
-        if (!medium_bounds) medium_bounds = make_medium(*scene.medium)->bounds();
-        if (!medium_bounds->bounded()) continue;
-        const Vec3 centre = 0.5 * (medium_bounds->lo + medium_bounds->hi);
-        if (cone_meets_ball(spot->position, axis, theta, centre, 0.5 * glm::length(medium_bounds->extent()))) continue;
+        const Aabb bounds = medium_bounds(*scene.medium);
+        if (!bounds.bounded()) continue;
+        if (cone_meets_ball(spot->position, axis, theta, 0.5 * (bounds.lo + bounds.hi), 0.5 * glm::length(bounds.extent()))) continue;
       }
       const bool lights_a_surface = std::any_of(scene.surfaces.begin(), scene.surfaces.end(), [&](const Surface& s) {
         if (const auto* ball = std::get_if<Sphere>(&s.shape)) return cone_meets_ball(spot->position, axis, theta, ball->center, ball->radius);

@@ -63,19 +63,11 @@ class ConstantMedium final : public Medium {
 class RbfMedium final : public Medium {
  public:
   RbfMedium(const MediumDesc& desc, const RbfDensity& rbf) : Medium(desc.sigma_t, desc.albedo, desc.phase), blobs_(rbf.blobs) {
-    bounds_ = desc.bounds;
+    bounds_ = medium_bounds(desc);
     feature_ = kInfinity;
     for (const auto& b : blobs_) {
       max_ += b.weight;
       feature_ = std::min(feature_, 1.0 / b.sharpness);
-    }
-    if (!bounds_.bounded() && !blobs_.empty()) {
-      // Beyond 6 / sharpness a blob's density is below weight * e^-36: treat it as zero.
-      bounds_ = {Vec3(kInfinity), Vec3(-kInfinity)};
-      for (const auto& b : blobs_) {
-        bounds_.lo = glm::min(bounds_.lo, b.center - Vec3(6.0 / b.sharpness));
-        bounds_.hi = glm::max(bounds_.hi, b.center + Vec3(6.0 / b.sharpness));
-      }
     }
   }
   Aabb bounds() const override { return bounds_; }
@@ -169,6 +161,18 @@ class GridMedium final : public Medium {
 };
 
 }  // namespace
+
+Aabb medium_bounds(const MediumDesc& desc) {
+  const auto* rbf = std::get_if<RbfDensity>(&desc.density);
+  if (!rbf || desc.bounds.bounded() || rbf->blobs.empty()) return desc.bounds;
+  // Beyond 6 / sharpness a blob's density is below weight * e^-36: treat it as zero.
+  Aabb box{Vec3(kInfinity), Vec3(-kInfinity)};
+  for (const auto& b : rbf->blobs) {
+    box.lo = glm::min(box.lo, b.center - Vec3(6.0 / b.sharpness));
+    box.hi = glm::max(box.hi, b.center + Vec3(6.0 / b.sharpness));
+  }
+  return box;
+}
 
 std::unique_ptr<Medium> make_medium(const MediumDesc& desc) {
   if (auto* c = std::get_if<ConstantDensity>(&desc.density)) return std::make_unique<ConstantMedium>(desc, c->value);

@@ -81,4 +81,8 @@ class Medium {
 // The medium a scene describes (constant, RBF or grid density in core's direct form).
 std::unique_ptr<Medium> make_medium(const MediumDesc& desc);
 
+// make_medium(desc)->bounds() without building the medium: desc.bounds, or for an RBF density
+// without them the box beyond which every blob is below e^-36 of its weight.
+Aabb medium_bounds(const MediumDesc& desc);
+
 }  // namespace haze
