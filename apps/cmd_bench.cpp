@@ -154,6 +154,42 @@ std::vector<Row> read_rows(const std::filesystem::path& file) {
   return rows;
 }
 
+struct Reference {
+  long long spp = 0;
+  Image image;
+  Image se;  // per-pixel standard error
+  double seconds = 0.0;
+  LitPixelError noise() const { return lit_pixel_error(image, image, &se); }
+};
+
+// The scene's reference at `spp` (seed 1), kept between runs in --out/reference: its spp is in the
+// file name, its render time beside it.
+Reference cached_reference(const Scene& scene, const std::string& name, long long spp, const std::filesystem::path& out,
+                           const TradeArgs& a) {
+  const auto path = out / "reference" / (name + "_" + std::to_string(spp) + "spp.exr");
+  const auto meta = std::filesystem::path(path).replace_extension(".json");
+  Reference ref{spp, {}, {}, 0.0};
+  if (std::filesystem::exists(path)) {
+    std::optional<Image> se;
+    ref.image = read_exr(path, &se);
+    if (!se) throw Error("--out", path.string(), "a reference EXR with its standard error channels");
+    ref.se = *se;
+    std::ifstream in(meta);
+    ref.seconds = nlohmann::json::parse(in).value("seconds", 0.0);
+    return ref;
+  }
+  RenderOptions options;
+  options.threads = a.threads;
+  options.settings = {{"spp", spp}, {"seed", 1}};
+  ProgressBar bar(name + " reference " + std::to_string(spp) + " spp");
+  options.progress = bar.callback();
+  RenderResult r = timed_once(scene, "reference", options, ref.seconds);
+  write_exr(path, r.radiance, &*r.std_error);
+  std::ofstream(meta) << nlohmann::json{{"seconds", ref.seconds}}.dump();
+  ref.image = std::move(r.radiance), ref.se = std::move(*r.std_error);
+  return ref;
+}
+
 // Past the sweep's 4096 spp, the reference doubles its spp until it meets the smallest tolerance,
 // unless another row already meets it faster than the next doubling would take (time grows with
 // spp). These are the rows that method auto's reference choices are compared with.
@@ -240,7 +276,10 @@ void write_tradeoffs(const std::filesystem::path& file, const std::vector<std::s
         "comparison) only if two more seeds (8 and 9) meet it too, when a render takes under a minute; the error\n"
         "shown in the recommendations is then the largest of the three.\n\n"
         "## The references\n\nThe reference's noise limits the smallest error the comparison resolves: about\n"
-        "noise (2 / pixels)^(1/4), the spread of the noise-removed estimate.\n\n"
+        "noise (2 / pixels)^(1/4), the spread of the noise-removed estimate, for Gaussian noise; heavy tails\n"
+        "make it larger. So a scene whose reference at --spp has more noise than the smallest tolerance\n"
+        "is rendered again at the power of two of spp that its noise, falling as 1 / sqrt(spp), predicts\n"
+        "brings it under; a heavy tail can leave it a little over (the table shows the noise reached).\n\n"
         "| scene | spp | seconds | reference noise (RMS relative, lit pixels) | lit pixels | smallest error resolved |\n|---|---|---|---|---|---|\n";
   for (const auto& scene : scenes) {
     const auto& r = references[scene];
@@ -274,8 +313,8 @@ void write_tradeoffs(const std::filesystem::path& file, const std::vector<std::s
   md << "\n## Method auto\n\n`--method auto --tolerance T` chooses from the scene alone (core/src/auto.cpp says which\n"
         "measurement each rule rests on; `--explain` prints the choice and why). Here it is checked against the\n"
         "reference, and its time against the fastest swept method and settings under the same T. When the sweep\n"
-        "measured the same choice (for the reference: the same spp, another seed), its error is shown too: the\n"
-        "spread between seeds is the measurement's own uncertainty.\n\n"
+        "measured the same choice, its error is shown too. A reference choice adds samples until its own noise\n"
+        "is 0.75 T (`target_noise`); the spp it reached follows its settings.\n\n"
         "| scene | T | auto chose | seconds | error | the same, swept | under T | fastest under T | auto / fastest |\n"
         "|---|---|---|---|---|---|---|---|---|\n";
   for (const Row& r : rows) {
@@ -339,28 +378,19 @@ int run(const TradeArgs& a) {
     const std::string name = path.stem().string();
     if (!selected(name)) continue;
     const Scene scene = Scene::load(path);
-    // The reference, kept between runs: its spp and seed are in the file name.
-    const auto ref_path = out / "reference" / (name + "_" + std::to_string(a.spp) + "spp.exr");
-    std::optional<Image> se;
-    Image reference;
-    double ref_seconds = 0.0;
-    if (std::filesystem::exists(ref_path)) {
-      reference = read_exr(ref_path, &se);
-      std::ifstream meta(std::filesystem::path(ref_path).replace_extension(".json"));
-      ref_seconds = nlohmann::json::parse(meta).value("seconds", 0.0);
-    } else {
-      RenderOptions options;
-      options.threads = a.threads;
-      options.settings = {{"spp", a.spp}, {"seed", 1}};
-      ProgressBar bar(name + " reference");
-      options.progress = bar.callback();
-      RenderResult r = timed_once(scene, "reference", options, ref_seconds);
-      write_exr(ref_path, r.radiance, &*r.std_error);
-      std::ofstream(std::filesystem::path(ref_path).replace_extension(".json")) << nlohmann::json{{"seconds", ref_seconds}}.dump();
-      reference = r.radiance, se = *r.std_error;
+    // The reference's own noise is brought to the smallest tolerance: a scene whose --spp reference
+    // is noisier is rendered again at the power of two of spp predicted to bring it there (1 / sqrt(spp)).
+    Reference ref = cached_reference(scene, name, a.spp, out, a);
+    const double smallest = *std::min_element(a.tolerances.begin(), a.tolerances.end());
+    if (const double noise = ref.noise().noise_rms; noise > smallest) {
+      long long spp = a.spp;
+      while (static_cast<double>(spp) < static_cast<double>(a.spp) * (noise / smallest) * (noise / smallest)) spp *= 2;
+      ref = cached_reference(scene, name, spp, out, a);
     }
-    const LitPixelError self = lit_pixel_error(reference, reference, &*se);
-    references[name] = {{"spp", a.spp}, {"seconds", ref_seconds}, {"noise_rms", self.noise_rms}, {"pixels", self.pixels}};
+    const Image& reference = ref.image;
+    const Image& se = ref.se;
+    const LitPixelError self = ref.noise();
+    references[name] = {{"spp", ref.spp}, {"seconds", ref.seconds}, {"noise_rms", self.noise_rms}, {"pixels", self.pixels}};
 
     std::vector<Row> rows;
     for (const Config& c : sweep()) {
@@ -372,7 +402,7 @@ int run(const TradeArgs& a) {
       Row row{name, c.method, c.settings, 0.0, {}, false, {}};
       try {
         const RenderResult r = timed(scene, c.method, options, row.seconds);
-        row.error = lit_pixel_error(r.radiance, reference, &*se);
+        row.error = lit_pixel_error(r.radiance, reference, &se);
       } catch (const Cancelled&) {
         throw;
       } catch (const Error& e) {
@@ -382,9 +412,9 @@ int run(const TradeArgs& a) {
       print_row(row);
       rows.push_back(row);
     }
-    if (a.method.empty() || a.method == "reference") deepen_reference(scene, name, reference, *se, a, all, rows);
+    if (a.method.empty() || a.method == "reference") deepen_reference(scene, name, reference, se, a, all, rows);
     all.insert(all.end(), rows.begin(), rows.end());
-    recheck_seeds(scene, name, reference, *se, a, all);
+    recheck_seeds(scene, name, reference, se, a, all);
     if (!a.method.empty() && a.method != "auto") continue;
     for (double tolerance : a.tolerances) {
       RenderOptions options;
@@ -393,8 +423,10 @@ int run(const TradeArgs& a) {
       options.settings = {{"tolerance", tolerance}};
       Row row{name, "auto", options.settings, 0.0, {}, false, {}};
       const RenderResult r = timed_once(scene, "auto", options, row.seconds);  // once: its choice may be a long reference render
-      row.error = lit_pixel_error(r.radiance, reference, &*se);
+      row.error = lit_pixel_error(r.radiance, reference, &se);
       row.chosen = r.stats["auto"]["method"].get<std::string>() + " " + compact(r.stats["auto"]["settings"]);
+      if (r.stats["auto"]["settings"].contains("target_noise"))  // the reference's rounds: the samples they took
+        row.chosen += ": spp=" + std::to_string(r.stats["method_stats"]["spp"].get<long long>());
       print_row(row);
       all.push_back(row);
     }

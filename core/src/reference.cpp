@@ -7,8 +7,12 @@
 #include "majorant.h"
 
 #include <haze/core/error.h>
+#include <haze/core/image.h>
 
+#include <algorithm>
+#include <array>
 #include <chrono>
+#include <cmath>
 #include <optional>
 
 namespace haze::internal {
@@ -18,6 +22,10 @@ namespace {
 constexpr double kEpsilon = 1e-7;
 constexpr long long kSamplesPerBlock = 1024;  // a work item: one pixel's samples in blocks of this size
 constexpr int kRouletteDepth = 4;
+// With target_noise: the first round's spp (at fewer samples the noise estimate misses the heavy
+// tails; docs/REFERENCE.md) and the default cap.
+constexpr long long kFirstRound = 1024;
+constexpr long long kProgressiveCap = 1LL << 20;
 
 double mean3(const Rgb& c) { return (c.r + c.g + c.b) / 3.0; }
 double max3(const Rgb& c) { return std::max({c.r, c.g, c.b}); }
@@ -236,11 +244,66 @@ struct Tracer {
   }
 };
 
+// Per pixel: the sum and the sum of squares of its samples.
+using Sums = std::vector<std::array<Rgb, 2>>;
+
+// Adds `spp` samples per pixel drawn with `seed` to `sums`; returns the scattering events. Work
+// items (pixel, block of kSamplesPerBlock) are reduced in block order, so the sums do not depend
+// on the thread count.
+long long accumulate(const Tracer& tracer, const Camera& camera, long long spp, std::uint64_t seed, int threads,
+                     const ProgressCallback& callback, Sums& sums) {
+  const long long pixels = static_cast<long long>(sums.size());
+  const long long blocks = (spp + kSamplesPerBlock - 1) / kSamplesPerBlock;
+  std::vector<std::array<Rgb, 2>> partial(static_cast<size_t>(pixels * blocks));
+  std::vector<long long> events(static_cast<size_t>(pixels * blocks), 0);
+  ProgressTracker progress(callback, pixels * blocks);
+  parallel_for(pixels * blocks, threads, 1, [&](long long begin, long long end) {
+    for (long long item = begin; item < end && !progress.cancelled(); ++item) {
+      long long pixel = item / blocks, block = item % blocks;
+      Rng rng(seed, static_cast<std::uint64_t>(item));
+      Ray ray = camera.pixel_ray(static_cast<int>(pixel % camera.width_px), static_cast<int>(pixel / camera.width_px));
+      Rgb sum(0.0), sum2(0.0);
+      long long count = std::min(kSamplesPerBlock, spp - block * kSamplesPerBlock);
+      for (long long s = 0; s < count; ++s) {
+        Rgb v = tracer.trace(ray, rng, events[static_cast<size_t>(item)]);
+        sum += v, sum2 += v * v;
+      }
+      partial[static_cast<size_t>(item)] = {sum, sum2};
+      progress.advance();
+    }
+  });
+  progress.throw_if_cancelled();
+  long long total_events = 0;
+  for (long long pixel = 0; pixel < pixels; ++pixel)
+    for (long long b = 0; b < blocks; ++b) {
+      const auto& p = partial[static_cast<size_t>(pixel * blocks + b)];
+      sums[static_cast<size_t>(pixel)][0] += p[0], sums[static_cast<size_t>(pixel)][1] += p[1];
+      total_events += events[static_cast<size_t>(pixel * blocks + b)];
+    }
+  return total_events;
+}
+
+// The mean of n samples per pixel and its standard error, sqrt(sample variance / n).
+void finish(const Sums& sums, long long spp, RenderResult& result) {
+  const int width = result.radiance.width();
+  const double n = static_cast<double>(spp);
+  for (size_t pixel = 0; pixel < sums.size(); ++pixel) {
+    const Rgb mean = sums[pixel][0] / n;
+    const Rgb variance = spp > 1 ? glm::max(Rgb(0.0), (sums[pixel][1] - n * mean * mean) / (n - 1.0)) : Rgb(0.0);
+    const int px = static_cast<int>(pixel) % width, py = static_cast<int>(pixel) / width;
+    result.radiance.set(px, py, mean);
+    result.std_error->set(px, py, glm::sqrt(variance / n));
+  }
+}
+
 class ReferenceMethod final : public Method {
  public:
   RenderResult render(const Scene& scene, const RenderOptions& options) const override {
     Settings settings(options.settings, "reference");
-    const long long spp = settings.integer("spp", 1024, 1, 1LL << 32);
+    // With target_noise, samples are added in rounds until the image's own relative noise over
+    // the lit pixels (lit_pixel_error's noise_rms) is at most target_noise; spp is then the cap.
+    const double target_noise = settings.number("target_noise", 0.0, 0.0, 0.99);
+    const long long spp = settings.integer("spp", target_noise > 0.0 ? kProgressiveCap : 1024, 1, 1LL << 32);
     const int max_scattering = static_cast<int>(settings.integer("max_scattering", -1, -1, 100000));
     const int max_bounces = static_cast<int>(settings.integer("max_bounces", -1, -1, 100000));
     const bool view_scattering = settings.integer("view_scattering", 1, 0, 1) == 1;
@@ -264,56 +327,38 @@ class ReferenceMethod final : public Method {
     }
 
     const Camera& camera = scene.camera;
-    const long long pixels = static_cast<long long>(camera.width_px) * camera.height_px;
-    const long long blocks = (spp + kSamplesPerBlock - 1) / kSamplesPerBlock;
-    // Per work item (pixel, block): sum and sum of squares per channel; reduced in block order so
-    // results do not depend on the thread count.
-    std::vector<std::array<Rgb, 2>> partial(static_cast<size_t>(pixels * blocks));
-    std::vector<long long> events(static_cast<size_t>(pixels * blocks), 0);
-    ProgressTracker progress(options.progress, pixels * blocks);
-    parallel_for(pixels * blocks, options.threads, 1, [&](long long begin, long long end) {
-      for (long long item = begin; item < end && !progress.cancelled(); ++item) {
-        long long pixel = item / blocks, block = item % blocks;
-        Rng rng(seed, static_cast<std::uint64_t>(item));
-        Ray ray = camera.pixel_ray(static_cast<int>(pixel % camera.width_px), static_cast<int>(pixel / camera.width_px));
-        Rgb sum(0.0), sum2(0.0);
-        long long count = std::min(kSamplesPerBlock, spp - block * kSamplesPerBlock);
-        for (long long s = 0; s < count; ++s) {
-          Rgb v = tracer.trace(ray, rng, events[static_cast<size_t>(item)]);
-          sum += v, sum2 += v * v;
-        }
-        partial[static_cast<size_t>(item)] = {sum, sum2};
-        progress.advance();
-      }
-    });
-    progress.throw_if_cancelled();
-
     RenderResult result{Image(camera.width_px, camera.height_px), Image(camera.width_px, camera.height_px), {}};
-    long long total_events = 0;
-    for (long long pixel = 0; pixel < pixels; ++pixel) {
-      Rgb sum(0.0), sum2(0.0);
-      for (long long b = 0; b < blocks; ++b) {
-        sum += partial[static_cast<size_t>(pixel * blocks + b)][0];
-        sum2 += partial[static_cast<size_t>(pixel * blocks + b)][1];
-        total_events += events[static_cast<size_t>(pixel * blocks + b)];
-      }
-      const double n = static_cast<double>(spp);
-      Rgb mean = sum / n;
-      // Standard error of the mean: sqrt(sample variance / n).
-      Rgb variance = spp > 1 ? glm::max(Rgb(0.0), (sum2 - n * mean * mean) / (n - 1.0)) : Rgb(0.0);
-      int px = static_cast<int>(pixel % camera.width_px), py = static_cast<int>(pixel / camera.width_px);
-      result.radiance.set(px, py, mean);
-      result.std_error->set(px, py, glm::sqrt(variance / n));
+    Sums sums(static_cast<size_t>(camera.width_px) * camera.height_px, {Rgb(0.0), Rgb(0.0)});
+    long long done = 0, planned = target_noise > 0.0 ? std::min(spp, kFirstRound) : spp, total_events = 0;
+    double noise = 0.0;
+    for (int round = 0;; ++round) {
+      // Round r draws with its own seed, so the rounds' samples are independent.
+      const std::uint64_t round_seed = seed + static_cast<std::uint64_t>(round) * 0x9E3779B97F4A7C15ULL;
+      ProgressCallback callback;
+      if (options.progress)
+        callback = [&, from = done, to = planned](double f) { return options.progress((from + f * (to - from)) / to); };
+      total_events += accumulate(tracer, camera, planned - done, round_seed, options.threads, callback, sums);
+      done = planned;
+      finish(sums, done, result);
+      if (!(target_noise > 0.0)) break;
+      noise = lit_pixel_error(result.radiance, result.radiance, &*result.std_error).noise_rms;
+      if (noise <= target_noise || done >= spp) break;
+      // Noise falls as 1 / sqrt(spp); heavy tails make the estimate grow with spp, so a little
+      // more, and at least a quarter more per round.
+      const double wanted = 1.05 * static_cast<double>(done) * (noise / target_noise) * (noise / target_noise);
+      const double next = std::clamp(wanted, 1.25 * static_cast<double>(done), 16.0 * static_cast<double>(done));
+      planned = std::min(spp, static_cast<long long>(std::ceil(next / 64.0)) * 64);
     }
     double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    result.stats = {{"spp", spp},
+    result.stats = {{"spp", done},
                     {"seed", seed},
                     {"max_scattering", max_scattering},
                     {"max_bounces", max_bounces},
-                    {"samples", spp * pixels},
+                    {"samples", done * static_cast<long long>(sums.size())},
                     {"scattering_events", total_events},
                     {"events_per_second", static_cast<double>(total_events) / seconds},
                     {"seconds", seconds}};
+    if (target_noise > 0.0) result.stats["target_noise"] = {{"target", target_noise}, {"noise", noise}, {"met", noise <= target_noise}};
     return result;
   }
 };

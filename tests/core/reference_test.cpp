@@ -1,6 +1,7 @@
 // The reference path tracer against published plane-parallel slab results, a white furnace, and
 // direct quadrature of the single-scattering integral.
 #include <haze/core/error.h>
+#include <haze/core/image.h>
 #include <haze/core/method.h>
 #include <haze/core/rng.h>
 
@@ -206,6 +207,44 @@ TEST(Reference, SameSeedSameImageOnAnyThreadCount) {
   EXPECT_EQ(a.std_error->data(), b.std_error->data());
   two.settings["seed"] = 6;
   EXPECT_NE(render(scene, "reference", two).radiance.data(), a.radiance.data());
+}
+
+// With target_noise the tracer adds rounds of samples until the image's own relative noise over
+// the lit pixels meets the target; noise falls as 1 / sqrt(spp), so half the noise takes about 4x.
+TEST(Reference, TargetNoiseAddsSamplesUntilTheImagesOwnNoiseMeetsIt) {
+  Scene scene = slab(1.0, 0.9, PhaseFunction::henyey_greenstein(0.3), 0.7, 0.6, true);
+  scene.camera.width_px = 3;
+  auto run = [&](const nlohmann::json& settings, int threads) {
+    RenderOptions options;
+    options.threads = threads;
+    options.settings = settings;
+    return render(scene, "reference", options);
+  };
+  const RenderResult loose = run({{"target_noise", 0.01}, {"seed", 5}}, 2), tight = run({{"target_noise", 0.005}, {"seed", 5}}, 2);
+  for (const RenderResult* r : {&loose, &tight}) {
+    const double noise = lit_pixel_error(r->radiance, r->radiance, &*r->std_error).noise_rms;
+    EXPECT_DOUBLE_EQ(r->stats["target_noise"]["noise"].get<double>(), noise);
+    EXPECT_LE(noise, r->stats["target_noise"]["target"].get<double>());
+    EXPECT_TRUE(r->stats["target_noise"]["met"].get<bool>());
+    EXPECT_GE(r->stats["spp"].get<long long>(), 1024);
+  }
+  const double ratio = tight.stats["spp"].get<double>() / loose.stats["spp"].get<double>();
+  EXPECT_GT(ratio, 2.5);
+  EXPECT_LT(ratio, 6.5);
+  // The rounds and their seeds do not depend on the thread count.
+  const RenderResult one = run({{"target_noise", 0.01}, {"seed", 5}}, 1);
+  EXPECT_EQ(one.radiance.data(), loose.radiance.data());
+  EXPECT_EQ(one.stats["spp"], loose.stats["spp"]);
+  // spp caps it, and the stats say the target was not met.
+  const RenderResult capped = run({{"target_noise", 1e-4}, {"spp", 2048}}, 2);
+  EXPECT_EQ(capped.stats["spp"].get<long long>(), 2048);
+  EXPECT_FALSE(capped.stats["target_noise"]["met"].get<bool>());
+  try {
+    run({{"target_noise", -0.1}}, 2);
+    FAIL() << "accepted target_noise -0.1";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.field(), "method.target_noise");
+  }
 }
 
 TEST(Reference, SettingsAreValidatedAndCancellationStops) {
