@@ -381,7 +381,7 @@ int run(const TradeArgs& a) {
     // The reference's own noise is brought to the smallest tolerance: a scene whose --spp reference
     // is noisier is rendered again at the power of two of spp predicted to bring it there (1 / sqrt(spp)).
     Reference ref = cached_reference(scene, name, a.spp, out, a);
-    const double smallest = *std::min_element(a.tolerances.begin(), a.tolerances.end());
+    const double smallest = std::min(0.01, *std::min_element(a.tolerances.begin(), a.tolerances.end()));  // not above 1%, whatever --tolerances
     if (const double noise = ref.noise().noise_rms; noise > smallest) {
       long long spp = a.spp;
       while (static_cast<double>(spp) < static_cast<double>(a.spp) * (noise / smallest) * (noise / smallest)) spp *= 2;
