@@ -277,7 +277,7 @@ void write_tradeoffs(const std::filesystem::path& file, const std::vector<std::s
         "shown in the recommendations is then the largest of the three.\n\n"
         "## The references\n\nThe reference's noise limits the smallest error the comparison resolves: about\n"
         "noise (2 / pixels)^(1/4), the spread of the noise-removed estimate, for Gaussian noise; heavy tails\n"
-        "make it larger. So a scene whose reference at --spp has more noise than the smallest tolerance\n"
+        "make it larger. So a scene whose reference at --spp has more noise than 1% (or the smallest tolerance)\n"
         "is rendered again at the power of two of spp that its noise, falling as 1 / sqrt(spp), predicts\n"
         "brings it under; a heavy tail can leave it a little over (the table shows the noise reached).\n\n"
         "| scene | spp | seconds | reference noise (RMS relative, lit pixels) | lit pixels | smallest error resolved |\n|---|---|---|---|---|---|\n";
@@ -378,10 +378,11 @@ int run(const TradeArgs& a) {
     const std::string name = path.stem().string();
     if (!selected(name)) continue;
     const Scene scene = Scene::load(path);
-    // The reference's own noise is brought to the smallest tolerance: a scene whose --spp reference
-    // is noisier is rendered again at the power of two of spp predicted to bring it there (1 / sqrt(spp)).
+    // The reference's own noise is brought to 1% (or the smallest tolerance, if smaller; the same
+    // reference whatever --tolerances a run takes): a scene whose --spp reference is noisier is
+    // rendered again at the power of two of spp predicted to bring it there (1 / sqrt(spp)).
     Reference ref = cached_reference(scene, name, a.spp, out, a);
-    const double smallest = std::min(0.01, *std::min_element(a.tolerances.begin(), a.tolerances.end()));  // not above 1%, whatever --tolerances
+    const double smallest = std::min(0.01, *std::min_element(a.tolerances.begin(), a.tolerances.end()));
     if (const double noise = ref.noise().noise_rms; noise > smallest) {
       long long spp = a.spp;
       while (static_cast<double>(spp) < static_cast<double>(a.spp) * (noise / smallest) * (noise / smallest)) spp *= 2;

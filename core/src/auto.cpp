@@ -35,6 +35,7 @@ constexpr double kNoiseShare = 0.75;
 
 AutoChoice reference_for(double tolerance, AutoChoice choice) {
   choice.method = "reference";
+  // Rounded to 6 decimals so the setting prints as written (0.0375, not 0.037500000000000006).
   choice.settings = {{"target_noise", std::round(kNoiseShare * tolerance * 1e6) / 1e6}, {"seed", 5}};
   choice.why.push_back(format("reference: adds samples until its own noise over the lit pixels is %.2f T (%.2f%%)", kNoiseShare,
                               100.0 * kNoiseShare * tolerance));
