@@ -104,12 +104,12 @@ void BM_AnalyticFrame(benchmark::State& state) {
   } else {
     set_airlight_batch_function(nullptr);
   }
-  auto method = create_method("analytic");
-  method->render(scene, options);  // fills the cache and the method's tables
+  Solution solution = prepare(scene, "analytic", options);  // fills the cache and the method's tables
   int frame = 0;
   for (auto _ : state) {
     scene.medium->phase = PhaseFunction::henyey_greenstein(++frame % 2 ? 0.58 : 0.62);
-    benchmark::DoNotOptimize(method->render(scene, options).radiance.data().data());
+    solution.update({.medium = scene.medium});
+    benchmark::DoNotOptimize(solution.render().radiance.data().data());
   }
   set_airlight_batch_function(nullptr);
   state.SetLabel(state.range(0) ? "simd airlight" : "float64 airlight");
@@ -124,7 +124,7 @@ void BM_FrameTables(benchmark::State& state) {
   RenderOptions options;
   options.threads = 2;
   options.settings = {{"dynamic_g_tolerance", 1e-2}};
-  for (auto _ : state) benchmark::DoNotOptimize(create_method("analytic")->render(scene, options).stats);
+  for (auto _ : state) benchmark::DoNotOptimize(prepare(scene, "analytic", options).stats());
 }
 BENCHMARK(BM_FrameTables)->Name("analytic/frame_tables_dynamic_g/threads:2")->UseRealTime()->Unit(benchmark::kMillisecond)->Iterations(1);
 

@@ -8,9 +8,9 @@
 
 #include <haze/core/airlight.h>
 #include <haze/core/error.h>
+#include <haze/core/stopwatch.h>
 
 #include <array>
-#include <chrono>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -25,7 +25,7 @@ struct AnalyticLight {
   Light light;
   Vec3 position;
   Rgb intensity;
-  const SpotLight* spot;
+  const SpotLight* spot() const { return std::get_if<SpotLight>(&light); }
 };
 
 // What surface shading needs: the medium, the lights and the J tables.
@@ -73,6 +73,133 @@ struct SurfaceShading {
   }
 };
 
+// Prepared: the medium, the lights and the tables; each view is evaluated from them.
+class AnalyticSolution final : public MethodSolution {
+ public:
+  AnalyticSolution(const Scene& scene, std::vector<AnalyticLight> lights, std::unique_ptr<Medium> medium, const Rgb& sigma_t,
+                   const Rgb& sigma_s, bool grey, bool airlight, bool surface_airlight, AirlightTable table,
+                   std::optional<SurfaceAirlightTable> lambert, std::map<double, SurfaceAirlightTable> phong)
+      : scene_(scene),
+        lights_(std::move(lights)),
+        medium_(std::move(medium)),
+        sigma_t_(sigma_t),
+        sigma_s_(sigma_s),
+        grey_(grey),
+        airlight_(airlight),
+        surface_airlight_(surface_airlight),
+        table_(std::move(table)),
+        lambert_(std::move(lambert)),
+        phong_(std::move(phong)) {}
+
+  RenderResult render(const View& view, const RenderOptions& options) const override {
+    const Camera& camera = view.camera;
+    const Aabb bounds = medium_->bounds();
+    const Stopwatch watch;
+    RenderResult result{Image(camera.width_px, camera.height_px), std::nullopt, {}};
+    ProgressTracker progress(options.progress, camera.height_px);
+    const AirlightBatchFunction add_airlight = airlight_batch_function();
+    const SurfaceShading shade{*medium_, lights_, sigma_t_, sigma_s_, grey_, surface_airlight_, lambert_, phong_};
+    parallel_for(camera.height_px, options.threads, 1, [&](long long y0, long long y1) {
+      // Per row: the view segments inside the medium as float arrays, then each point light's
+      // airlight over the whole row in one batch (SIMD when haze::simd::install() has run).
+      std::vector<float> ox, oy, oz, dx, dy, dz, seg;
+      std::vector<int> slot(static_cast<size_t>(camera.width_px));
+      struct PixelHit {
+        Ray ray;
+        double t_hit;
+        Vec3 normal;
+        const Surface* hit;
+      };
+      std::vector<PixelHit> row(static_cast<size_t>(camera.width_px));
+      std::array<std::vector<float>, 3> batch_airlight;
+      std::vector<float> unit;
+      for (auto y = static_cast<int>(y0); y < y1 && !progress.cancelled(); ++y) {
+        for (auto* v : {&ox, &oy, &oz, &dx, &dy, &dz, &seg}) v->clear();
+        for (int x = 0; x < camera.width_px; ++x) {
+          PixelHit& px = row[static_cast<size_t>(x)];
+          px.ray = camera.pixel_ray(x, y);
+          px.normal = Vec3(0.0);
+          px.hit = nearest_surface(scene_.surfaces, px.ray, kInfinity, px.t_hit, px.normal);
+          const Ray& ray = px.ray;
+          double t0 = 0.0, t1 = px.t_hit;
+          slot[static_cast<size_t>(x)] = -1;
+          if (!(airlight_ && bounds.clip(ray, t0, t1) && t1 > t0)) continue;
+          slot[static_cast<size_t>(x)] = static_cast<int>(ox.size());
+          Vec3 entry = ray.at(t0);
+          ox.push_back(static_cast<float>(entry.x)), oy.push_back(static_cast<float>(entry.y)), oz.push_back(static_cast<float>(entry.z));
+          dx.push_back(static_cast<float>(ray.direction.x)), dy.push_back(static_cast<float>(ray.direction.y));
+          dz.push_back(static_cast<float>(ray.direction.z));
+          seg.push_back(std::isfinite(t1) ? static_cast<float>(t1 - t0) : INFINITY);
+        }
+        const SegmentBatch batch{ox.data(), oy.data(), oz.data(), dx.data(), dy.data(), dz.data(), seg.data(), ox.size()};
+        for (auto& channel : batch_airlight) channel.assign(ox.size(), 0.0f);
+        for (const auto& light : lights_) {
+          if (light.spot()) continue;
+          const Vec3& p = light.position;
+          if (grey_) {
+            // One batch at unit intensity, scaled per channel: airlight is linear in I.
+            unit.assign(ox.size(), 0.0f);
+            add_airlight(table_, {static_cast<float>(p.x), static_cast<float>(p.y), static_cast<float>(p.z),
+                                 static_cast<float>(sigma_t_[0]), static_cast<float>(sigma_s_[0]), 1.0f},
+                         batch, unit.data());
+            for (int c = 0; c < 3; ++c)
+              for (size_t i = 0; i < unit.size(); ++i)
+                batch_airlight[static_cast<size_t>(c)][i] += static_cast<float>(light.intensity[c]) * unit[i];
+            continue;
+          }
+          for (int c = 0; c < 3; ++c) {
+            if (sigma_s_[c] == 0.0 || light.intensity[c] == 0.0) continue;
+            add_airlight(table_, {static_cast<float>(p.x), static_cast<float>(p.y), static_cast<float>(p.z), static_cast<float>(sigma_t_[c]),
+                                 static_cast<float>(sigma_s_[c]), static_cast<float>(light.intensity[c])},
+                         batch, batch_airlight[static_cast<size_t>(c)].data());
+          }
+        }
+        for (int x = 0; x < camera.width_px; ++x) {
+          const auto& [ray, t_hit, normal, hit] = row[static_cast<size_t>(x)];
+          Rgb radiance(0.0);
+          if (int k = slot[static_cast<size_t>(x)]; k >= 0) {
+            for (int c = 0; c < 3; ++c) radiance[c] = static_cast<double>(batch_airlight[static_cast<size_t>(c)][static_cast<size_t>(k)]);
+            double t0 = 0.0, t1 = t_hit;
+            bounds.clip(ray, t0, t1);
+            Vec3 entry = ray.at(t0);
+            for (const auto& light : lights_) {
+              if (!light.spot()) continue;
+              for (int c = 0; c < 3; ++c) {
+                if (sigma_s_[c] == 0.0 || light.intensity[c] == 0.0) continue;
+                radiance[c] += spot_airlight(scene_.medium->phase, {sigma_t_[c], sigma_s_[c], light.intensity[c]}, entry, ray.direction,
+                                             t1 - t0, light.position, light.spot()->direction, light.spot()->exponent,
+                                             light.spot()->cone_deg);
+              }
+            }
+          }
+          Rgb view_t = medium_->transmittance_along(ray.origin, ray.direction, t_hit);
+          if (hit) {
+            Rgb surface = shade(*hit, ray.at(t_hit), normal, ray.direction);
+            radiance += view_t * surface;
+          } else {
+            radiance += view_t * scene_.background;
+          }
+          result.radiance.set(x, y, radiance);
+        }
+        progress.advance();
+      }
+    });
+    progress.throw_if_cancelled();
+    result.stats = {{"seconds", watch.seconds()}};
+    return result;
+  }
+
+ private:
+  const Scene scene_;
+  const std::vector<AnalyticLight> lights_;
+  const std::unique_ptr<Medium> medium_;
+  const Rgb sigma_t_, sigma_s_;
+  const bool grey_, airlight_, surface_airlight_;
+  const AirlightTable table_;
+  const std::optional<SurfaceAirlightTable> lambert_;
+  const std::map<double, SurfaceAirlightTable> phong_;
+};
+
 class AnalyticMethod final : public Method {
  public:
   // Tables stay with this object between renders: reuse one object (haze::create_method) to
@@ -88,7 +215,7 @@ class AnalyticMethod final : public Method {
     return value;
   }
 
-  RenderResult render(const Scene& scene, const RenderOptions& options) const override {
+  std::unique_ptr<MethodSolution> prepare(const Scene& scene, const RenderOptions& options) const override {
     Settings settings(options.settings, "analytic");
     const int a_samples = static_cast<int>(settings.integer("table_a", 256, 16, 4096));
     const int eta_samples = static_cast<int>(settings.integer("table_eta", 512, 16, 4096));
@@ -106,16 +233,16 @@ class AnalyticMethod final : public Method {
     std::vector<AnalyticLight> lights;
     for (size_t i = 0; i < scene.lights.size(); ++i) {
       if (auto* p = std::get_if<PointLight>(&scene.lights[i])) {
-        lights.push_back({*p, p->position, p->intensity, nullptr});
+        lights.push_back({*p, p->position, p->intensity});
       } else if (auto* sp = std::get_if<SpotLight>(&scene.lights[i])) {
-        lights.push_back({*sp, sp->position, sp->intensity, sp});
+        lights.push_back({*sp, sp->position, sp->intensity});
       } else {
         throw Error("lights[" + std::to_string(i) + "].type", "a directional or sky light",
                     "point or spot lights for the analytic method");
       }
     }
 
-    auto start = std::chrono::steady_clock::now();
+    const Stopwatch watch;
     auto medium = make_medium(desc);
     const Rgb sigma_t = desc.sigma_t * constant->value;
     const Rgb sigma_s = desc.albedo * sigma_t;
@@ -174,108 +301,15 @@ class AnalyticMethod final : public Method {
         if (s.ks != Rgb(0.0) && !phong.count(s.shininess)) phong.emplace(s.shininess, surface_table(s.shininess));
       }
     }
-    double table_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-
-    const Camera& camera = scene.camera;
-    const Aabb bounds = medium->bounds();
-    RenderResult result{Image(camera.width_px, camera.height_px), std::nullopt, {}};
-    ProgressTracker progress(options.progress, camera.height_px);
-    const AirlightBatchFunction add_airlight = airlight_batch_function();
-    const SurfaceShading shade{*medium, lights, sigma_t, sigma_s, grey, surface_airlight, lambert, phong};
-    parallel_for(camera.height_px, options.threads, 1, [&](long long y0, long long y1) {
-      // Per row: the view segments inside the medium as float arrays, then each point light's
-      // airlight over the whole row in one batch (SIMD when haze::simd::install() has run).
-      std::vector<float> ox, oy, oz, dx, dy, dz, seg;
-      std::vector<int> slot(static_cast<size_t>(camera.width_px));
-      struct PixelHit {
-        Ray ray;
-        double t_hit;
-        Vec3 normal;
-        const Surface* hit;
-      };
-      std::vector<PixelHit> row(static_cast<size_t>(camera.width_px));
-      std::array<std::vector<float>, 3> batch_airlight;
-      std::vector<float> unit;
-      for (auto y = static_cast<int>(y0); y < y1 && !progress.cancelled(); ++y) {
-        for (auto* v : {&ox, &oy, &oz, &dx, &dy, &dz, &seg}) v->clear();
-        for (int x = 0; x < camera.width_px; ++x) {
-          PixelHit& px = row[static_cast<size_t>(x)];
-          px.ray = camera.pixel_ray(x, y);
-          px.normal = Vec3(0.0);
-          px.hit = nearest_surface(scene.surfaces, px.ray, kInfinity, px.t_hit, px.normal);
-          const Ray& ray = px.ray;
-          double t0 = 0.0, t1 = px.t_hit;
-          slot[static_cast<size_t>(x)] = -1;
-          if (!(airlight && bounds.clip(ray, t0, t1) && t1 > t0)) continue;
-          slot[static_cast<size_t>(x)] = static_cast<int>(ox.size());
-          Vec3 entry = ray.at(t0);
-          ox.push_back(static_cast<float>(entry.x)), oy.push_back(static_cast<float>(entry.y)), oz.push_back(static_cast<float>(entry.z));
-          dx.push_back(static_cast<float>(ray.direction.x)), dy.push_back(static_cast<float>(ray.direction.y));
-          dz.push_back(static_cast<float>(ray.direction.z));
-          seg.push_back(std::isfinite(t1) ? static_cast<float>(t1 - t0) : INFINITY);
-        }
-        const SegmentBatch batch{ox.data(), oy.data(), oz.data(), dx.data(), dy.data(), dz.data(), seg.data(), ox.size()};
-        for (auto& channel : batch_airlight) channel.assign(ox.size(), 0.0f);
-        for (const auto& light : lights) {
-          if (light.spot) continue;
-          const Vec3& p = light.position;
-          if (grey) {
-            // One batch at unit intensity, scaled per channel: airlight is linear in I.
-            unit.assign(ox.size(), 0.0f);
-            add_airlight(table, {static_cast<float>(p.x), static_cast<float>(p.y), static_cast<float>(p.z),
-                                 static_cast<float>(sigma_t[0]), static_cast<float>(sigma_s[0]), 1.0f},
-                         batch, unit.data());
-            for (int c = 0; c < 3; ++c)
-              for (size_t i = 0; i < unit.size(); ++i)
-                batch_airlight[static_cast<size_t>(c)][i] += static_cast<float>(light.intensity[c]) * unit[i];
-            continue;
-          }
-          for (int c = 0; c < 3; ++c) {
-            if (sigma_s[c] == 0.0 || light.intensity[c] == 0.0) continue;
-            add_airlight(table, {static_cast<float>(p.x), static_cast<float>(p.y), static_cast<float>(p.z), static_cast<float>(sigma_t[c]),
-                                 static_cast<float>(sigma_s[c]), static_cast<float>(light.intensity[c])},
-                         batch, batch_airlight[static_cast<size_t>(c)].data());
-          }
-        }
-        for (int x = 0; x < camera.width_px; ++x) {
-          const auto& [ray, t_hit, normal, hit] = row[static_cast<size_t>(x)];
-          Rgb radiance(0.0);
-          if (int k = slot[static_cast<size_t>(x)]; k >= 0) {
-            for (int c = 0; c < 3; ++c) radiance[c] = static_cast<double>(batch_airlight[static_cast<size_t>(c)][static_cast<size_t>(k)]);
-            double t0 = 0.0, t1 = t_hit;
-            bounds.clip(ray, t0, t1);
-            Vec3 entry = ray.at(t0);
-            for (const auto& light : lights) {
-              if (!light.spot) continue;
-              for (int c = 0; c < 3; ++c) {
-                if (sigma_s[c] == 0.0 || light.intensity[c] == 0.0) continue;
-                radiance[c] += spot_airlight(desc.phase, {sigma_t[c], sigma_s[c], light.intensity[c]}, entry, ray.direction,
-                                             t1 - t0, light.position, light.spot->direction, light.spot->exponent,
-                                             light.spot->cone_deg);
-              }
-            }
-          }
-          Rgb view_t = medium->transmittance_along(ray.origin, ray.direction, t_hit);
-          if (hit) {
-            Rgb surface = shade(*hit, ray.at(t_hit), normal, ray.direction);
-            radiance += view_t * surface;
-          } else {
-            radiance += view_t * scene.background;
-          }
-          result.radiance.set(x, y, radiance);
-        }
-        progress.advance();
-      }
-    });
-    progress.throw_if_cancelled();
-    result.stats = {{"table_seconds", table_seconds},
-                    {"airlight_path", add_airlight == &add_airlight_float64 ? "float64" : "simd"},
-                    {"tables_reused", all_reused},
-                    {"table", {a_samples, eta_samples}},
-                    {"legendre_terms", legendre_terms},
-                    {"truncation_bound", truncation_bound},
-                    {"seconds", std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()}};
-    return result;
+    auto solution = std::make_unique<AnalyticSolution>(scene, std::move(lights), std::move(medium), sigma_t, sigma_s, grey, airlight,
+                                                       surface_airlight, table, std::move(lambert), std::move(phong));
+    solution->stats = {{"table_seconds", watch.seconds()},
+                       {"airlight_path", airlight_batch_function() == &add_airlight_float64 ? "float64" : "simd"},
+                       {"tables_reused", all_reused},
+                       {"table", {a_samples, eta_samples}},
+                       {"legendre_terms", legendre_terms},
+                       {"truncation_bound", truncation_bound}};
+    return solution;
   }
 
  private:

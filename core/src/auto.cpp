@@ -42,9 +42,35 @@ AutoChoice reference_for(double tolerance, AutoChoice choice) {
   return choice;
 }
 
+// The chosen method's solution, with the choice in the stats.
+class AutoSolution final : public MethodSolution {
+ public:
+  explicit AutoSolution(Solution chosen) : chosen_(std::move(chosen)) {}
+  RenderResult render(const View& view, const RenderOptions& options) const override {
+    RenderOptions o;
+    o.threads = options.threads;
+    o.progress = options.progress;
+    RenderResult result = chosen_.render(view, o);
+    result.stats = {{"method_stats", std::move(result.stats)}};
+    return result;
+  }
+  std::optional<UpdateReport> update(const Scene&, const SceneChange& change, const RenderOptions& options) override {
+    RenderOptions o;
+    o.threads = options.threads;
+    o.progress = options.progress;
+    return chosen_.update(change, o);
+  }
+  Rgb transmittance(size_t light, const Vec3& x) const override { return chosen_.transmittance(light, x); }
+  Rgb fluence(const Vec3& x) const override { return chosen_.fluence(x); }
+  Rgb inscattered(const Vec3& x, const Vec3& w) const override { return chosen_.inscattered(x, w); }
+
+ private:
+  Solution chosen_;
+};
+
 class AutoMethod final : public Method {
  public:
-  RenderResult render(const Scene& scene, const RenderOptions& options) const override {
+  std::unique_ptr<MethodSolution> prepare(const Scene& scene, const RenderOptions& options) const override {
     Settings settings(options.settings, "auto");
     const double tolerance = settings.number("tolerance", 0.05, 1e-4, 0.99);
     settings.reject_unknown();
@@ -55,10 +81,9 @@ class AutoMethod final : public Method {
     }
     RenderOptions delegated = options;
     delegated.settings = choice.settings;
-    RenderResult result = haze::render(scene, choice.method, delegated);
-    result.stats = {{"auto", {{"tolerance", tolerance}, {"method", choice.method}, {"settings", choice.settings}, {"why", choice.why}}},
-                    {"method_stats", result.stats}};
-    return result;
+    auto solution = std::make_unique<AutoSolution>(haze::prepare(scene, choice.method, delegated));
+    solution->stats = {{"auto", {{"tolerance", tolerance}, {"method", choice.method}, {"settings", choice.settings}, {"why", choice.why}}}};
+    return solution;
   }
 };
 

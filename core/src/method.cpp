@@ -1,7 +1,6 @@
 #include "builtin_methods.h"
 
 #include <haze/core/error.h>
-#include <haze/core/light_culling.h>
 #include <haze/core/method.h>
 
 #include <algorithm>
@@ -80,73 +79,31 @@ std::filesystem::path default_cache_dir() {
   return std::filesystem::temp_directory_path() / "haze";
 }
 
-namespace {
-
-// The method on the scene without the lights that reach nothing it shows (light_culling.h), which
-// the stats list. A scene whose lights all reach nothing renders as it is.
-RenderResult render_culled(const Method& method, bool single_scattering, const Scene& scene, const RenderOptions& options) {
-  const std::vector<CulledLight> culled = culled_lights(scene, single_scattering);
-  if (culled.empty() || culled.size() == scene.lights.size()) return method.render(scene, options);
-  Scene kept = scene;
-  kept.lights.clear();
-  std::vector<size_t> original;  // kept light -> its index in scene.lights
-  nlohmann::json listed = nlohmann::json::array();
-  for (size_t i = 0, c = 0; i < scene.lights.size(); ++i) {
-    if (c < culled.size() && culled[c].index == i) listed.push_back({{"index", i}, {"why", culled[c++].why}});
-    else kept.lights.push_back(scene.lights[i]), original.push_back(i);
-  }
-  try {
-    RenderResult result = method.render(kept, options);
-    result.stats["culled_lights"] = listed;
-    return result;
-  } catch (const Cancelled&) {
-    throw;
-  } catch (const Error& e) {
-    // An error about "lights[k]..." names the caller's light, not the k-th one kept.
-    const std::string& field = e.field();
-    const size_t close = field.find(']');
-    if (field.rfind("lights[", 0) != 0 || close == std::string::npos || close == 7) throw;
-    const std::string digits = field.substr(7, close - 7);
-    if (!std::all_of(digits.begin(), digits.end(), [](char ch) { return ch >= '0' && ch <= '9'; })) throw;
-    const size_t k = std::stoul(digits);
-    if (k >= original.size()) throw;
-    throw Error("lights[" + std::to_string(original[k]) + field.substr(close), e.value(), e.expected());
-  }
+// Registry look-ups for solution.cpp.
+MethodInfo method_info(const std::string& name) {
+  create_method(name);  // the error lists the available methods
+  auto& r = registry();
+  std::lock_guard lock(r.mutex);
+  return r.methods.at(name);
 }
 
+ParticleMediumFactory particle_medium_factory() {
+  auto& r = registry();
+  std::lock_guard lock(r.mutex);
+  return r.particle_medium;
+}
+
+std::optional<UpdateReport> MethodSolution::update(const Scene&, const SceneChange&, const RenderOptions&) { return std::nullopt; }
+
+namespace {
+[[noreturn]] void no_field(const char* field) {
+  throw Error(field, std::string(internal::kNoField), "a method that keeps lighting fields on a grid");
+}
 }  // namespace
 
-RenderResult render(const Scene& scene, const std::string& method_name, RenderOptions options) {
-  std::string name = method_name.empty() ? scene.method_name() : method_name;
-  if (name.empty()) throw Error("method.name", "missing", "a method named by the scene or the caller");
-  auto method = create_method(name);
-  nlohmann::json settings = nlohmann::json::object();
-  if (scene.method_name() == name) settings = scene.method;
-  for (const auto& [key, value] : options.settings.items()) settings[key] = value;
-  settings.erase("name");
-  auto& r = registry();
-  ParticleMediumFactory factory;
-  bool reads_particles = false, single_scattering = false;
-  {
-    std::lock_guard lock(r.mutex);
-    factory = r.particle_medium;
-    reads_particles = r.methods.at(name).reads_particles;
-    single_scattering = r.methods.at(name).single_scattering;
-  }
-  if (!scene.particles.is_null()) {
-    if (!reads_particles) {
-      if (scene.medium)
-        throw Error("particles", "given with a medium", "one of `medium` and `particles` for method " + name + ", which renders one medium");
-      if (!factory) throw Error("particles", "no particle module registered", "haze::particles::register_methods() before rendering particles");
-      Scene converted = scene;
-      converted.medium = factory(scene, settings);
-      options.settings = std::move(settings);
-      return render_culled(*method, single_scattering, converted, options);
-    }
-  }
-  options.settings = std::move(settings);
-  return render_culled(*method, single_scattering, scene, options);
-}
+Rgb MethodSolution::transmittance(size_t, const Vec3&) const { no_field("transmittance"); }
+Rgb MethodSolution::fluence(const Vec3&) const { no_field("fluence"); }
+Rgb MethodSolution::inscattered(const Vec3&, const Vec3&) const { no_field("inscattered"); }
 
 }  // namespace haze
 

@@ -8,6 +8,7 @@
 
 #include <haze/core/directions.h>
 #include <haze/core/error.h>
+#include <haze/core/stopwatch.h>
 
 #include <algorithm>
 #include <chrono>
@@ -140,35 +141,47 @@ struct Context {
   }
 };
 
-class QuadratureMethod final : public Method {
+// Prepared: the medium and the sky's directions; each view is integrated from scratch.
+class QuadratureSolution final : public MethodSolution {
  public:
-  RenderResult render(const Scene& scene, const RenderOptions& options) const override {
-    Settings settings(options.settings, "quadrature");
-    int steps = static_cast<int>(settings.integer("steps", 512, kNodesPerPanel, 1 << 20));
-    int sky_count = static_cast<int>(settings.integer("sky_directions", 256, 1, 1 << 16));
-    settings.reject_unknown();
+  QuadratureSolution(const Scene& scene, int steps, int sky_count)
+      : scene_(scene), ctx_{scene_, scene.medium ? make_medium(*scene.medium) : nullptr, Rgb(0.0), DirectionSet::fibonacci(sky_count), steps} {
+    for (const auto& light : scene_.lights)
+      if (auto* sky = std::get_if<SkyLight>(&light)) ctx_.sky += sky->radiance;
+    gauss_legendre(kNodesPerPanel, nodes_, weights_);
+    stats = {{"steps", steps}, {"sky_directions", sky_count}};
+  }
 
-    auto start = std::chrono::steady_clock::now();
-    Context ctx{scene, scene.medium ? make_medium(*scene.medium) : nullptr, Rgb(0.0), DirectionSet::fibonacci(sky_count), steps};
-    for (const auto& light : scene.lights)
-      if (auto* sky = std::get_if<SkyLight>(&light)) ctx.sky += sky->radiance;
-    std::vector<double> nodes, weights;
-    gauss_legendre(kNodesPerPanel, nodes, weights);
-
-    const Camera& camera = scene.camera;
+  RenderResult render(const View& view, const RenderOptions& options) const override {
+    const Stopwatch watch;
+    const Camera& camera = view.camera;
     RenderResult result{Image(camera.width_px, camera.height_px), std::nullopt, {}};
     ProgressTracker progress(options.progress, camera.height_px);
     parallel_for(camera.height_px, options.threads, 1, [&](long long y0, long long y1) {
       for (auto y = static_cast<int>(y0); y < y1 && !progress.cancelled(); ++y) {
-        for (int x = 0; x < camera.width_px; ++x) result.radiance.set(x, y, ctx.pixel(camera.pixel_ray(x, y), nodes, weights));
+        for (int x = 0; x < camera.width_px; ++x) result.radiance.set(x, y, ctx_.pixel(camera.pixel_ray(x, y), nodes_, weights_));
         progress.advance();
       }
     });
     progress.throw_if_cancelled();
-    result.stats = {{"steps", steps},
-                    {"sky_directions", sky_count},
-                    {"seconds", std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()}};
+    result.stats = {{"seconds", watch.seconds()}};
     return result;
+  }
+
+ private:
+  const Scene scene_;
+  Context ctx_;  // reads scene_
+  std::vector<double> nodes_, weights_;
+};
+
+class QuadratureMethod final : public Method {
+ public:
+  std::unique_ptr<MethodSolution> prepare(const Scene& scene, const RenderOptions& options) const override {
+    Settings settings(options.settings, "quadrature");
+    const int steps = static_cast<int>(settings.integer("steps", 512, kNodesPerPanel, 1 << 20));
+    const int sky_count = static_cast<int>(settings.integer("sky_directions", 256, 1, 1 << 16));
+    settings.reject_unknown();
+    return std::make_unique<QuadratureSolution>(scene, steps, sky_count);
   }
 };
 

@@ -7,6 +7,7 @@
 #include "majorant.h"
 
 #include <haze/core/error.h>
+#include <haze/core/stopwatch.h>
 #include <haze/core/image.h>
 
 #include <algorithm>
@@ -296,70 +297,99 @@ void finish(const Sums& sums, long long spp, RenderResult& result) {
   }
 }
 
-class ReferenceMethod final : public Method {
+struct ReferenceSettings {
+  double target_noise = 0.0;
+  long long spp = 1024;
+  int max_scattering = -1, max_bounces = -1;
+  bool view_scattering = true;
+  std::uint64_t seed = 1;
+};
+
+// Prepared: the medium and its majorant grid; each view is traced from scratch.
+class ReferenceSolution final : public MethodSolution {
  public:
-  RenderResult render(const Scene& scene, const RenderOptions& options) const override {
-    Settings settings(options.settings, "reference");
-    // With target_noise, samples are added in rounds until the image's own relative noise over
-    // the lit pixels (lit_pixel_error's noise_rms) is at most target_noise; spp is then the cap.
-    const double target_noise = settings.number("target_noise", 0.0, 0.0, 0.99);
-    const long long spp = settings.integer("spp", target_noise > 0.0 ? kProgressiveCap : 1024, 1, 1LL << 32);
-    const int max_scattering = static_cast<int>(settings.integer("max_scattering", -1, -1, 100000));
-    const int max_bounces = static_cast<int>(settings.integer("max_bounces", -1, -1, 100000));
-    const bool view_scattering = settings.integer("view_scattering", 1, 0, 1) == 1;
-    const auto seed = static_cast<std::uint64_t>(settings.integer("seed", 1, 0, 1LL << 62));
-    settings.reject_unknown();
-
-    auto start = std::chrono::steady_clock::now();
-    std::unique_ptr<Medium> medium = scene.medium ? make_medium(*scene.medium) : nullptr;
-    Tracer tracer{scene, medium.get(), std::nullopt, 0.0, Rgb(0.0), max_scattering, max_bounces, false, view_scattering,
-                  false, Aabb{}, Rgb(0.0)};
-    if (medium) {
-      tracer.majorants.emplace(*medium);
-      tracer.sigma_max = max3(medium->sigma_t_scale());
-      tracer.homogeneous = medium->homogeneous();
-      tracer.bounds = medium->bounds();
-      if (tracer.homogeneous) tracer.sigma_t_homogeneous = medium->sigma_t_scale() * medium->max_density(tracer.bounds);
+  ReferenceSolution(const Scene& scene, const ReferenceSettings& s)
+      : scene_(scene),
+        settings_(s),
+        medium_(scene.medium ? make_medium(*scene.medium) : nullptr),
+        tracer_{scene_, medium_.get(), std::nullopt, 0.0, Rgb(0.0), s.max_scattering, s.max_bounces, false, s.view_scattering,
+                false, Aabb{}, Rgb(0.0)} {
+    const Stopwatch watch;
+    if (medium_) {
+      tracer_.majorants.emplace(*medium_);
+      tracer_.sigma_max = max3(medium_->sigma_t_scale());
+      tracer_.homogeneous = medium_->homogeneous();
+      tracer_.bounds = medium_->bounds();
+      if (tracer_.homogeneous) tracer_.sigma_t_homogeneous = medium_->sigma_t_scale() * medium_->max_density(tracer_.bounds);
     }
-    for (const auto& light : scene.lights) {
-      if (auto* s = std::get_if<SkyLight>(&light)) tracer.sky += s->radiance;
-      tracer.local_lights |= Tracer::is_local(light);
+    for (const auto& light : scene_.lights) {
+      if (auto* sky = std::get_if<SkyLight>(&light)) tracer_.sky += sky->radiance;
+      tracer_.local_lights |= Tracer::is_local(light);
     }
+    stats["prepare_seconds"] = watch.seconds();
+  }
 
-    const Camera& camera = scene.camera;
+  RenderResult render(const View& view, const RenderOptions& options) const override {
+    const Stopwatch watch;
+    const ReferenceSettings& s = settings_;
+    const Camera& camera = view.camera;
     RenderResult result{Image(camera.width_px, camera.height_px), Image(camera.width_px, camera.height_px), {}};
     Sums sums(static_cast<size_t>(camera.width_px) * camera.height_px, {Rgb(0.0), Rgb(0.0)});
-    long long done = 0, planned = target_noise > 0.0 ? std::min(spp, kFirstRound) : spp, total_events = 0;
+    long long done = 0, planned = s.target_noise > 0.0 ? std::min(s.spp, kFirstRound) : s.spp, total_events = 0;
     double noise = 0.0;
     for (int round = 0;; ++round) {
       // Round r draws with its own seed, so the rounds' samples are independent.
-      const std::uint64_t round_seed = seed + static_cast<std::uint64_t>(round) * 0x9E3779B97F4A7C15ULL;
+      const std::uint64_t round_seed = s.seed + static_cast<std::uint64_t>(round) * 0x9E3779B97F4A7C15ULL;
       ProgressCallback callback;
       if (options.progress)
         callback = [&, from = done, to = planned](double f) { return options.progress((from + f * (to - from)) / to); };
-      total_events += accumulate(tracer, camera, planned - done, round_seed, options.threads, callback, sums);
+      total_events += accumulate(tracer_, camera, planned - done, round_seed, options.threads, callback, sums);
       done = planned;
       finish(sums, done, result);
-      if (!(target_noise > 0.0)) break;
+      if (!(s.target_noise > 0.0)) break;
       noise = lit_pixel_error(result.radiance, result.radiance, &*result.std_error).noise_rms;
-      if (noise <= target_noise || done >= spp) break;
+      if (noise <= s.target_noise || done >= s.spp) break;
       // Noise falls as 1 / sqrt(spp); heavy tails make the estimate grow with spp, so a little
       // more, and at least a quarter more per round.
-      const double wanted = 1.05 * static_cast<double>(done) * (noise / target_noise) * (noise / target_noise);
+      const double wanted = 1.05 * static_cast<double>(done) * (noise / s.target_noise) * (noise / s.target_noise);
       const double next = std::clamp(wanted, 1.25 * static_cast<double>(done), 16.0 * static_cast<double>(done));
-      planned = std::min(spp, static_cast<long long>(std::ceil(next / 64.0)) * 64);
+      planned = std::min(s.spp, static_cast<long long>(std::ceil(next / 64.0)) * 64);
     }
-    double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const double seconds = watch.seconds();
     result.stats = {{"spp", done},
-                    {"seed", seed},
-                    {"max_scattering", max_scattering},
-                    {"max_bounces", max_bounces},
+                    {"seed", s.seed},
+                    {"max_scattering", s.max_scattering},
+                    {"max_bounces", s.max_bounces},
                     {"samples", done * static_cast<long long>(sums.size())},
                     {"scattering_events", total_events},
                     {"events_per_second", static_cast<double>(total_events) / seconds},
                     {"seconds", seconds}};
-    if (target_noise > 0.0) result.stats["target_noise"] = {{"target", target_noise}, {"noise", noise}, {"met", noise <= target_noise}};
+    if (s.target_noise > 0.0) result.stats["target_noise"] = {{"target", s.target_noise}, {"noise", noise}, {"met", noise <= s.target_noise}};
     return result;
+  }
+
+ private:
+  const Scene scene_;
+  const ReferenceSettings settings_;
+  const std::unique_ptr<Medium> medium_;
+  Tracer tracer_;  // reads scene_ and medium_
+};
+
+class ReferenceMethod final : public Method {
+ public:
+  std::unique_ptr<MethodSolution> prepare(const Scene& scene, const RenderOptions& options) const override {
+    Settings settings(options.settings, "reference");
+    ReferenceSettings s;
+    // With target_noise, samples are added in rounds until the image's own relative noise over
+    // the lit pixels (lit_pixel_error's noise_rms) is at most target_noise; spp is then the cap.
+    s.target_noise = settings.number("target_noise", 0.0, 0.0, 0.99);
+    s.spp = settings.integer("spp", s.target_noise > 0.0 ? kProgressiveCap : 1024, 1, 1LL << 32);
+    s.max_scattering = static_cast<int>(settings.integer("max_scattering", -1, -1, 100000));
+    s.max_bounces = static_cast<int>(settings.integer("max_bounces", -1, -1, 100000));
+    s.view_scattering = settings.integer("view_scattering", 1, 0, 1) == 1;
+    s.seed = static_cast<std::uint64_t>(settings.integer("seed", 1, 0, 1LL << 62));
+    settings.reject_unknown();
+    return std::make_unique<ReferenceSolution>(scene, s);
   }
 };
 

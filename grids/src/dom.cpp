@@ -5,20 +5,18 @@
 #include <haze/grids/dom.h>
 
 #include <haze/core/error.h>
+#include <haze/core/stopwatch.h>
 #include <haze/grids/optical_depth.h>
+#include <haze/grids/rbf.h>
+#include <haze/grids/solution.h>
 
 #include "dom_internal.h"
 #include "trilinear.h"
 
-#include <chrono>
 
 namespace haze::grids {
 
 namespace {
-
-double seconds_since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
 
 // Along each camera ray inside the volume, up to the first surface, the formal solution of the
 // (delta-M scaled) equation for light scattered at least once:
@@ -123,20 +121,95 @@ Image render_dom(const Scene& scene, const ExtinctionVolume& volume, const std::
 
 namespace {
 
+// Prepared: the extinction volume, the depth to every delta light and the converged moments.
+class DomMethodSolution final : public GridSolution {
+ public:
+  DomMethodSolution(const Scene& scene, DomFields fields)
+      : GridSolution(scene, std::move(fields.volume), std::move(fields.delta_depths), fields.step_cells),
+        solution_(std::move(fields.solution)),
+        resolution_(fields.resolution),
+        settings_(fields.settings),
+        depth_(fields.depth),
+        warm_iterations_(fields.warm_iterations) {
+    stats = std::move(fields.stats);
+  }
+
+  const DomSolution* dom() const override { return &solution_; }
+
+  RenderResult render(const View& view, const RenderOptions& options) const override {
+    const Stopwatch watch;
+    Scene seen = scene_;
+    seen.camera = view.camera;
+    RenderResult result{render_dom(seen, volume_, depths_, solution_, step_cells_, options), std::nullopt, {}};
+    result.stats["render_seconds"] = watch.seconds();
+    return result;
+  }
+
+  // A new density (re-injected by region for an RBF over the same bounds) redoes every light's
+  // depth, new lights only those that differ; the moments then iterate from the previous ones
+  // (warm_iterations sweeps, or to the tolerance).
+  std::optional<UpdateReport> update(const Scene& scene, const SceneChange& change, const RenderOptions& options) override {
+    UpdateReport report;
+    Stopwatch watch;
+    depth_.threads = settings_.threads = options.threads;
+    std::vector<Light> old_delta, delta;
+    for (const Light& l : scene_.lights)
+      if (!std::holds_alternative<SkyLight>(l)) old_delta.push_back(l);
+    for (const Light& l : scene.lights)
+      if (!std::holds_alternative<SkyLight>(l)) delta.push_back(l);
+    bool all = false;
+    if (change.medium) {
+      const auto* old_rbf = std::get_if<RbfDensity>(&scene_.medium->density);
+      const auto* rbf = std::get_if<RbfDensity>(&change.medium->density);
+      if (old_rbf && rbf && change.region && medium_bounds(*change.medium) == medium_bounds(*scene_.medium) &&
+          injection_cutoff(rbf->blobs) == injection_cutoff(old_rbf->blobs)) {
+        const size_t cells = reinject_region(rbf->blobs, volume_.density, *change.region, injection_cutoff(rbf->blobs), 8, options.threads);
+        report.redone.push_back("extinction volume: " + to_text(cells) + " of " + to_text(volume_.density.cell_count()) + " cells re-injected");
+      } else {
+        const ExtinctionVolume fresh = make_extinction_volume(scene, resolution_, 0.0, options.threads);
+        if (fresh.density.resolution() != volume_.density.resolution()) return std::nullopt;  // a new shape: solve again
+        volume_.density = fresh.density;
+        report.redone.push_back("extinction volume");
+      }
+      volume_.sigma_t_scale = change.medium->sigma_t, volume_.albedo = change.medium->albedo, volume_.phase = change.medium->phase;
+      all = true;
+    }
+    depths_.resize(delta.size(), DenseGrid(volume_.density.resolution(), volume_.density.bounds()));
+    for (size_t i = 0; i < delta.size(); ++i) {
+      if (!all && i < old_delta.size() && delta[i] == old_delta[i]) continue;
+      depths_[i] = optical_depth(volume_.density, delta[i], depth_);
+      report.redone.push_back("optical depth of delta light " + std::to_string(i));
+    }
+    report.stats["depth_seconds"] = watch.lap();
+    const bool relit = change.medium || change.lights;
+    if (relit) {
+      DomSettings warm = settings_;
+      warm.progress = options.progress;
+      if (warm_iterations_ > 0) warm.max_iterations = 1 + warm_iterations_;
+      DomSolution next = solve_dom(volume_, scene.lights, depths_, warm, &solution_);
+      report.redone.push_back("moments: first-collision source and " + to_text(next.iterations - 1) + " sweeps from the previous solution");
+      report.stats["iterations"] = next.iterations;
+      report.stats["final_change"] = next.changes.empty() ? 0.0 : next.changes.back();
+      report.stats["converged"] = next.converged;
+      solution_ = std::move(next);
+    }
+    report.stats["solve_seconds"] = watch.lap();
+    scene_ = scene;
+    return report;
+  }
+
+ private:
+  DomSolution solution_;
+  int resolution_;
+  DomSettings settings_;
+  DepthOptions depth_;
+  int warm_iterations_;
+};
+
 class DomMethod final : public Method {
  public:
-  RenderResult render(const Scene& scene, const RenderOptions& options) const override {
-    const ProgressCallback& progress = options.progress;
-    RenderOptions solve_options = options;
-    solve_options.progress = progress ? [&](double f) { return progress(0.8 * f); } : ProgressCallback();
-    DomFields fields = dom_fields(scene, solve_options);
-    const auto start = std::chrono::steady_clock::now();
-    RenderOptions render_options = options;
-    render_options.progress = progress ? [&](double f) { return progress(0.8 + 0.2 * f); } : ProgressCallback();
-    Image image = render_dom(scene, fields.volume, fields.delta_depths, fields.solution, fields.step_cells, render_options);
-    RenderResult result{std::move(image), std::nullopt, std::move(fields.stats)};
-    result.stats["render_seconds"] = seconds_since(start);
-    return result;
+  std::unique_ptr<MethodSolution> prepare(const Scene& scene, const RenderOptions& options) const override {
+    return std::make_unique<DomMethodSolution>(scene, dom_fields(scene, options));
   }
 };
 
@@ -159,22 +232,23 @@ DomFields dom_fields(const Scene& scene, const RenderOptions& options) {
   depth.scheme = depth_scheme_from_name(settings.choice("optical_depth", "exact", {"exact", "paper", "sweep"}));
   depth.threads = options.threads;
   const double step_cells = settings.number("step", 0.5, 0.01, 4.0);
+  const int warm_iterations = static_cast<int>(settings.integer("warm_iterations", 0, 0, 100000));
   settings.reject_unknown();
 
-  auto start = std::chrono::steady_clock::now();
+  Stopwatch watch;
   ExtinctionVolume volume = make_extinction_volume(scene, resolution, 0.0, options.threads);
   // Delta lights get depth volumes; the sky enters the solver through the boundary and reaches
   // the eye as background.
   std::vector<DenseGrid> delta_depths;
   for (const Light& l : scene.lights)
     if (!std::holds_alternative<SkyLight>(l)) delta_depths.push_back(optical_depth(volume.density, l, depth));
-  const double depth_seconds = seconds_since(start);
+  const double depth_seconds = watch.lap();
 
-  start = std::chrono::steady_clock::now();
   dom.progress = options.progress;
   DomSolution solution = solve_dom(volume, scene.lights, delta_depths, dom);
-  const double solve_seconds = seconds_since(start);
-  DomFields fields{std::move(volume), std::move(delta_depths), std::move(solution), step_cells, {}};
+  const double solve_seconds = watch.lap();
+  dom.progress = nullptr;
+  DomFields fields{std::move(volume), std::move(delta_depths), std::move(solution), step_cells, {}, resolution, dom, depth, warm_iterations};
   const ExtinctionVolume& v = fields.volume;
   const DomSolution& solved = fields.solution;
   fields.stats = {{"cells", v.density.resolution()},

@@ -221,6 +221,11 @@ void solve_moments(const dom::Transport& t, const dom::Channel& channel, const s
         break;
       }
     }
+    // The budget ran out before a Krylov step: the residual's sweep is still a source iteration.
+    if (j == 0) {
+      axpy(x, 1.0, w, th);
+      return;
+    }
     // x += V_j y, with H_j y = g_j (upper triangular).
     Eigen::VectorXd y = h.topLeftCorner(j, j).triangularView<Eigen::Upper>().solve(g.head(j));
     for (int i = 0; i < j; ++i) v.axpy(x, y(i), i, th);

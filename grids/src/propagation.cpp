@@ -8,26 +8,90 @@
 #include <haze/core/error.h>
 #include <haze/core/method.h>
 #include <haze/grids/optical_depth.h>
+#include <haze/core/stopwatch.h>
 #include <haze/grids/rbf.h>
-
-#include <chrono>
+#include <haze/grids/solution.h>
 
 namespace haze::grids {
 
 namespace {
 
-double seconds_since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
+// Prepared: the extinction volume and one optical-depth volume per light.
+class PropagationSolution final : public GridSolution {
+ public:
+  PropagationSolution(const Scene& scene, PropagationFields fields, DepthOptions depth, int resolution, double cutoff)
+      : GridSolution(scene, std::move(fields.volume), std::move(fields.depths), fields.march.step_cells),
+        march_(fields.march),
+        depth_(depth),
+        resolution_(resolution),
+        cutoff_(cutoff) {
+    stats = std::move(fields.stats);
+  }
+
+  RenderResult render(const View& view, const RenderOptions& options) const override {
+    const Stopwatch watch;
+    Scene seen = scene_;
+    seen.camera = view.camera;
+    RenderResult result{march_image(seen, volume_, depths_, march_, options), std::nullopt, {}};
+    result.stats["march_seconds"] = watch.seconds();
+    return result;
+  }
+
+  // A new RBF density over the same bounds re-injects only the bricks in change.region; any new
+  // density redoes every light's depth, new lights only the lights that differ.
+  std::optional<UpdateReport> update(const Scene& scene, const SceneChange& change, const RenderOptions& options) override {
+    for (size_t i = 0; i < scene.lights.size(); ++i)
+      if (std::holds_alternative<SkyLight>(scene.lights[i]))
+        throw Error("lights[" + std::to_string(i) + "].type", "sky", "point, spot or directional lights for the propagation method");
+    UpdateReport report;
+    Stopwatch watch;
+    depth_.threads = options.threads;
+    std::vector<bool> redo(scene.lights.size(), false);
+    if (change.medium) {
+      const auto* old_rbf = std::get_if<RbfDensity>(&scene_.medium->density);
+      const auto* rbf = std::get_if<RbfDensity>(&change.medium->density);
+      if (old_rbf && rbf && change.region && medium_bounds(*change.medium) == medium_bounds(*scene_.medium) &&
+          injection_cutoff(rbf->blobs, cutoff_) == injection_cutoff(old_rbf->blobs, cutoff_)) {
+        const size_t cells = reinject_region(rbf->blobs, volume_.density, *change.region, injection_cutoff(rbf->blobs, cutoff_), 8, options.threads);
+        report.redone.push_back("extinction volume: " + to_text(cells) + " of " + to_text(volume_.density.cell_count()) + " cells re-injected");
+      } else {
+        volume_.density = make_extinction_volume(scene, resolution_, cutoff_, options.threads).density;
+        report.redone.push_back("extinction volume");
+      }
+      volume_.sigma_t_scale = change.medium->sigma_t, volume_.albedo = change.medium->albedo, volume_.phase = change.medium->phase;
+      report.stats["inject_seconds"] = watch.lap();
+      redo.assign(redo.size(), true);
+    }
+    for (size_t i = 0; i < scene.lights.size(); ++i) redo[i] = redo[i] || i >= scene_.lights.size() || !(scene.lights[i] == scene_.lights[i]);
+    depths_.resize(scene.lights.size(), DenseGrid(volume_.density.resolution(), volume_.density.bounds()));
+    for (size_t i = 0; i < scene.lights.size(); ++i) {
+      if (!redo[i]) continue;
+      depths_[i] = optical_depth(volume_.density, scene.lights[i], depth_);
+      report.redone.push_back("optical depth of lights[" + std::to_string(i) + "]");
+    }
+    report.stats["propagate_seconds"] = watch.lap();
+    scene_ = scene;
+    return report;
+  }
+
+ private:
+  MarchSettings march_;
+  DepthOptions depth_;
+  int resolution_;
+  double cutoff_;
+};
 
 class PropagationMethod final : public Method {
  public:
-  RenderResult render(const Scene& scene, const RenderOptions& options) const override {
+  std::unique_ptr<MethodSolution> prepare(const Scene& scene, const RenderOptions& options) const override {
     PropagationFields fields = propagation_fields(scene, options);
-    const auto start = std::chrono::steady_clock::now();
-    RenderResult result{march_image(scene, fields.volume, fields.depths, fields.march, options), std::nullopt, std::move(fields.stats)};
-    result.stats["march_seconds"] = seconds_since(start);
-    return result;
+    // The settings again, for updates (propagation_fields checked them).
+    const int resolution = options.settings.value("resolution", 64);
+    const double cutoff = options.settings.value("cutoff", 0.0);
+    DepthOptions depth;
+    depth.scheme = depth_scheme_from_name(options.settings.value("optical_depth", std::string("sweep")));
+    depth.sweep_layers = options.settings.value("sweep_layers", depth.sweep_layers);
+    return std::make_unique<PropagationSolution>(scene, std::move(fields), depth, resolution, cutoff);
   }
 };
 
@@ -47,11 +111,10 @@ PropagationFields propagation_fields(const Scene& scene, const RenderOptions& op
   for (size_t i = 0; i < scene.lights.size(); ++i)
     if (std::holds_alternative<SkyLight>(scene.lights[i]))
       throw Error("lights[" + std::to_string(i) + "].type", "sky", "point, spot or directional lights for the propagation method");
-  auto start = std::chrono::steady_clock::now();
+  Stopwatch watch;
   VolumeReport report;
   PropagationFields fields{make_extinction_volume(scene, resolution, cutoff, options.threads, &report), {}, MarchSettings{step_cells}, {}};
-  const double inject_seconds = seconds_since(start);
-  start = std::chrono::steady_clock::now();
+  const double inject_seconds = watch.lap();
   DepthStats depth_stats;
   fields.depths = optical_depths(fields.volume.density, scene.lights, depth, &depth_stats);
   fields.stats = {{"cells", fields.volume.density.resolution()},
@@ -60,7 +123,7 @@ PropagationFields propagation_fields(const Scene& scene, const RenderOptions& op
                   {"paper_iterations", depth.scheme == DepthScheme::paper ? depth_stats.iterations : 0},
                   {"truncation_bound", report.truncation_bound},
                   {"inject_seconds", inject_seconds},
-                  {"propagate_seconds", seconds_since(start)}};
+                  {"propagate_seconds", watch.seconds()}};
   return fields;
 }
 

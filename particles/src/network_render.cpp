@@ -1,5 +1,6 @@
 // Camera rays through the particles' Gaussians (network.h, render_network), and method "network".
 #include <haze/core/error.h>
+#include <haze/core/stopwatch.h>
 #include <haze/particles/network.h>
 
 #include "erf_table.h"
@@ -189,9 +190,71 @@ Image render_network(const Scene& scene, const ParticleField& field, const Netwo
 
 namespace {
 
+// Prepared: the particle set, its field and the networks with the converged I.
+class NetworkMethodSolution final : public MethodSolution {
+ public:
+  NetworkMethodSolution(const Scene& scene, ParticleSet set, int neighbours, const NetworkSettings& settings)
+      : scene_(scene), set_(std::move(set)), field_(set_.view(), neighbours), settings_(settings) {
+    solution_ = solve_network(field_, scene_.lights, settings_);
+    settings_.progress = nullptr;
+    describe();
+  }
+
+  RenderResult render(const View& view, const RenderOptions& options) const override {
+    const Stopwatch watch;
+    Scene seen = scene_;
+    seen.camera = view.camera;
+    RenderResult result{render_network(seen, field_, solution_, options), std::nullopt, {}};
+    result.stats["render_seconds"] = watch.seconds();
+    return result;
+  }
+
+  // New lights: update_network, which rebuilds only the maps of lights that moved, then iterates
+  // from the previous I. Surfaces are not drawn; anything else prepares again.
+  std::optional<UpdateReport> update(const Scene& scene, const SceneChange& change, const RenderOptions& options) override {
+    if (change.medium) return std::nullopt;
+    UpdateReport report;
+    if (change.lights) {
+      NetworkSettings settings = settings_;
+      settings.threads = options.threads;
+      settings.progress = options.progress;
+      solution_ = update_network(std::move(solution_), field_, scene.lights, settings);
+      const auto& u = solution_.update;
+      if (u.rebuilt) report.redone.push_back("networks rebuilt: " + u.reason);
+      else report.redone.push_back("light depth maps: " + to_text(u.maps) + " rebuilt; direct light of " + to_text(u.direct) + " particles");
+      report.redone.push_back("I: " + to_text(solution_.iterations) + " iterations from the previous solution");
+      describe();
+      report.stats = stats;
+    }
+    scene_ = scene;
+    return report;
+  }
+
+ private:
+  void describe() {
+    stats = {{"particles", field_.size()},
+             {"directions", settings_.directions},
+             {"window", solution_.visibility.window.size},
+             {"terms", solution_.terms},
+             {"channels", solution_.channels},
+             {"iterations", solution_.iterations},
+             {"converged", solution_.converged},
+             {"final_change", solution_.changes.empty() ? 0.0 : solution_.changes.back()},
+             {"build_seconds", solution_.build_seconds},
+             {"direct_seconds", solution_.direct_seconds},
+             {"iterate_seconds", solution_.iterate_seconds}};
+  }
+
+  Scene scene_;
+  const ParticleSet set_;
+  const ParticleField field_;  // views set_
+  NetworkSettings settings_;
+  NetworkSolution solution_;
+};
+
 class NetworkMethod final : public Method {
  public:
-  RenderResult render(const Scene& scene, const RenderOptions& options) const override {
+  std::unique_ptr<MethodSolution> prepare(const Scene& scene, const RenderOptions& options) const override {
     Settings settings(options.settings, "network");
     NetworkSettings network;
     network.directions = static_cast<int>(settings.integer("directions", network.directions, 8, 4096));
@@ -204,29 +267,8 @@ class NetworkMethod final : public Method {
     settings.reject_unknown();
     if (scene.particles.is_null()) throw Error("particles", "missing", "a particles block for method network");
     if (scene.medium) throw Error("medium", "given with particles", "particles only for method network");
-
-    const ParticleSet set = ParticleSet::from_json(scene.particles, scene.directory);
-    const ParticleField field(set.view(), neighbours);
-    ProgressCallback progress = options.progress;
-    network.progress = progress ? [&](double f) { return progress(0.8 * f); } : ProgressCallback();
-    const NetworkSolution solution = solve_network(field, scene.lights, network);
-    const auto start = std::chrono::steady_clock::now();
-    RenderOptions render_options = options;
-    render_options.progress = progress ? [&](double f) { return progress(0.8 + 0.2 * f); } : ProgressCallback();
-    RenderResult result{render_network(scene, field, solution, render_options), std::nullopt, {}};
-    result.stats = {{"particles", field.size()},
-                    {"directions", network.directions},
-                    {"window", solution.visibility.window.size},
-                    {"terms", solution.terms},
-                    {"channels", solution.channels},
-                    {"iterations", solution.iterations},
-                    {"converged", solution.converged},
-                    {"final_change", solution.changes.empty() ? 0.0 : solution.changes.back()},
-                    {"build_seconds", solution.build_seconds},
-                    {"direct_seconds", solution.direct_seconds},
-                    {"iterate_seconds", solution.iterate_seconds},
-                    {"render_seconds", std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()}};
-    return result;
+    network.progress = options.progress;
+    return std::make_unique<NetworkMethodSolution>(scene, ParticleSet::from_json(scene.particles, scene.directory), neighbours, network);
   }
 };
 

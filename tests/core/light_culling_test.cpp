@@ -99,7 +99,7 @@ TEST(LightCulling, ChangesNoImage) {
                   PointLight{Vec3(-1.5, 0.5, 1.5), Rgb(2.0, 1.5, 1.0)},
                   spot(Vec3(-0.9, 0.9, 0.5), Vec3(-1, 0.3, 0), 15)};  // in the box, out of view, facing away from it
   for (const std::string method : {"quadrature", "analytic"}) {
-    const RenderResult all = create_method(method)->render(scene, {});
+    const RenderResult all = create_method(method)->prepare(scene, {})->render(View{scene.camera}, {});
     const RenderResult culled = render(scene, method);
     ASSERT_EQ(culled.stats["culled_lights"].size(), 3u) << method;
     EXPECT_EQ(culled.stats["culled_lights"][0]["index"], 0);

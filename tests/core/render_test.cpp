@@ -232,21 +232,21 @@ TEST(Analytic, DynamicGStaysWithinItsTolerance) {
   EXPECT_THROW(render(scene, "analytic", dynamic), Error);
 }
 
-// One method object keeps its tables: a new g on the next frame reuses the Legendre tables and
-// gives exactly what a fresh object computes.
-TEST(Analytic, ReusedMethodKeepsTablesAcrossFrames) {
+// A solution keeps its method's tables: a new g on the next frame (an update that prepares again)
+// reuses the Legendre tables and gives exactly what a fresh solution computes.
+TEST(Analytic, UpdatedSolutionKeepsTablesAcrossFrames) {
   Scene scene = analytic_scene();
   scene.medium->phase = PhaseFunction::henyey_greenstein(0.3);
   scene.surfaces[0].ks = Rgb(0.0);
   RenderOptions options;
   options.settings = {{"table_a", 64}, {"table_eta", 128}, {"dynamic_g_tolerance", 1e-2}};
-  auto method = create_method("analytic");
-  auto first = method->render(scene, options);
-  EXPECT_FALSE(first.stats["tables_reused"].get<bool>());
+  Solution solution = prepare(scene, "analytic", options);
+  EXPECT_FALSE(solution.stats()["tables_reused"].get<bool>());
   scene.medium->phase = PhaseFunction::henyey_greenstein(0.35);
-  auto second = method->render(scene, options);
-  EXPECT_TRUE(second.stats["tables_reused"].get<bool>());
-  EXPECT_EQ(second.radiance.data(), create_method("analytic")->render(scene, options).radiance.data());
+  const UpdateReport report = solution.update({.medium = scene.medium});
+  EXPECT_TRUE(report.rebuilt);
+  EXPECT_TRUE(solution.stats()["tables_reused"].get<bool>());
+  EXPECT_EQ(solution.render().radiance.data(), render(scene, "analytic", options).radiance.data());
 }
 
 TEST(Analytic, RejectsWhatItDoesNotModel) {

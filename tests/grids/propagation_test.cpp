@@ -107,7 +107,7 @@ TEST(Propagation, SpotsOutOfViewAreCulledWithoutChangingTheImage) {
   ASSERT_EQ(culled.stats["culled_lights"].size(), 1u);
   EXPECT_EQ(culled.stats["culled_lights"][0]["index"], 2);
   EXPECT_GT(*std::max_element(culled.radiance.data().begin(), culled.radiance.data().end()), 0.01f);
-  EXPECT_EQ(culled.radiance.data(), create_method("propagation")->render(scene, options).radiance.data());
+  EXPECT_EQ(culled.radiance.data(), create_method("propagation")->prepare(scene, options)->render(View{scene.camera}, options).radiance.data());
 }
 
 // Seed 003 table 1: the stages kept apart. Moving a light re-propagates only its depth volume over

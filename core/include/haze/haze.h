@@ -14,4 +14,6 @@
 #include <haze/core/progress.h>
 #include <haze/core/rng.h>
 #include <haze/core/scene.h>
+#include <haze/core/solution.h>
+#include <haze/core/stopwatch.h>
 #include <haze/core/surface.h>

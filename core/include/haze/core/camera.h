@@ -20,6 +20,7 @@ struct Camera {
   // Ray through film position (px, py) in pixels, (0, 0) the top-left corner.
   Ray generate_ray(double px, double py) const;
   Ray pixel_ray(int x, int y) const { return generate_ray(x + 0.5, y + 0.5); }
+  bool operator==(const Camera&) const = default;
 };
 
 }  // namespace haze

@@ -37,6 +37,7 @@ struct Aabb {
     return p.x >= lo.x && p.y >= lo.y && p.z >= lo.z && p.x <= hi.x && p.y <= hi.y && p.z <= hi.z;
   }
   Vec3 extent() const { return hi - lo; }
+  bool operator==(const Aabb&) const = default;
   // Clips the ray's [t0, t1] to the box (slab test); false when they do not overlap.
   bool clip(const Ray& ray, double& t0, double& t1) const;
 };

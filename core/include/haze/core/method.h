@@ -6,6 +6,7 @@
 #include <haze/core/image.h>
 #include <haze/core/progress.h>
 #include <haze/core/scene.h>
+#include <haze/core/solution.h>
 
 #include <nlohmann/json.hpp>
 
@@ -18,28 +19,13 @@
 
 namespace haze {
 
-struct RenderOptions {
-  int threads = 0;  // 0: every core oneTBB offers; otherwise a cap
-  nlohmann::json settings = nlohmann::json::object();  // the method's settings ("name" ignored)
-  ProgressCallback progress;  // optional; return false to cancel (render throws haze::Cancelled)
-  // Where methods may keep precomputed tables between runs; empty: build them every time. The
-  // `haze` command passes default_cache_dir().
-  std::filesystem::path cache_dir;
-};
-
-// $HAZE_CACHE_DIR, else $XDG_CACHE_HOME/haze, else $HOME/.cache/haze, else the temporary directory.
-std::filesystem::path default_cache_dir();
-
-struct RenderResult {
-  Image radiance;
-  std::optional<Image> std_error;  // per-pixel standard error, for Monte Carlo methods
-  nlohmann::json stats = nlohmann::json::object();  // method-specific figures for --json
-};
-
+// A method turns a scene into a solution (DESIGN.md, "Callers"); the solution renders views.
 class Method {
  public:
   virtual ~Method() = default;
-  virtual RenderResult render(const Scene& scene, const RenderOptions& options) const = 0;
+  // Everything that does not depend on the camera, from the scene and options.settings (checked:
+  // unknown keys are an error). options.progress follows the work.
+  virtual std::unique_ptr<MethodSolution> prepare(const Scene& scene, const RenderOptions& options) const = 0;
 };
 
 struct MethodInfo {
@@ -85,11 +71,51 @@ std::vector<MethodInfo> registered_methods();
 // Throws haze::Error listing the available methods when the name is unknown.
 std::unique_ptr<Method> create_method(const std::string& name);
 
-// Renders with `method_name`, or the scene's method when empty. The scene's method settings
-// apply when its name matches; options.settings override them key by key. A scene with particles
-// and no medium renders with a method that does not read particles through the registered
-// ParticleMediumFactory. Lights that reach nothing (for a single-scattering method: nothing in
-// view) are left out first (light_culling.h); the result's stats list them under "culled_lights".
+// A prepared method: render any camera without solving again, update it when the scene changes,
+// read its fields. Made by haze::prepare; movable, not copyable.
+class Solution {
+ public:
+  Solution(Solution&&) noexcept;
+  Solution& operator=(Solution&&) noexcept;
+  ~Solution();
+
+  const std::string& method() const;
+  // The scene as prepared, with every update applied (all of its lights, culled ones included).
+  const Scene& scene() const;
+  // What prepare (or the last update that rebuilt) computed and measured.
+  const nlohmann::json& stats() const;
+
+  // options: threads, progress (settings were fixed by prepare; giving any is an error).
+  RenderResult render(const View& view, const RenderOptions& options = {}) const;
+  RenderResult render(const RenderOptions& options = {}) const { return render(View{scene().camera}, options); }
+  // Redoes only what the change reaches (the method says what in the report); a change nothing
+  // can be reused for prepares again (report.rebuilt). The scene's camera may change freely: it
+  // is not part of a solution.
+  UpdateReport update(const SceneChange& change, const RenderOptions& options = {});
+
+  // The method's fields (solution.h: MethodSolution), lights indexed as in scene().lights.
+  Rgb transmittance(size_t light, const Vec3& x) const;
+  Rgb fluence(const Vec3& x) const;
+  Rgb inscattered(const Vec3& x, const Vec3& w) const;
+
+  struct State;
+
+ private:
+  explicit Solution(std::unique_ptr<State> state);
+  friend Solution prepare(const Scene&, const std::string&, RenderOptions);
+  std::unique_ptr<State> state_;
+};
+
+// Prepares `method_name`, or the scene's method when empty. The scene's method settings apply
+// when its name matches; options.settings override them key by key. A scene with particles and no
+// medium prepares a method that does not read particles through the registered
+// ParticleMediumFactory. Lights that reach nothing (with options.single_view and a
+// single-scattering method: nothing in view) are left out first (light_culling.h); the stats
+// list them under "culled_lights".
+Solution prepare(const Scene& scene, const std::string& method_name = "", RenderOptions options = {});
+
+// prepare() (with options.single_view) and render() of the scene's camera in a row; the stats hold
+// both steps' figures.
 RenderResult render(const Scene& scene, const std::string& method_name, RenderOptions options = {});
 
 }  // namespace haze

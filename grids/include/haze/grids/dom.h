@@ -9,6 +9,7 @@
 #include <haze/core/method.h>
 #include <haze/core/phase_matrix.h>
 #include <haze/core/progress.h>
+#include <haze/grids/optical_depth.h>
 #include <haze/grids/propagation.h>
 
 #include <memory>
@@ -129,6 +130,11 @@ struct DomFields {
   DomSolution solution;
   double step_cells = 0.5;
   nlohmann::json stats;
+  // The settings they were made with, for updates.
+  int resolution = 64;
+  DomSettings settings;
+  DepthOptions depth;
+  int warm_iterations = 0;  // sweeps per update after the first-collision one; 0: to the tolerance
 };
 DomFields dom_fields(const Scene& scene, const RenderOptions& options);
 

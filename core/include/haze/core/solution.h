@@ -1,0 +1,97 @@
+// Solve once, render many (DESIGN.md, "Callers"): what a method computes before it sees a camera,
+// the views it renders, and the changes it can take without solving again.
+#pragma once
+
+#include <haze/core/camera.h>
+#include <haze/core/image.h>
+#include <haze/core/light.h>
+#include <haze/core/medium.h>
+#include <haze/core/progress.h>
+#include <haze/core/scene.h>
+#include <haze/core/surface.h>
+
+#include <nlohmann/json.hpp>
+
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace haze {
+
+struct RenderOptions {
+  int threads = 0;  // 0: every core oneTBB offers; otherwise a cap
+  // The method's settings ("name" ignored), read when a solution is prepared; a render takes
+  // none (the solution keeps what it was prepared with).
+  nlohmann::json settings = nlohmann::json::object();
+  ProgressCallback progress;  // optional; return false to cancel (the call throws haze::Cancelled)
+  // Where methods may keep precomputed tables between runs; empty: build them every time. The
+  // `haze` command passes default_cache_dir().
+  std::filesystem::path cache_dir;
+  // The solution will render the scene's own camera only (haze::render sets this): a
+  // single-scattering method may then leave out the lights that camera cannot see, and rendering
+  // another camera is an error.
+  bool single_view = false;
+};
+
+// $HAZE_CACHE_DIR, else $XDG_CACHE_HOME/haze, else $HOME/.cache/haze, else the temporary directory.
+std::filesystem::path default_cache_dir();
+
+// What a solution renders: a camera (the caller's matrices and depth buffer are to come).
+struct View {
+  Camera camera;
+};
+
+struct RenderResult {
+  Image radiance;
+  std::optional<Image> std_error;  // per-pixel standard error, for Monte Carlo methods
+  nlohmann::json stats = nlohmann::json::object();  // method-specific figures for --json
+};
+
+// What changed since a solution was prepared (or last updated); unset fields are unchanged.
+struct SceneChange {
+  std::optional<MediumDesc> medium = std::nullopt;  // the new medium: density, coefficients, phase
+  // Where the new medium's density differs from the old one (world space); unset: anywhere. A
+  // hint: a method that cannot use it redoes the whole density.
+  std::optional<Aabb> region = std::nullopt;
+  std::optional<std::vector<Light>> lights = std::nullopt;
+  std::optional<std::vector<Surface>> surfaces = std::nullopt;
+};
+
+// What an update redid, in words a caller can log ("optical depth of lights[1]", "moments: 2
+// sweeps from the previous solution"), with the method's figures.
+struct UpdateReport {
+  bool rebuilt = false;  // nothing could be reused: the solution was prepared again
+  std::vector<std::string> redone;
+  double seconds = 0.0;
+  nlohmann::json stats = nlohmann::json::object();
+};
+
+// What a method prepares: implemented by each method, held by a Solution. Views and options come
+// checked; lights are the kept ones (light_culling.h), indexed as in the scene the method saw.
+class MethodSolution {
+ public:
+  virtual ~MethodSolution() = default;
+  // The scene's medium, lights and surfaces as prepared, seen from view.camera.
+  virtual RenderResult render(const View& view, const RenderOptions& options) const = 0;
+  // Applies `change` in place, given `scene` with the change applied, and reports what it redid;
+  // std::nullopt when nothing can be reused (the Solution then prepares again). The default.
+  virtual std::optional<UpdateReport> update(const Scene& scene, const SceneChange& change, const RenderOptions& options);
+
+  // Fields for callers who shade their own surfaces, at world points, per RGB channel. A method
+  // without them throws haze::Error naming the field. Light indices are the method's own.
+  // Transmittance exp(-tau) from x to the light.
+  virtual Rgb transmittance(size_t light, const Vec3& x) const;
+  // Fluence phi(x) = integral over the sphere of the radiance the method carries at x (W/m^2 for
+  // W/(m^2 sr) radiance): the unscattered light of point, spot and directional lights plus, in
+  // multiple-scattering methods, the light scattered at least once.
+  virtual Rgb fluence(const Vec3& x) const;
+  // In-scattered radiance toward the propagation direction w per unit scattering coefficient:
+  // S(x, w) = integral p(wi . w) L(x, wi) dwi, so that a host's ray march adds sigma_s(x) S ds.
+  virtual Rgb inscattered(const Vec3& x, const Vec3& w) const;
+
+  // What prepare computed and measured (merged into every render's stats).
+  nlohmann::json stats = nlohmann::json::object();
+};
+
+}  // namespace haze

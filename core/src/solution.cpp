@@ -1,0 +1,213 @@
+// haze::prepare, haze::Solution and haze::render (method.h): the registry's method on the caller's
+// scene, less the lights that reach nothing (light_culling.h), with the particles turned into a
+// medium for methods that do not read them, and errors about lights naming the caller's light.
+#include "builtin_methods.h"
+
+#include <haze/core/error.h>
+#include <haze/core/light_culling.h>
+#include <haze/core/method.h>
+#include <haze/core/stopwatch.h>
+
+#include <algorithm>
+
+namespace haze {
+
+struct Solution::State {
+  MethodInfo info;
+  std::unique_ptr<Method> method;
+  Scene scene;                  // the caller's, with every update applied
+  RenderOptions options;        // as prepared: settings merged, no progress
+  std::optional<MediumDesc> particle_medium;  // the particles' medium, for a method that does not read them
+  std::vector<size_t> kept;     // the method's light k is scene.lights[kept[k]]
+  nlohmann::json culled = nlohmann::json::array();
+  std::unique_ptr<MethodSolution> solution;
+
+  // The scene the method sees: the particles' medium where it needs one, the kept lights only.
+  Scene method_scene() const {
+    Scene s = scene;
+    if (particle_medium) s.medium = particle_medium;
+    s.lights.clear();
+    for (size_t i : kept) s.lights.push_back(scene.lights[i]);
+    return s;
+  }
+
+  // Decides which lights the method sees; true when that changed.
+  bool cull() {
+    Scene s = scene;
+    if (particle_medium) s.medium = particle_medium;
+    const std::vector<CulledLight> found = culled_lights(s, info.single_scattering && options.single_view);
+    std::vector<size_t> kept_now;
+    culled = nlohmann::json::array();
+    for (size_t i = 0, c = 0; i < scene.lights.size(); ++i) {
+      // A scene whose lights all reach nothing renders as it is.
+      if (c < found.size() && found[c].index == i && found.size() < scene.lights.size()) culled.push_back({{"index", i}, {"why", found[c++].why}});
+      else kept_now.push_back(i);
+    }
+    const bool changed = kept_now != kept;
+    kept = std::move(kept_now);
+    return changed;
+  }
+
+  // An error about "lights[k]..." from the method names the caller's light, not the k-th kept.
+  template <class F>
+  auto naming_lights(F f) const {
+    try {
+      return f();
+    } catch (const Cancelled&) {
+      throw;
+    } catch (const Error& e) {
+      const std::string& field = e.field();
+      const size_t close = field.find(']');
+      if (field.rfind("lights[", 0) != 0 || close == std::string::npos || close == 7) throw;
+      const std::string digits = field.substr(7, close - 7);
+      if (!std::all_of(digits.begin(), digits.end(), [](char ch) { return ch >= '0' && ch <= '9'; })) throw;
+      const size_t k = std::stoul(digits);
+      if (k >= kept.size()) throw;
+      throw Error("lights[" + std::to_string(kept[k]) + field.substr(close), e.value(), e.expected());
+    }
+  }
+
+  void prepare(const ProgressCallback& progress) {
+    RenderOptions o = options;
+    o.progress = progress;
+    solution = naming_lights([&] { return method->prepare(method_scene(), o); });
+    if (!culled.empty()) solution->stats["culled_lights"] = culled;
+  }
+
+  // A field query: the caller's light index, and a clear error for a method without the field.
+  template <class F>
+  Rgb field(const char* name, F f) const {
+    try {
+      return f();
+    } catch (const Error& e) {
+      if (e.field() != name || e.value() != internal::kNoField) throw;
+      throw Error(name, "method " + info.name, e.expected());
+    }
+  }
+  size_t method_light(size_t light) const {
+    if (light >= scene.lights.size())
+      throw Error("light", to_text(light), "an index into the scene's " + to_text(scene.lights.size()) + " lights");
+    const auto it = std::find(kept.begin(), kept.end(), light);
+    if (it == kept.end()) throw Error("light", to_text(light), "a light the solution kept (lights[" + to_text(light) + "] reaches nothing: culled)");
+    return static_cast<size_t>(it - kept.begin());
+  }
+};
+
+Solution::Solution(std::unique_ptr<State> state) : state_(std::move(state)) {}
+Solution::Solution(Solution&&) noexcept = default;
+Solution& Solution::operator=(Solution&&) noexcept = default;
+Solution::~Solution() = default;
+
+const std::string& Solution::method() const { return state_->info.name; }
+const Scene& Solution::scene() const { return state_->scene; }
+const nlohmann::json& Solution::stats() const { return state_->solution->stats; }
+
+RenderResult Solution::render(const View& view, const RenderOptions& options) const {
+  const State& s = *state_;
+  if (!options.settings.is_null() && (!options.settings.is_object() || !options.settings.empty()))
+    throw Error("settings", options.settings.dump(), "none when rendering a solution (settings are given to haze::prepare)");
+  if (s.options.single_view && !(view.camera == s.scene.camera))
+    throw Error("view.camera", "another camera than the scene's", "the scene's camera for a solution prepared with single_view");
+  RenderOptions o = s.options;
+  o.threads = options.threads;
+  o.progress = options.progress;
+  RenderResult result = s.naming_lights([&] { return s.solution->render(view, o); });
+  nlohmann::json stats = s.solution->stats;
+  for (auto& [key, value] : result.stats.items()) stats[key] = std::move(value);
+  result.stats = std::move(stats);
+  return result;
+}
+
+UpdateReport Solution::update(const SceneChange& change, const RenderOptions& options) {
+  State& s = *state_;
+  const Stopwatch watch;
+  Scene next = s.scene;
+  if (change.medium) {
+    if (s.particle_medium) throw Error("change.medium", "a medium for a particle scene", "a scene with a medium (particles change through their set)");
+    next.medium = change.medium;
+  }
+  if (change.region && !change.medium) throw Error("change.region", "given without a medium", "the changed medium it bounds");
+  if (change.lights) next.lights = *change.lights;
+  if (change.surfaces) next.surfaces = *change.surfaces;
+  std::swap(s.scene, next);
+  const std::vector<size_t> kept_before = s.kept;
+  UpdateReport report;
+  try {
+    const bool kept_changed = s.cull();
+    SceneChange method_change = change;
+    if (change.lights || kept_changed) method_change.lights = s.method_scene().lights;
+    RenderOptions o = s.options;
+    o.threads = options.threads;
+    o.progress = options.progress;
+    std::optional<UpdateReport> done = s.naming_lights([&] { return s.solution->update(s.method_scene(), method_change, o); });
+    if (done) {
+      report = std::move(*done);
+      if (!s.culled.empty()) s.solution->stats["culled_lights"] = s.culled;
+      else s.solution->stats.erase("culled_lights");
+    } else {
+      s.prepare(options.progress);
+      report.rebuilt = true;
+      report.redone = {"everything: method " + s.info.name + " reuses nothing for this change"};
+      report.stats = s.solution->stats;
+    }
+  } catch (...) {  // a change that cannot be applied leaves the solution as it was
+    std::swap(s.scene, next);
+    s.kept = kept_before;
+    throw;
+  }
+  report.seconds = watch.seconds();
+  return report;
+}
+
+Rgb Solution::transmittance(size_t light, const Vec3& x) const {
+  const size_t k = state_->method_light(light);
+  return state_->field("transmittance", [&] { return state_->solution->transmittance(k, x); });
+}
+Rgb Solution::fluence(const Vec3& x) const {
+  return state_->field("fluence", [&] { return state_->solution->fluence(x); });
+}
+Rgb Solution::inscattered(const Vec3& x, const Vec3& w) const {
+  return state_->field("inscattered", [&] { return state_->solution->inscattered(x, w); });
+}
+
+Solution prepare(const Scene& scene, const std::string& method_name, RenderOptions options) {
+  const std::string name = method_name.empty() ? scene.method_name() : method_name;
+  if (name.empty()) throw Error("method.name", "missing", "a method named by the scene or the caller");
+  auto state = std::make_unique<Solution::State>();
+  state->info = method_info(name);
+  state->method = state->info.create();
+  state->scene = scene;
+  nlohmann::json settings = nlohmann::json::object();
+  if (scene.method_name() == name) settings = scene.method;
+  if (!options.settings.is_null() && !options.settings.is_object()) throw Error("settings", options.settings.dump(), "an object of " + name + " settings");
+  for (const auto& [key, value] : options.settings.items()) settings[key] = value;
+  settings.erase("name");
+  if (!scene.particles.is_null() && !state->info.reads_particles) {
+    if (scene.medium)
+      throw Error("particles", "given with a medium", "one of `medium` and `particles` for method " + name + ", which renders one medium");
+    const ParticleMediumFactory factory = particle_medium_factory();
+    if (!factory) throw Error("particles", "no particle module registered", "haze::particles::register_methods() before rendering particles");
+    state->particle_medium = factory(scene, settings);
+  }
+  const ProgressCallback progress = std::move(options.progress);
+  options.settings = std::move(settings);
+  state->options = std::move(options);
+  state->cull();
+  state->prepare(progress);
+  return Solution(std::move(state));
+}
+
+RenderResult render(const Scene& scene, const std::string& method_name, RenderOptions options) {
+  const ProgressCallback progress = options.progress;
+  const int threads = options.threads;
+  options.single_view = true;
+  // Progress: the share each step takes varies by method; prepare reports the first half.
+  options.progress = progress ? [&](double f) { return progress(0.5 * f); } : ProgressCallback();
+  const Solution solution = prepare(scene, method_name, std::move(options));
+  RenderOptions render_options;
+  render_options.threads = threads;
+  render_options.progress = progress ? [&](double f) { return progress(0.5 + 0.5 * f); } : ProgressCallback();
+  return solution.render(render_options);
+}
+
+}  // namespace haze
