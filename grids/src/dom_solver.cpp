@@ -142,18 +142,20 @@ class KrylovBasis {
 };
 
 // Calls the progress callback once per iteration; throws haze::Cancelled when it says stop.
+// Each channel has its own budget of settings.max_iterations sweeps, starting at `start`.
 struct IterationProgress {
   const DomSettings& settings;
+  int channel, channels, start;
   void operator()(int iteration) const {
-    if (settings.progress && !settings.progress(std::min(1.0, iteration / static_cast<double>(settings.max_iterations))))
-      throw Cancelled();
+    const double fraction = std::min(1.0, (iteration - start) / static_cast<double>(settings.max_iterations));
+    if (settings.progress && !settings.progress((channel + fraction) / channels)) throw Cancelled();
   }
 };
 
 // Source iteration x <- b + K x (each step one sweep), or restarted GMRES on (I - K) x = b.
 void solve_moments(const dom::Transport& t, const dom::Channel& channel, const std::vector<float>& b, std::vector<float>& x,
-                   const DomSettings& settings, DomSolution& out) {
-  const IterationProgress progress{settings};
+                   const DomSettings& settings, const IterationProgress& progress, DomSolution& out) {
+  const int limit = progress.start + settings.max_iterations;
   std::vector<float> kx(x.size());
   const int th = settings.threads;
   auto residual = [&](std::vector<float>& r) {  // r = b + K x - x, one sweep
@@ -165,7 +167,7 @@ void solve_moments(const dom::Transport& t, const dom::Channel& channel, const s
   };
   if (settings.accelerator == DomAccelerator::none) {
     std::vector<float> r(x.size());
-    while (out.iterations < settings.max_iterations) {
+    while (out.iterations < limit) {
       residual(r);
       axpy(x, 1.0, r, th);
       const double change = norm(r, th) / std::max(norm(x, th), 1e-300);
@@ -182,7 +184,7 @@ void solve_moments(const dom::Transport& t, const dom::Channel& channel, const s
   std::vector<float> w(x.size());
   Eigen::MatrixXd h = Eigen::MatrixXd::Zero(m + 1, m);
   Eigen::VectorXd cs(m), sn(m), g(m + 1);
-  while (out.iterations < settings.max_iterations) {
+  while (out.iterations < limit) {
     residual(w);
     const double x_norm = std::max(norm(x, th), 1e-300);
     double beta = norm(w, th);
@@ -193,7 +195,7 @@ void solve_moments(const dom::Transport& t, const dom::Channel& channel, const s
     g.setZero();
     g(0) = beta;
     int j = 0;
-    for (; j < m && out.iterations < settings.max_iterations; ++j) {
+    for (; j < m && out.iterations < limit; ++j) {
       v.load(j, w, th);
       t.sweep(channel, nullptr, w.data(), 0.0f, kx.data(), th);  // w = (I - K) v_j
       ++out.iterations;
@@ -315,12 +317,13 @@ DomSolution solve_dom(const ExtinctionVolume& volume, const std::vector<Light>& 
                           out.changes);
       continue;
     }
+    const IterationProgress progress{settings, c, out.channels, out.iterations};
     std::vector<float> b(size);
     transport.sweep(channel, &first, nullptr, channel.sky, b.data(), settings.threads);
     ++out.iterations;
     first = {};
     x = warm_fits ? warm->moments[static_cast<size_t>(c)] : b;
-    solve_moments(transport, channel, b, x, settings, out);
+    solve_moments(transport, channel, b, x, settings, progress, out);
   }
   out.converged = !out.changes.empty() && out.changes.back() < settings.tolerance;
   out.sweep_seconds = transport.seconds();

@@ -5,6 +5,8 @@
 
 #include "trilinear.h"
 
+#include <algorithm>
+
 namespace haze::grids {
 
 namespace {
@@ -53,9 +55,13 @@ Rgb GridSolution::transmittance(size_t light, const Vec3& x) const {
   double t0 = 0.0, t1 = a.distance;
   const Ray ray{x, a.to_light};
   if (!depth.bounds().clip(ray, t0, t1) || !(t1 > t0)) return Rgb(1.0);
-  // Past the entry point the stored depth counts the whole stretch through the grid.
-  const Vec3 p = depth.bounds().contains(x) ? x : ray.at(t0 + 1e-9 * (t1 - t0));
-  return glm::exp(-volume_.sigma_t_scale * sample(depth, p));
+  if (depth.bounds().contains(x)) return glm::exp(-volume_.sigma_t_scale * sample(depth, x));
+  // From outside: the stored depth half a cell past the entry point (where trilinear no longer
+  // clamps to the edge cells), plus that half cell's density by the midpoint rule.
+  const Vec3 h = depth.cell_size();
+  const double step = std::min(0.5 * std::min({h.x, h.y, h.z}), t1 - t0);
+  const double tau = sample(depth, ray.at(t0 + step)) + step * sample(volume_.density, ray.at(t0 + 0.5 * step));
+  return glm::exp(-volume_.sigma_t_scale * tau);
 }
 
 Rgb GridSolution::unscattered(size_t light, const Vec3& x, LightArrival& a) const {

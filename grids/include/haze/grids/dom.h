@@ -56,7 +56,7 @@ struct DomSettings {
   int terms = 25;
   DomScheme scheme = DomScheme::sweep;
   DomAccelerator accelerator = DomAccelerator::gmres;
-  int max_iterations = 500;
+  int max_iterations = 500;  // per solved channel, the first-collision sweep included
   // Stop when a source iteration would change the moments by less than this, relative (L2 over
   // every cell and term); the error to the converged answer can be larger by 1 / (1 - albedo).
   double tolerance = 1e-3;
@@ -85,7 +85,7 @@ struct DomSolution {
   int channels = 0;
   std::vector<std::vector<float>> moments;  // [channel][cell * N + k], cells in public x-fastest order
 
-  int iterations = 0;              // transport sweeps, the first-collision sweep included
+  int iterations = 0;              // transport sweeps over all channels, the first-collision sweeps included
   bool converged = false;
   std::vector<double> changes;     // the relative change after each iteration
   size_t bytes = 0;                // peak memory the solver held for its fields
