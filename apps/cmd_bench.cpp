@@ -34,16 +34,12 @@ struct Config {
 };
 
 // What each method's sweep varies: the settings that trade time for error.
+// (MethodInfo::trade_sweep; auto's tolerances run apart, after the references are known.)
 std::vector<Config> sweep() {
   std::vector<Config> c;
-  for (int spp : {16, 64, 256, 1024, 4096}) c.push_back({"reference", {{"spp", spp}, {"seed", 7}}});
-  for (int steps : {32, 64, 128, 256}) c.push_back({"quadrature", {{"steps", steps}, {"sky_directions", 64}}});
-  for (auto [a, eta] : {std::pair{64, 128}, {128, 256}, {256, 512}}) c.push_back({"analytic", {{"table_a", a}, {"table_eta", eta}}});
-  for (int resolution : {16, 32, 64, 96})
-    for (double step : {1.0, 0.5}) c.push_back({"propagation", {{"resolution", resolution}, {"step", step}}});
-  for (auto [resolution, directions, terms] : {std::tuple{16, 32, 9}, {24, 48, 16}, {32, 80, 25}, {48, 128, 25}, {64, 128, 25}, {96, 128, 25}})
-    c.push_back({"dom", {{"resolution", resolution}, {"directions", directions}, {"terms", terms}}});
-  for (int directions : {32, 64, 128}) c.push_back({"network", {{"directions", directions}}});
+  for (const MethodInfo& m : registered_methods())
+    if (m.name != "auto")
+      for (const nlohmann::json& settings : m.trade_sweep) c.push_back({m.name, settings});
   return c;
 }
 

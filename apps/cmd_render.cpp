@@ -2,9 +2,10 @@
 #include "commands.h"
 #include "progress_bar.h"
 
+#include <haze/core/auto.h>
 #include <haze/core/error.h>
+#include <haze/core/stopwatch.h>
 
-#include <chrono>
 #include <optional>
 #include <iostream>
 
@@ -76,17 +77,23 @@ int run(const RenderArgs& a) {
     options.settings["tolerance"] = *a.tolerance;
   }
   if (a.explain && method != "auto") throw Error("--explain", "method " + method, "--method auto (the choice it explains)");
+  if (a.explain) {  // before the render, which may be long
+    nlohmann::json settings = scene.method_name() == "auto" ? scene.method : nlohmann::json::object();
+    for (const auto& [key, value] : options.settings.items()) settings[key] = value;
+    const AutoChoice choice = choose_method(scene, settings.value("tolerance", 0.05));
+    std::cout << "auto chose " << choice.method << " " << choice.settings.dump() << ", expected "
+              << (choice.expected_seconds > 0.0 ? to_text(choice.expected_seconds) + " s (the trade suite's closest scene)"
+                                                : std::string("time unknown (the reference renders until its noise target)"))
+              << "\n";
+    for (const auto& line : choice.why) std::cout << "  - " << line << "\n";
+    std::cout << std::flush;
+  }
   ProgressBar bar(method);
   options.progress = bar.callback();
-  auto start = std::chrono::steady_clock::now();
+  const Stopwatch watch;
   RenderResult result = a.display == "gl" ? render_gl(scene, method, options) : render(scene, method, options);
-  double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const double seconds = watch.seconds();
   std::filesystem::path out = a.out.empty() ? std::filesystem::path(a.scene).stem().string() + "_" + method + ".exr" : a.out;
-  if (a.explain) {
-    const auto& choice = result.stats["auto"];
-    std::cout << "auto chose " << choice["method"].get<std::string>() << " " << choice["settings"].dump() << "\n";
-    for (const auto& line : choice["why"]) std::cout << "  - " << line.get<std::string>() << "\n";
-  }
   auto summary = save_result(result, method, seconds, out, !a.no_png);
   summary["scene"] = a.scene;
   if (a.json) {
@@ -121,6 +128,7 @@ Command add_render(CLI::App& app) {
   sub->add_flag("--json", a->json, "Print a JSON summary");
   sub->add_flag("--no-png", a->no_png, "Do not write the PNG preview");
   sub->add_flag("--no-cache", a->no_cache, "Rebuild precomputed tables instead of reading them from the cache");
+  sub->footer(methods_help());
   return {sub, [a] { return run(*a); }};
 }
 

@@ -26,6 +26,9 @@ Command add_demo(CLI::App& app);
 Command add_compare(CLI::App& app);
 Command add_tables(CLI::App& app);
 Command add_bench(CLI::App& app);
+Command add_methods(CLI::App& app);
+// Every registered method and its settings, for help texts.
+std::string methods_help();
 
 // Writes the result's EXR (with its standard-error layer, if any) and a PNG preview beside it;
 // returns the JSON summary `haze render --json` prints.

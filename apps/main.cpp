@@ -9,13 +9,13 @@ int main(int argc, char** argv) {
   CLI::App app{"Haze: light transport in participating media (fog, haze, smoke, clouds)"};
   app.require_subcommand(1);
   app.set_version_flag("--version", std::string("haze ") + HAZE_VERSION);
+  haze::app::register_all_methods();  // before the commands: their help lists the methods
   const haze::app::Command commands[] = {haze::app::add_info(app), haze::app::add_phase(app),
                                           haze::app::add_render(app), haze::app::add_demo(app),
                                           haze::app::add_compare(app), haze::app::add_tables(app),
-                                          haze::app::add_bench(app)};
+                                          haze::app::add_bench(app), haze::app::add_methods(app)};
   CLI11_PARSE(app, argc, argv);
   try {
-    haze::app::register_all_methods();
     for (const auto& command : commands)
       if (command.sub->parsed()) return command.run();
   } catch (const haze::Error& e) {

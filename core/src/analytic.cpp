@@ -217,13 +217,13 @@ class AnalyticMethod final : public Method {
 
   std::unique_ptr<MethodSolution> prepare(const Scene& scene, const RenderOptions& options) const override {
     Settings settings(options.settings, "analytic");
-    const int a_samples = static_cast<int>(settings.integer("table_a", 256, 16, 4096));
-    const int eta_samples = static_cast<int>(settings.integer("table_eta", 512, 16, 4096));
-    const bool surface_airlight = settings.integer("surface_airlight", 1, 0, 1) == 1;
-    const bool airlight = settings.integer("airlight", 1, 0, 1) == 1;
+    const int a_samples = static_cast<int>(settings.integer("table_a"));
+    const int eta_samples = static_cast<int>(settings.integer("table_eta"));
+    const bool surface_airlight = settings.integer("surface_airlight") == 1;
+    const bool airlight = settings.integer("airlight") == 1;
     // Dynamic g (seed 002 sec. 4.3): > 0 builds g-independent Legendre tables (cached) and sums
     // them for the scene's g with enough orders for this relative tolerance.
-    const double dynamic_g = settings.number("dynamic_g_tolerance", 0.0, 0.0, 0.5);
+    const double dynamic_g = settings.number("dynamic_g_tolerance");
     settings.reject_unknown();
 
     if (!scene.medium) throw Error("medium", "missing", "a homogeneous medium for the analytic method");
@@ -319,6 +319,27 @@ class AnalyticMethod final : public Method {
 
 }  // namespace
 
-std::unique_ptr<Method> make_analytic_method() { return std::make_unique<AnalyticMethod>(); }
+MethodInfo analytic_info() {
+  MethodInfo info;
+  info.name = "analytic";
+  info.summary = "closed-form single scattering, homogeneous medium, point and spot lights (seed 002; no shadows)";
+  info.create = [] { return std::make_unique<AnalyticMethod>(); };
+  info.handles = {"constant density (bounded or not)", "point, spot",
+                  "planes and spheres lit by unscattered light and the airlight, no shadows", false};
+  info.settings = {SettingInfo::integer("table_a", 256, 16, 4096, "airlight table samples along A = T_sv sin(gamma)"),
+                   SettingInfo::integer("table_eta", 512, 16, 4096, "airlight table samples along the angle eta"),
+                   SettingInfo::integer("surface_airlight", 1, 0, 1, "1: surfaces also receive the airlight (tables J1 and J_n)"),
+                   SettingInfo::integer("airlight", 1, 0, 1, "0: leave out the view ray's airlight (surfaces only)"),
+                   SettingInfo::number("dynamic_g_tolerance", 0.0, 0.0, 0.5,
+                                       "> 0: sum g-independent Legendre tables for the scene's HG g to this relative tolerance")};
+  for (auto [a, eta] : {std::pair{64, 128}, {128, 256}, {256, 512}}) info.trade_sweep.push_back({{"table_a", a}, {"table_eta", eta}});
+  info.offer = [](const SceneFeatures& f, double tolerance) {
+    if (!single_scattering_suffices(f, tolerance)) return AutoOffer{false, {}, 0.0, "multiple scattering matters"};
+    if (!f.homogeneous || f.sky || f.directional) return AutoOffer{false, {}, 0.0, "needs a homogeneous medium and point or spot lights"};
+    return AutoOffer{true, {{"table_a", 128}, {"table_eta", 256}}, 0.003, "homogeneous medium, point and spot lights (thin_haze: 0.0027 s)"};
+  };
+  info.single_scattering = true;
+  return info;
+}
 
 }  // namespace haze::internal

@@ -22,11 +22,6 @@ std::string format(const char* f, double a, double b = 0.0, double c = 0.0) {
   return s;
 }
 
-bool available(const std::string& method) {
-  const auto methods = registered_methods();
-  return std::any_of(methods.begin(), methods.end(), [&](const MethodInfo& m) { return m.name == method; });
-}
-
 // The reference path tracer, adding samples until its own relative noise over the lit pixels is
 // 0.75 T (the reference's target_noise; at least 1024 spp). On the trade suite the error of a
 // reference render on other seeds reached 1.3x that noise estimate (heavy tails: fog_lamps at
@@ -72,13 +67,9 @@ class AutoMethod final : public Method {
  public:
   std::unique_ptr<MethodSolution> prepare(const Scene& scene, const RenderOptions& options) const override {
     Settings settings(options.settings, "auto");
-    const double tolerance = settings.number("tolerance", 0.05, 1e-4, 0.99);
+    const double tolerance = settings.number("tolerance");
     settings.reject_unknown();
-    AutoChoice choice = choose_method(scene, tolerance);
-    if (!available(choice.method)) {  // a consumer that registered core only: the reference is always there
-      choice.why.push_back("but " + choice.method + " is not registered (its module's register_methods() was not called)");
-      choice = reference_for(tolerance, choice);
-    }
+    const AutoChoice choice = choose_method(scene, tolerance);
     RenderOptions delegated = options;
     delegated.settings = choice.settings;
     auto solution = std::make_unique<AutoSolution>(haze::prepare(scene, choice.method, delegated));
@@ -132,75 +123,53 @@ SceneFeatures scene_features(const Scene& scene) {
 
 namespace {
 
-// The rules (docs/METHODS.md), from the scene's features.
+// The cheapest registered method's offer (MethodInfo::offer), else the reference.
 AutoChoice choose(const Scene& scene, double tolerance) {
   const SceneFeatures f = scene_features(scene);
+  if (!f.particles && !scene.medium) throw Error("medium", "missing", "a medium or particles for method auto");
   AutoChoice c;
   c.why.push_back(format("tolerance %.1f%%", 100.0 * tolerance));
-  if (f.particles) {
-    c.why.push_back("particles, no grid medium");
-    // Trade suite, particle_cloud: network 5.5% in 0.46 s at any D; dom on the particles'
-    // density, 16^3 cells and 32 directions, 0.8% in 3.6 s.
-    if (tolerance >= 0.06) {
-      c.method = "network", c.settings = {{"directions", 64}};
-      c.why.push_back("network: the illumination network is measured at 5.5% on the suite's particle cloud");
-    } else {
-      c.method = "dom", c.settings = {{"resolution", 16}, {"directions", 32}, {"terms", 9}};
-      c.why.push_back("dom on the particles' density: measured at 0.8% on the suite's particle cloud, 8x the network's time");
-    }
-    return c;
+  if (f.particles) c.why.push_back("particles, no grid medium");
+  else
+    c.why.push_back(format("optical diameter %.2f, albedo %.2f: estimated multiple-scattering share %.0f%%", f.optical_diameter, f.albedo,
+                           100.0 * f.multiple_share));
+  std::vector<std::pair<std::string, AutoOffer>> offers;
+  for (const MethodInfo& info : registered_methods())
+    if (info.offer) offers.emplace_back(info.name, info.offer(f, tolerance));
+  const auto best = std::min_element(offers.begin(), offers.end(), [](const auto& a, const auto& b) {
+    if (a.second.offered != b.second.offered) return a.second.offered;
+    return a.second.expected_seconds < b.second.expected_seconds;
+  });
+  if (best != offers.end() && best->second.offered) {
+    c.method = best->first, c.settings = best->second.settings, c.expected_seconds = best->second.expected_seconds;
+    c.why.push_back(best->first + format(", expected %.3g s: ", best->second.expected_seconds) + best->second.why);
   }
-  if (!scene.medium) throw Error("medium", "missing", "a medium or particles for method auto");
-  c.why.push_back(format("optical diameter %.2f, albedo %.2f: estimated multiple-scattering share %.0f%%", f.optical_diameter, f.albedo,
-                         100.0 * f.multiple_share));
-  const bool single_enough = f.multiple_share < 0.5 * tolerance;
-  if (f.surfaces && !single_enough) {
-    // Trade suite, cloud_sun, fog_lamps, thin_haze: with surfaces in view every fast method is
-    // 15% to 50% off, since none lights surfaces with scattered light or between surfaces.
-    c.why.push_back("surfaces in a scattering medium: no fast method lights them with scattered light (15% to 50% off on the suite)");
-    return reference_for(tolerance, c);
+  for (const auto& [name, offer] : offers) {
+    if (name == c.method) continue;
+    c.why.push_back(name + (offer.offered ? format(" (expected %.3g s): ", offer.expected_seconds) : std::string(" declines: ")) + offer.why);
   }
-  if (single_enough) {
-    c.why.push_back("single scattering is enough: the multiple-scattering share is under half the tolerance");
-    if (f.homogeneous && !f.sky && !f.directional) {
-      c.method = "analytic", c.settings = {{"table_a", 128}, {"table_eta", 256}};
-      c.why.push_back("analytic: homogeneous medium, point and spot lights");
-    } else if (!f.sky) {
-      c.method = "propagation", c.settings = {{"resolution", 64}, {"step", 0.5}};
-      c.why.push_back("propagation: heterogeneous medium or a directional light");
-    } else {
-      c.method = "quadrature", c.settings = {{"steps", 128}};
-      c.why.push_back("quadrature: a sky light");
-    }
-    return c;
-  }
-  if (!f.bounded && f.homogeneous) {
-    c.why.push_back("multiple scattering in an unbounded medium: no grid to solve it on");
-    return reference_for(tolerance, c);
-  }
-  // Trade suite, dense_cloud (albedo 0.99), against its 262144-spp reference: dom error 25.6% at
-  // 16^3, 13.2% at 24^3, 8.0% at 32^3, 4.4% at 48^3, 2.9% at 64^3, 1.8% at 96^3 (128 directions):
-  // below 2% only the reference is known to get there.
-  if (tolerance < 0.02) {
-    c.why.push_back("multiple scattering, no surfaces, but a tolerance under dom's measured 1.8% at 96^3");
-    return reference_for(tolerance, c);
-  }
-  const int resolution = tolerance >= 0.05 ? 48 : tolerance >= 0.035 ? 64 : 96;
-  c.method = "dom", c.settings = {{"resolution", resolution}, {"directions", 128}, {"terms", 25}};
-  c.why.push_back(format("dom at %.0f^3 cells, 128 directions: multiple scattering matters, no surfaces; the suite's dense cloud measured 4.4%% at 48^3, 2.9%% at 64^3 and 1.8%% at 96^3",
-                         resolution));
-  return c;
+  if (!c.method.empty()) return c;
+  c.why.push_back("no registered method offers a fast way under the tolerance");
+  return reference_for(tolerance, c);
 }
 
 }  // namespace
+
+MethodInfo internal::auto_info() {
+  MethodInfo info;
+  info.name = "auto";
+  info.summary = "the cheapest registered method and settings expected to meet --set tolerance=T (0.05), chosen from the scene alone";
+  info.create = [] { return std::make_unique<AutoMethod>(); };
+  info.handles = {"what the chosen method handles", "what the chosen method handles", "what the chosen method handles", true};
+  info.settings = {SettingInfo::number("tolerance", 0.05, 1e-4, 0.99, "the relative error to stay under (mean over lit pixels)")};
+  for (double t : {0.05, 0.02, 0.01}) info.trade_sweep.push_back({{"tolerance", t}});
+  info.reads_particles = true;  // the chosen method's own preparation decides
+  return info;
+}
 
 AutoChoice choose_method(const Scene& scene, double tolerance) {
   if (!(tolerance > 0.0 && tolerance < 1.0)) throw Error("tolerance", format("%g", tolerance), "a relative error in (0, 1), e.g. 0.05");
   return choose(scene, tolerance);
 }
-
-namespace internal {
-std::unique_ptr<Method> make_auto_method() { return std::make_unique<AutoMethod>(); }
-}  // namespace internal
 
 }  // namespace haze

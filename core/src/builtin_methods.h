@@ -17,12 +17,12 @@ inline constexpr const char* kNoField = "not kept by this method";
 
 
 // Deterministic single scattering by numerical quadrature (quadrature.cpp).
-std::unique_ptr<Method> make_quadrature_method();
+MethodInfo quadrature_info();
 // The unbiased volumetric path tracer every fast method is measured against (reference.cpp).
-std::unique_ptr<Method> make_reference_method();
+MethodInfo reference_info();
 // Closed-form single scattering in homogeneous media from point lights (analytic.cpp).
-std::unique_ptr<Method> make_analytic_method();
-// The cheapest method expected to meet a tolerance, chosen from the scene (auto.cpp).
-std::unique_ptr<Method> make_auto_method();
+MethodInfo analytic_info();
+// The cheapest method expected to meet a tolerance, chosen from the registry's offers (auto.cpp).
+MethodInfo auto_info();
 
 }  // namespace haze::internal

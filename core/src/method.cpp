@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <map>
 #include <mutex>
+#include <sstream>
 
 namespace haze {
 
@@ -17,18 +18,8 @@ struct Registry {
   std::map<std::string, MethodInfo> methods;
   ParticleMediumFactory particle_medium;
   Registry() {
-    methods["quadrature"] = {"quadrature",
-                             "single scattering by deterministic numerical quadrature (any medium; a yardstick, not fast)",
-                             internal::make_quadrature_method, false, true};
-    methods["reference"] = {"reference",
-                            "unbiased volumetric path tracer with a standard-error image (the yardstick for every method)",
-                            internal::make_reference_method};
-    methods["analytic"] = {"analytic",
-                           "closed-form single scattering, homogeneous medium, point and spot lights (seed 002; no shadows)",
-                           internal::make_analytic_method, false, true};
-    methods["auto"] = {"auto",
-                       "the cheapest method and settings expected to meet --set tolerance=T (0.05), chosen from the scene alone",
-                       internal::make_auto_method, true};
+    for (MethodInfo info : {internal::quadrature_info(), internal::reference_info(), internal::analytic_info(), internal::auto_info()})
+      methods[info.name] = std::move(info);
   }
 };
 
@@ -109,44 +100,102 @@ Rgb MethodSolution::inscattered(const Vec3&, const Vec3&) const { no_field("insc
 
 namespace haze {
 
-Settings::Settings(const nlohmann::json& settings, std::string method) : settings_(settings), method_(std::move(method)) {
-  if (!settings_.is_object()) throw Error("method", settings_.dump(), "an object of " + method_ + " settings");
+SettingInfo SettingInfo::integer(std::string name, nlohmann::json fallback, long long min, long long max, std::string doc) {
+  return {std::move(name), Type::integer, std::move(fallback), static_cast<double>(min), static_cast<double>(max), {}, std::move(doc)};
+}
+SettingInfo SettingInfo::number(std::string name, nlohmann::json fallback, double min, double max, std::string doc) {
+  return {std::move(name), Type::number, std::move(fallback), min, max, {}, std::move(doc)};
+}
+SettingInfo SettingInfo::choice(std::string name, std::string fallback, std::vector<std::string> choices, std::string doc) {
+  return {std::move(name), Type::choice, std::move(fallback), 0.0, 0.0, std::move(choices), std::move(doc)};
 }
 
-long long Settings::integer(const std::string& key, long long fallback, long long min, long long max) {
+namespace {
+std::string quoted_list(const std::vector<std::string>& names) {
+  std::string out;
+  for (const auto& n : names) out += (out.empty() ? "\"" : ", \"") + n + "\"";
+  return out;
+}
+std::string range(const SettingInfo& s) {
+  if (s.type == SettingInfo::Type::choice) return "one of " + quoted_list(s.choices);
+  if (s.type == SettingInfo::Type::integer)
+    return "an integer in [" + to_text(static_cast<long long>(s.min)) + ", " + to_text(static_cast<long long>(s.max)) + "]";
+  return "a number in [" + to_text(s.min) + ", " + to_text(s.max) + "]";
+}
+}  // namespace
+
+std::string SettingInfo::describe() const {
+  return range(*this) + ", default " + (fallback.is_null() ? std::string("as described") : fallback.dump());
+}
+
+const SettingInfo* MethodInfo::setting(const std::string& key) const {
+  for (const SettingInfo& s : settings)
+    if (s.name == key) return &s;
+  return nullptr;
+}
+
+std::string settings_help(const MethodInfo& info) {
+  std::string out;
+  for (const SettingInfo& s : info.settings) out += "  " + s.name + ": " + s.doc + " (" + s.describe() + ")\n";
+  return out.empty() ? "  (no settings)\n" : out;
+}
+
+std::string settings_markdown(const MethodInfo& info) {
+  std::ostringstream out;
+  out << "| setting | default | accepted | what it does |\n|---|---|---|---|\n";
+  for (const SettingInfo& s : info.settings) {
+    out << "| `" << s.name << "` | ";
+    if (s.fallback.is_null()) out << "see text";
+    else out << '`' << s.fallback.dump() << '`';
+    out << " | " << range(s) << " | " << s.doc << " |\n";
+  }
+  return out.str();
+}
+
+Settings::Settings(const nlohmann::json& settings, const std::string& method) : settings_(settings), method_(method_info(method)) {
+  if (!settings_.is_object()) throw Error("method", settings_.dump(), "an object of " + method + " settings");
+}
+
+const SettingInfo& Settings::info(const std::string& key, SettingInfo::Type type) {
+  const SettingInfo* s = method_.setting(key);
+  HAZE_CHECK(s && s->type == type);  // a method reads only the settings its MethodInfo declares
   known_.push_back(key);
+  return *s;
+}
+
+long long Settings::integer(const std::string& key) { return integer(key, info(key, SettingInfo::Type::integer).fallback.get<long long>()); }
+long long Settings::integer(const std::string& key, long long fallback) {
+  const SettingInfo& s = info(key, SettingInfo::Type::integer);
   auto it = settings_.find(key);
   if (it == settings_.end()) return fallback;
-  if (!it->is_number_integer() || it->get<long long>() < min || it->get<long long>() > max)
-    throw Error("method." + key, it->dump(), "an integer in [" + std::to_string(min) + ", " + std::to_string(max) + "]");
+  if (!it->is_number_integer() || static_cast<double>(it->get<long long>()) < s.min || static_cast<double>(it->get<long long>()) > s.max)
+    throw Error("method." + key, it->dump(), range(s));
   return it->get<long long>();
 }
 
-double Settings::number(const std::string& key, double fallback, double min, double max) {
-  known_.push_back(key);
+double Settings::number(const std::string& key) { return number(key, info(key, SettingInfo::Type::number).fallback.get<double>()); }
+double Settings::number(const std::string& key, double fallback) {
+  const SettingInfo& s = info(key, SettingInfo::Type::number);
   auto it = settings_.find(key);
   if (it == settings_.end()) return fallback;
-  if (!it->is_number() || !(it->get<double>() >= min && it->get<double>() <= max))
-    throw Error("method." + key, it->dump(), "a number in [" + to_text(min) + ", " + to_text(max) + "]");
+  if (!it->is_number() || !(it->get<double>() >= s.min && it->get<double>() <= s.max)) throw Error("method." + key, it->dump(), range(s));
   return it->get<double>();
 }
 
-std::string Settings::choice(const std::string& key, const std::string& fallback, const std::vector<std::string>& allowed) {
-  known_.push_back(key);
+std::string Settings::choice(const std::string& key) {
+  const SettingInfo& s = info(key, SettingInfo::Type::choice);
   auto it = settings_.find(key);
-  if (it == settings_.end()) return fallback;
-  if (it->is_string() && std::find(allowed.begin(), allowed.end(), it->get<std::string>()) != allowed.end()) return it->get<std::string>();
-  std::string names;
-  for (const auto& a : allowed) names += (names.empty() ? "\"" : ", \"") + a + "\"";
-  throw Error("method." + key, it->dump(), "one of " + names);
+  if (it == settings_.end()) return s.fallback.get<std::string>();
+  if (it->is_string() && std::find(s.choices.begin(), s.choices.end(), it->get<std::string>()) != s.choices.end()) return it->get<std::string>();
+  throw Error("method." + key, it->dump(), range(s));
 }
 
 void Settings::reject_unknown() const {
   for (const auto& [key, value] : settings_.items()) {
     if (key == "name" || std::find(known_.begin(), known_.end(), key) != known_.end()) continue;
     std::string names;
-    for (const auto& k : known_) names += (names.empty() ? "" : ", ") + k;
-    throw Error("method." + key, value.dump(), "a setting of " + method_ + ": " + (names.empty() ? "none" : names));
+    for (const auto& k : method_.settings) names += (names.empty() ? "" : ", ") + k.name;
+    throw Error("method." + key, value.dump(), "a setting of " + method_.name + ": " + (names.empty() ? "none" : names));
   }
 }
 

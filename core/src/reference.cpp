@@ -382,12 +382,12 @@ class ReferenceMethod final : public Method {
     ReferenceSettings s;
     // With target_noise, samples are added in rounds until the image's own relative noise over
     // the lit pixels (lit_pixel_error's noise_rms) is at most target_noise; spp is then the cap.
-    s.target_noise = settings.number("target_noise", 0.0, 0.0, 0.99);
-    s.spp = settings.integer("spp", s.target_noise > 0.0 ? kProgressiveCap : 1024, 1, 1LL << 32);
-    s.max_scattering = static_cast<int>(settings.integer("max_scattering", -1, -1, 100000));
-    s.max_bounces = static_cast<int>(settings.integer("max_bounces", -1, -1, 100000));
-    s.view_scattering = settings.integer("view_scattering", 1, 0, 1) == 1;
-    s.seed = static_cast<std::uint64_t>(settings.integer("seed", 1, 0, 1LL << 62));
+    s.target_noise = settings.number("target_noise");
+    s.spp = settings.integer("spp", s.target_noise > 0.0 ? kProgressiveCap : 1024);
+    s.max_scattering = static_cast<int>(settings.integer("max_scattering"));
+    s.max_bounces = static_cast<int>(settings.integer("max_bounces"));
+    s.view_scattering = settings.integer("view_scattering") == 1;
+    s.seed = static_cast<std::uint64_t>(settings.integer("seed"));
     settings.reject_unknown();
     return std::make_unique<ReferenceSolution>(scene, s);
   }
@@ -395,6 +395,22 @@ class ReferenceMethod final : public Method {
 
 }  // namespace
 
-std::unique_ptr<Method> make_reference_method() { return std::make_unique<ReferenceMethod>(); }
+MethodInfo reference_info() {
+  MethodInfo info;
+  info.name = "reference";
+  info.summary = "unbiased volumetric path tracer with a standard-error image (the yardstick for every method)";
+  info.create = [] { return std::make_unique<ReferenceMethod>(); };
+  info.handles = {"any: constant, RBF and grid densities, the particles' density", "point, spot, directional, sky",
+                  "planes and spheres: every light path", true};
+  info.settings = {
+      SettingInfo::number("target_noise", 0.0, 0.0, 0.99, "add samples until the image's own relative noise over the lit pixels is this (0: off)"),
+      SettingInfo::integer("spp", nullptr, 1, 1LL << 32, "samples per pixel: 1024, or with target_noise the cap (2^20)"),
+      SettingInfo::integer("max_scattering", -1, -1, 100000, "medium scattering events per path (-1: unlimited)"),
+      SettingInfo::integer("max_bounces", -1, -1, 100000, "surface reflections per path (-1: unlimited)"),
+      SettingInfo::integer("view_scattering", 1, 0, 1, "0: the camera ray to the first surface does not scatter"),
+      SettingInfo::integer("seed", 1, 0, 1LL << 62, "the random streams' seed")};
+  for (int spp : {16, 64, 256, 1024, 4096}) info.trade_sweep.push_back({{"spp", spp}, {"seed", 7}});
+  return info;
+}
 
 }  // namespace haze::internal

@@ -5,10 +5,8 @@
 namespace haze::grids {
 
 void register_methods() {
-  register_method({"propagation", "single scattering in heterogeneous media: RBF injection, optical-depth volumes, ray marching (seed 003)",
-                   make_propagation_method, false, true});
-  register_method({"dom", "multiple scattering on grids: discrete ordinates with a separable phase function (seed 000)",
-                   make_dom_method});
+  register_method(propagation_info());
+  register_method(dom_info());
 }
 
 }  // namespace haze::grids

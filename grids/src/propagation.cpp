@@ -99,13 +99,13 @@ class PropagationMethod final : public Method {
 
 PropagationFields propagation_fields(const Scene& scene, const RenderOptions& options) {
   Settings settings(options.settings, "propagation");
-  const int resolution = static_cast<int>(settings.integer("resolution", 64, 2, 1024));
+  const int resolution = static_cast<int>(settings.integer("resolution"));
   DepthOptions depth;
-  depth.scheme = depth_scheme_from_name(settings.choice("optical_depth", "sweep", {"exact", "paper", "sweep"}));
-  depth.sweep_layers = static_cast<int>(settings.integer("sweep_layers", depth.sweep_layers, 1, 64));
+  depth.scheme = depth_scheme_from_name(settings.choice("optical_depth"));
+  depth.sweep_layers = static_cast<int>(settings.integer("sweep_layers"));
   depth.threads = options.threads;
-  const double step_cells = settings.number("step", 0.5, 0.01, 4.0);
-  const double cutoff = settings.number("cutoff", 0.0, 0.0, 1e30);
+  const double step_cells = settings.number("step");
+  const double cutoff = settings.number("cutoff");
   settings.reject_unknown();
 
   for (size_t i = 0; i < scene.lights.size(); ++i)
@@ -127,6 +127,28 @@ PropagationFields propagation_fields(const Scene& scene, const RenderOptions& op
   return fields;
 }
 
-std::unique_ptr<Method> make_propagation_method() { return std::make_unique<PropagationMethod>(); }
+MethodInfo propagation_info() {
+  MethodInfo info;
+  info.name = "propagation";
+  info.summary = "single scattering in heterogeneous media: RBF injection, optical-depth volumes, ray marching (seed 003)";
+  info.create = [] { return std::make_unique<PropagationMethod>(); };
+  info.handles = {"RBF, grid and bounded constant densities, the particles' density", "point, spot, directional",
+                  "planes and spheres lit by unscattered light through the depth volumes, no shadows", false};
+  info.settings = {SettingInfo::integer("resolution", 64, 2, 1024, "cells along the longest side of the medium's bounds (RBF and constant)"),
+                   SettingInfo::choice("optical_depth", "sweep", {"exact", "paper", "sweep"}, "how the depth to each light is computed"),
+                   SettingInfo::integer("sweep_layers", 4, 1, 64, "sweep: cell layers each short characteristic walks exactly"),
+                   SettingInfo::number("step", 0.5, 0.01, 4.0, "ray-march step in cells"),
+                   SettingInfo::number("cutoff", 0.0, 0.0, 1e30, "RBF injection cutoff (0: 1e-4 of the largest weight)")};
+  for (int resolution : {16, 32, 64, 96})
+    for (double step : {1.0, 0.5}) info.trade_sweep.push_back({{"resolution", resolution}, {"step", step}});
+  info.offer = [](const SceneFeatures& f, double tolerance) {
+    if (!single_scattering_suffices(f, tolerance)) return AutoOffer{false, {}, 0.0, "multiple scattering matters (or particles)"};
+    if (f.sky) return AutoOffer{false, {}, 0.0, "a sky light"};
+    if (f.homogeneous && !f.bounded) return AutoOffer{false, {}, 0.0, "an unbounded homogeneous medium has no grid"};
+    return AutoOffer{true, {{"resolution", 64}, {"step", 0.5}}, 0.008, "heterogeneous medium or a directional light (thin_haze: 0.0078 s at 64^3)"};
+  };
+  info.single_scattering = true;
+  return info;
+}
 
 }  // namespace haze::grids

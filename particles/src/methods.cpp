@@ -5,9 +5,7 @@
 namespace haze::particles {
 
 void register_methods() {
-  MethodInfo network{"network", "multiple scattering in particle media: visibility and illumination networks (seed 001)", make_network_method};
-  network.reads_particles = true;
-  register_method(std::move(network));
+  register_method(network_info());
   // Every other method renders the particles' continuous density, sampled on a grid of
   // `particle_resolution` cells along the longest side (96 unless the settings say).
   register_particle_medium([](const Scene& scene, nlohmann::json& settings) {

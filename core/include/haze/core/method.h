@@ -3,6 +3,7 @@
 // "method" block pick one.
 #pragma once
 
+#include <haze/core/features.h>
 #include <haze/core/image.h>
 #include <haze/core/progress.h>
 #include <haze/core/scene.h>
@@ -28,17 +29,65 @@ class Method {
   virtual std::unique_ptr<MethodSolution> prepare(const Scene& scene, const RenderOptions& options) const = 0;
 };
 
+// One setting of a method, as validation, `haze render --help` and docs/METHODS.md read it.
+struct SettingInfo {
+  enum class Type { integer, number, choice };
+  std::string name;
+  Type type = Type::integer;
+  nlohmann::json fallback;  // the default; null when it follows from other settings (the doc says how)
+  double min = 0.0, max = 0.0;       // integer and number: the accepted range
+  std::vector<std::string> choices;  // choice: the accepted names
+  std::string doc;                   // one line
+
+  static SettingInfo integer(std::string name, nlohmann::json fallback, long long min, long long max, std::string doc);
+  static SettingInfo number(std::string name, nlohmann::json fallback, double min, double max, std::string doc);
+  static SettingInfo choice(std::string name, std::string fallback, std::vector<std::string> choices, std::string doc);
+  // "integer in [2, 1024], default 64" and the like.
+  std::string describe() const;
+};
+
+// What a method handles, for help, docs and callers choosing one.
+struct MethodHandles {
+  std::string media;     // e.g. "constant, RBF and grid densities (bounded)"
+  std::string lights;    // e.g. "point, spot, directional"
+  std::string surfaces;  // e.g. "planes and spheres lit by unscattered light, no shadows"
+  bool multiple_scattering = false;
+};
+
+// What a method offers method "auto" for a scene: settings expected to meet the tolerance and
+// their expected time (measured on the trade suite's closest scene), or why it declines.
+struct AutoOffer {
+  bool offered = false;
+  nlohmann::json settings = nlohmann::json::object();
+  double expected_seconds = 0.0;
+  std::string why;  // one line: the measurement the offer rests on, or why not
+};
+using AutoRule = std::function<AutoOffer(const SceneFeatures& features, double tolerance)>;
+
 struct MethodInfo {
   std::string name;
   std::string summary;  // one line for `haze render --help` and error messages
   std::function<std::unique_ptr<Method>()> create;
+  MethodHandles handles;
+  std::vector<SettingInfo> settings;
+  // The settings `haze bench trade` sweeps: those that trade time for error.
+  std::vector<nlohmann::json> trade_sweep;
+  // How the method bids for a scene in method "auto" (none: never chosen; the reference is the
+  // fallback when nothing offers).
+  AutoRule offer;
   // The method reads the scene's `particles` block itself; any other method is given the
   // particles' continuous density as the scene's medium (register_particle_medium).
   bool reads_particles = false;
   // The image holds light scattered or reflected once only, at points the camera sees: a light
   // that reaches none of the view is left out too (light_culling.h).
   bool single_scattering = false;
+
+  const SettingInfo* setting(const std::string& key) const;
 };
+
+// The method's settings for `haze render --help` (one line each) and as a markdown table.
+std::string settings_help(const MethodInfo& info);
+std::string settings_markdown(const MethodInfo& info);
 
 // Turns a scene's `particles` block into a medium (the particle module registers one when its
 // methods are registered: the particles' continuous density sampled on a grid). `settings` are the
@@ -46,21 +95,25 @@ struct MethodInfo {
 using ParticleMediumFactory = std::function<MediumDesc(const Scene& scene, nlohmann::json& settings)>;
 void register_particle_medium(ParticleMediumFactory factory);
 
-// Reads a method's settings with validation: a bad value or a key the method never asked for
-// throws haze::Error naming "method.<key>".
+// Reads a method's settings against its registered schema (MethodInfo::settings): a bad value, or
+// a key the method never asked for, throws haze::Error naming "method.<key>", the value and the
+// schema's range. A fallback given here replaces the schema's (a default that follows from
+// other settings).
 class Settings {
  public:
-  Settings(const nlohmann::json& settings, std::string method);
-  long long integer(const std::string& key, long long fallback, long long min, long long max);
-  double number(const std::string& key, double fallback, double min, double max);
-  // A string that must be one of `allowed`.
-  std::string choice(const std::string& key, const std::string& fallback, const std::vector<std::string>& allowed);
-  // Throws for any key not read by integer() or number().
+  Settings(const nlohmann::json& settings, const std::string& method);
+  long long integer(const std::string& key);
+  long long integer(const std::string& key, long long fallback);
+  double number(const std::string& key);
+  double number(const std::string& key, double fallback);
+  std::string choice(const std::string& key);
+  // Throws for any key not read.
   void reject_unknown() const;
 
  private:
+  const SettingInfo& info(const std::string& key, SettingInfo::Type type);
   const nlohmann::json& settings_;
-  std::string method_;
+  MethodInfo method_;
   std::vector<std::string> known_;
 };
 

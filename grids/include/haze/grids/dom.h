@@ -141,6 +141,7 @@ DomFields dom_fields(const Scene& scene, const RenderOptions& options);
 // The memory a solve with these settings needs, in bytes (what solve_dom checks).
 size_t dom_memory_bytes(const std::array<int, 3>& resolution, int channels, const DomSettings& settings);
 
-std::unique_ptr<Method> make_dom_method();
+// Method "dom": its settings, what it handles and its auto rule.
+MethodInfo dom_info();
 
 }  // namespace haze::grids

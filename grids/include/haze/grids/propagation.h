@@ -59,6 +59,7 @@ struct PropagationFields {
 };
 PropagationFields propagation_fields(const Scene& scene, const RenderOptions& options);
 
-std::unique_ptr<Method> make_propagation_method();
+// Method "propagation": its settings, what it handles and its auto rule.
+MethodInfo propagation_info();
 
 }  // namespace haze::grids

@@ -142,6 +142,7 @@ NetworkSolution update_network(NetworkSolution previous, const ParticleField& fi
 // Surfaces are not drawn.
 Image render_network(const Scene& scene, const ParticleField& field, const NetworkSolution& solution, const RenderOptions& options = {});
 
-std::unique_ptr<Method> make_network_method();
+// Method "network": its settings, what it handles and its auto rule.
+MethodInfo network_info();
 
 }  // namespace haze::particles

@@ -1,0 +1,30 @@
+// Method auto with core's methods only (this program registers no module): what no registered
+// method offers goes to the reference, and the explanation says which declined and why.
+#include <haze/core/auto.h>
+
+#include <gtest/gtest.h>
+
+namespace haze {
+namespace {
+
+TEST(AutoMethod, WhatNothingRegisteredOffersGoesToTheReference) {
+  Scene scene;
+  scene.camera.width_px = scene.camera.height_px = 8;
+  MediumDesc medium;
+  medium.bounds = {Vec3(-1.0), Vec3(1.0)};
+  medium.sigma_t = Rgb(3.0);
+  medium.albedo = Rgb(0.95);
+  scene.medium = medium;
+  scene.lights.push_back(PointLight{Vec3(0.0, 2.0, 0.0), Rgb(5.0)});
+  const AutoChoice choice = choose_method(scene, 0.1);  // with grids registered: dom
+  EXPECT_EQ(choice.method, "reference");
+  EXPECT_EQ(choice.expected_seconds, 0.0);
+  std::string why;
+  for (const auto& line : choice.why) why += line + "\n";
+  EXPECT_NE(why.find("analytic declines: multiple scattering matters"), std::string::npos) << why;
+  EXPECT_NE(why.find("no registered method offers"), std::string::npos) << why;
+  EXPECT_EQ(why.find("dom"), std::string::npos) << why;
+}
+
+}  // namespace
+}  // namespace haze
