@@ -91,11 +91,15 @@ void axpy(std::vector<float>& a, double s, const std::vector<float>& b, int thre
 // float16 vector a chunk at a time, converted, in the same fixed chunks.
 class KrylovBasis {
  public:
+  // Vectors are allocated when first stored: a solve that stops after a few steps (a warm start)
+  // does not pay for the whole basis.
   KrylovBasis(int count, size_t size, bool half) : size_(size), half_(half) {
-    if (half) halves_.assign(static_cast<size_t>(count), std::vector<simd::Half>(size));
-    else floats_.assign(static_cast<size_t>(count), std::vector<float>(size));
+    if (half) halves_.resize(static_cast<size_t>(count));
+    else floats_.resize(static_cast<size_t>(count));
   }
   void store(int i, const std::vector<float>& w, double scale, int threads) {  // v_i = scale w
+    if (half_) halves_[static_cast<size_t>(i)].resize(size_);
+    else floats_[static_cast<size_t>(i)].resize(size_);
     const auto s = static_cast<float>(scale);
     parallel_for(static_cast<long long>(size_), threads, kChunk, [&](long long i0, long long i1) {
       const auto b = static_cast<size_t>(i0), count = static_cast<size_t>(i1 - i0);
@@ -318,6 +322,23 @@ DomSolution solve_dom(const ExtinctionVolume& volume, const std::vector<Light>& 
       continue;
     }
     const IterationProgress progress{settings, c, out.channels, out.iterations};
+    if (warm_fits && settings.accelerator == DomAccelerator::none) {
+      // Source iteration from the warm moments with the first-collision source in every sweep,
+      // x <- b + K x in one sweep, where forming b apart would take one more.
+      x = warm->moments[static_cast<size_t>(c)];
+      std::vector<float> next(size);
+      while (out.iterations - progress.start < settings.max_iterations) {
+        transport.sweep(channel, &first, x.data(), channel.sky, next.data(), settings.threads);
+        ++out.iterations;
+        axpy(x, -1.0, next, settings.threads);
+        const double change = norm(x, settings.threads) / std::max(norm(next, settings.threads), 1e-300);
+        x.swap(next);
+        out.changes.push_back(change);
+        progress(out.iterations);
+        if (change < settings.tolerance) break;
+      }
+      continue;
+    }
     std::vector<float> b(size);
     transport.sweep(channel, &first, nullptr, channel.sky, b.data(), settings.threads);
     ++out.iterations;

@@ -102,7 +102,8 @@ struct DomSolution {
 // before allocating). `delta_depths` holds, for each point, spot or directional light of `lights`
 // in order, the density integral from every cell to it (exact or propagated, optical_depth.h), as
 // render_dom takes them; sky lights enter through the boundary and have none. `warm`, when given and of the same shape, starts the iteration from its moments (the
-// paper's one-iteration-per-frame mode when density or lights change a little).
+// paper's one-iteration-per-frame mode when density or lights change a little); with accelerator
+// none each iteration is then one sweep with the first-collision source in it (x <- b + K x).
 DomSolution solve_dom(const ExtinctionVolume& volume, const std::vector<Light>& lights, const std::vector<DenseGrid>& delta_depths,
                       const DomSettings& settings, const DomSolution* warm = nullptr);
 
@@ -134,7 +135,7 @@ struct DomFields {
   int resolution = 64;
   DomSettings settings;
   DepthOptions depth;
-  int warm_iterations = 0;  // sweeps per update after the first-collision one; 0: to the tolerance
+  int warm_iterations = 0;  // sweeps per update (source iteration); 0: GMRES to the tolerance
 };
 DomFields dom_fields(const Scene& scene, const RenderOptions& options);
 
