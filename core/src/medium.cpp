@@ -2,6 +2,7 @@
 #include <haze/core/medium.h>
 
 #include <algorithm>
+#include <sstream>
 
 namespace haze {
 
@@ -100,20 +101,22 @@ class RbfMedium final : public Medium {
 
 class GridMedium final : public Medium {
  public:
+  // A grid's own values are copied; a view of the caller's memory is only viewed.
   GridMedium(const MediumDesc& desc, const GridDensity& grid)
-      : Medium(desc.sigma_t, desc.albedo, desc.phase), bounds_(desc.bounds), grid_(grid) {
+      : Medium(desc.sigma_t, desc.albedo, desc.phase), bounds_(desc.bounds), resolution_(grid.resolution), owned_(grid.values) {
+    values_ = grid.view.data() ? grid.view : std::span<const float>(owned_);
     if (!bounds_.bounded()) throw Error("medium.bounds", "unbounded", "bounds for a grid density");
-    size_t cells = static_cast<size_t>(grid.resolution[0]) * static_cast<size_t>(grid.resolution[1]) * static_cast<size_t>(grid.resolution[2]);
-    if (grid.values.size() != cells) throw Error("medium.density.values", to_text(grid.values.size()), to_text(cells) + " values");
-    max_ = grid.values.empty() ? 0.0 : static_cast<double>(*std::max_element(grid.values.begin(), grid.values.end()));
-    Vec3 cell = bounds_.extent() / Vec3(grid.resolution[0], grid.resolution[1], grid.resolution[2]);
+    const size_t cells = static_cast<size_t>(resolution_[0]) * static_cast<size_t>(resolution_[1]) * static_cast<size_t>(resolution_[2]);
+    if (values_.size() != cells) throw Error("medium.density.values", to_text(values_.size()) + " values", to_text(cells) + " values");
+    max_ = values_.empty() ? 0.0 : static_cast<double>(*std::max_element(values_.begin(), values_.end()));
+    Vec3 cell = bounds_.extent() / Vec3(resolution_[0], resolution_[1], resolution_[2]);
     feature_ = std::min({cell.x, cell.y, cell.z});
   }
   Aabb bounds() const override { return bounds_; }
   // Trilinear between cell centres, clamped to the outermost centres inside the bounds.
   double density(const Vec3& x) const override {
     if (!bounds_.contains(x)) return 0.0;
-    const auto& r = grid_.resolution;
+    const auto& r = resolution_;
     Vec3 u = (x - bounds_.lo) / bounds_.extent() * Vec3(r[0], r[1], r[2]) - 0.5;
     int i0[3], i1[3];
     double f[3];
@@ -124,7 +127,7 @@ class GridMedium final : public Medium {
       f[a] = c - i0[a];
     }
     auto at = [&](int x_, int y_, int z_) {
-      return static_cast<double>(grid_.values[(static_cast<size_t>(z_) * static_cast<size_t>(r[1]) + static_cast<size_t>(y_)) * static_cast<size_t>(r[0]) + static_cast<size_t>(x_)]);
+      return static_cast<double>(values_[(static_cast<size_t>(z_) * static_cast<size_t>(r[1]) + static_cast<size_t>(y_)) * static_cast<size_t>(r[0]) + static_cast<size_t>(x_)]);
     };
     double c00 = at(i0[0], i0[1], i0[2]) * (1 - f[0]) + at(i1[0], i0[1], i0[2]) * f[0];
     double c10 = at(i0[0], i1[1], i0[2]) * (1 - f[0]) + at(i1[0], i1[1], i0[2]) * f[0];
@@ -136,7 +139,7 @@ class GridMedium final : public Medium {
   }
   // The largest sample among the cells whose centres the region's trilinear lookups can touch.
   double max_density(const Aabb& region) const override {
-    const auto& r = grid_.resolution;
+    const auto& r = resolution_;
     int lo[3], hi[3];
     for (int a = 0; a < 3; ++a) {
       double scale = r[a] / bounds_.extent()[a];
@@ -149,14 +152,16 @@ class GridMedium final : public Medium {
     for (int z = lo[2]; z <= hi[2]; ++z)
       for (int y = lo[1]; y <= hi[1]; ++y)
         for (int x = lo[0]; x <= hi[0]; ++x)
-          bound = std::max(bound, grid_.values[(static_cast<size_t>(z) * static_cast<size_t>(r[1]) + static_cast<size_t>(y)) * static_cast<size_t>(r[0]) + static_cast<size_t>(x)]);
+          bound = std::max(bound, values_[(static_cast<size_t>(z) * static_cast<size_t>(r[1]) + static_cast<size_t>(y)) * static_cast<size_t>(r[0]) + static_cast<size_t>(x)]);
     return static_cast<double>(bound);
   }
   double feature_size() const override { return feature_; }
 
  private:
   Aabb bounds_;
-  GridDensity grid_;
+  std::array<int, 3> resolution_;
+  std::vector<float> owned_;
+  std::span<const float> values_;
   double max_ = 0.0, feature_ = 1.0;
 };
 
@@ -172,6 +177,56 @@ Aabb medium_bounds(const MediumDesc& desc) {
     box.hi = glm::max(box.hi, b.center + Vec3(6.0 / b.sharpness));
   }
   return box;
+}
+
+namespace {
+bool finite(const Vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+bool finite_non_negative(const Rgb& c) { return finite(c) && c.r >= 0.0 && c.g >= 0.0 && c.b >= 0.0; }
+std::string text(const Vec3& v) {
+  std::ostringstream out;
+  out << '[' << v.x << ", " << v.y << ", " << v.z << ']';
+  return out.str();
+}
+}  // namespace
+
+void check_medium(const MediumDesc& desc, const std::string& path) {
+  const Aabb& b = desc.bounds;
+  const bool unbounded = b.lo == Vec3(-kInfinity) && b.hi == Vec3(kInfinity);
+  if (!unbounded && !(finite(b.lo) && finite(b.hi) && b.lo.x < b.hi.x && b.lo.y < b.hi.y && b.lo.z < b.hi.z))
+    throw Error(path + ".bounds", text(b.lo) + " to " + text(b.hi), "a finite box with lo < hi on every axis, or unbounded");
+  if (!finite_non_negative(desc.sigma_t)) throw Error(path + ".sigma_t", text(desc.sigma_t), "finite values >= 0");
+  if (!(finite_non_negative(desc.albedo) && desc.albedo.r <= 1.0 && desc.albedo.g <= 1.0 && desc.albedo.b <= 1.0))
+    throw Error(path + ".albedo", text(desc.albedo), "values in [0, 1]");
+  if (const auto* c = std::get_if<ConstantDensity>(&desc.density)) {
+    if (!(std::isfinite(c->value) && c->value >= 0.0)) throw Error(path + ".density.value", to_text(c->value), "a finite density >= 0");
+  } else if (const auto* rbf = std::get_if<RbfDensity>(&desc.density)) {
+    if (rbf->blobs.empty()) throw Error(path + ".density.blobs", "[]", "at least one blob");
+    for (size_t i = 0; i < rbf->blobs.size(); ++i) {
+      const RbfBlob& blob = rbf->blobs[i];
+      const std::string at = path + ".density.blobs[" + std::to_string(i) + "]";
+      if (!finite(blob.center)) throw Error(at + ".center", text(blob.center), "a finite point");
+      if (!(std::isfinite(blob.weight) && blob.weight >= 0.0)) throw Error(at + ".weight", to_text(blob.weight), "a finite weight >= 0");
+      if (!(std::isfinite(blob.sharpness) && blob.sharpness > 0.0)) throw Error(at + ".sharpness", to_text(blob.sharpness), "a finite sharpness > 0");
+    }
+  } else {
+    const auto& grid = std::get<GridDensity>(desc.density);
+    if (unbounded) throw Error(path + ".bounds", "unbounded", "bounds for a grid density");
+    size_t cells = 1;
+    for (int a = 0; a < 3; ++a) {
+      if (grid.resolution[a] < 1)
+        throw Error(path + ".density.resolution[" + std::to_string(a) + "]", to_text(grid.resolution[a]), "at least 1 cell");
+      cells *= static_cast<size_t>(grid.resolution[a]);
+    }
+    const std::span<const float> samples = grid.samples();
+    const std::string field = path + ".density." + (grid.view.data() ? "view" : "values");
+    if (samples.size() != cells)
+      throw Error(field, to_text(samples.size()) + " values",
+                  to_text(cells) + " (resolution " + to_text(grid.resolution[0]) + " x " + to_text(grid.resolution[1]) + " x " +
+                      to_text(grid.resolution[2]) + ")");
+    for (size_t i = 0; i < samples.size(); ++i)
+      if (!(std::isfinite(samples[i]) && samples[i] >= 0.0f))
+        throw Error(field + "[" + std::to_string(i) + "]", to_text(samples[i]), "a finite density >= 0");
+  }
 }
 
 std::unique_ptr<Medium> make_medium(const MediumDesc& desc) {

@@ -124,6 +124,7 @@ UpdateReport Solution::update(const SceneChange& change, const RenderOptions& op
   Scene next = s.scene;
   if (change.medium) {
     if (s.particle_medium) throw Error("change.medium", "a medium for a particle scene", "a scene with a medium (particles change through their set)");
+    check_medium(*change.medium, "change.medium");
     next.medium = change.medium;
   }
   if (change.region && !change.medium) throw Error("change.region", "given without a medium", "the changed medium it bounds");
@@ -173,6 +174,7 @@ Rgb Solution::inscattered(const Vec3& x, const Vec3& w) const {
 Solution prepare(const Scene& scene, const std::string& method_name, RenderOptions options) {
   const std::string name = method_name.empty() ? scene.method_name() : method_name;
   if (name.empty()) throw Error("method.name", "missing", "a method named by the scene or the caller");
+  if (scene.medium) check_medium(*scene.medium);
   auto state = std::make_unique<Solution::State>();
   state->info = method_info(name);
   state->method = state->info.create();

@@ -42,7 +42,7 @@ ExtinctionVolume make_extinction_volume(const Scene& scene, int resolution, doub
     if (report) report->truncation_bound = injected.truncation_bound;
   } else if (const auto* grid = std::get_if<GridDensity>(&desc.density)) {
     volume.density = DenseGrid(grid->resolution, bounds);
-    volume.density.values() = grid->values;
+    volume.density.values().assign(grid->samples().begin(), grid->samples().end());
   } else {
     const auto& constant = std::get<ConstantDensity>(desc.density);
     if (!bounds.bounded()) throw Error("medium.bounds", "unbounded", "bounds for a constant density in the propagation method");

@@ -5,6 +5,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
+
 namespace haze {
 namespace {
 
@@ -101,6 +104,38 @@ TEST(Solution, ErrorsNameTheCallersLight) {
   } catch (const Error& e) {
     EXPECT_EQ(e.field(), "lights[3].type");
   }
+}
+
+// Memory handed over in code is checked (a wrong size or a bad value is a haze::Error naming it,
+// never a crash) and a view of it is not copied: a quadrature solution sees the caller's changes.
+TEST(Solution, CallerGridsAreCheckedAndViewed) {
+  Scene scene = lamp_fog();
+  scene.surfaces.clear();
+  auto message = [&](const GridDensity& grid) {
+    scene.medium->density = grid;
+    try {
+      prepare(scene, "quadrature", with(kSteps));
+    } catch (const Error& e) {
+      return e.field() + ": " + e.value() + "; expected " + e.expected();
+    }
+    return std::string("no error");
+  };
+  EXPECT_EQ(message({{8, 8, 8}, std::vector<float>(100, 1.0f)}), "medium.density.values: 100 values; expected 512 (resolution 8 x 8 x 8)");
+  std::vector<float> samples(4 * 4 * 4, 0.5f);
+  samples[17] = -1.0f;
+  EXPECT_EQ(message(GridDensity::viewing({4, 4, 4}, samples)), "medium.density.view[17]: -1; expected a finite density >= 0");
+  samples[17] = std::nanf("");
+  EXPECT_EQ(message(GridDensity::viewing({4, 4, 4}, samples)), "medium.density.view[17]: nan; expected a finite density >= 0");
+  EXPECT_EQ(message(GridDensity::viewing({4, 4, 0}, samples)), "medium.density.resolution[2]: 0; expected at least 1 cell");
+
+  samples[17] = 0.5f;
+  scene.medium->density = GridDensity::viewing({4, 4, 4}, samples);
+  const Solution viewed = prepare(scene, "quadrature", with(kSteps));
+  scene.medium->density = GridDensity{{4, 4, 4}, samples};
+  EXPECT_EQ(viewed.render().radiance.data(), render(scene, "quadrature", with(kSteps)).radiance.data());
+  std::fill(samples.begin(), samples.end(), 2.0f);  // the caller's simulation moves on
+  scene.medium->density = GridDensity{{4, 4, 4}, samples};
+  EXPECT_EQ(viewed.render().radiance.data(), render(scene, "quadrature", with(kSteps)).radiance.data());
 }
 
 }  // namespace

@@ -7,6 +7,8 @@
 
 #include <array>
 #include <memory>
+#include <span>
+#include <string>
 #include <variant>
 #include <vector>
 
@@ -27,9 +29,16 @@ struct RbfDensity {
 };
 
 // Cell-centred samples over the medium's bounds, x fastest, then y, then z; trilinear in between.
+// The samples are the grid's own (`values`) or a view of the caller's memory (`view`, used when
+// set): a view is never copied, so it must outlive every medium and solution made from it.
 struct GridDensity {
   std::array<int, 3> resolution{1, 1, 1};
   std::vector<float> values;
+  std::span<const float> view = {};
+
+  std::span<const float> samples() const { return view.data() ? view : std::span<const float>(values); }
+  // A grid over the caller's nx * ny * nz floats (checked when a medium or solution is made).
+  static GridDensity viewing(const std::array<int, 3>& resolution, std::span<const float> samples) { return {resolution, {}, samples}; }
 };
 
 using Density = std::variant<ConstantDensity, RbfDensity, GridDensity>;
@@ -78,7 +87,14 @@ class Medium {
   PhaseFunction phase_;
 };
 
-// The medium a scene describes (constant, RBF or grid density in core's direct form).
+// Checks what a caller built in code as Scene::from_json checks a file: bounds, coefficients,
+// phase, and the density (a grid's sample count against its resolution, every sample finite and
+// >= 0; RBF blobs finite with weight >= 0 and sharpness > 0). Throws haze::Error naming
+// `path`.<field>, the value and what was expected.
+void check_medium(const MediumDesc& desc, const std::string& path = "medium");
+
+// The medium a scene describes (constant, RBF or grid density in core's direct form). haze::prepare
+// checks it first (check_medium); here only a grid's sample count is.
 std::unique_ptr<Medium> make_medium(const MediumDesc& desc);
 
 // make_medium(desc)->bounds() without building the medium: desc.bounds, or for an RBF density
