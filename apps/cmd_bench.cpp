@@ -4,10 +4,10 @@
 #include "progress_bar.h"
 
 #include <haze/core/error.h>
+#include <haze/core/stopwatch.h>
 
 #include <algorithm>
 #include <cmath>
-#include <chrono>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
@@ -70,9 +70,9 @@ std::string compact(const nlohmann::json& settings) {
 
 // One render and its wall time.
 RenderResult timed_once(const Scene& scene, const std::string& method, const RenderOptions& options, double& seconds) {
-  const auto start = std::chrono::steady_clock::now();
+  Stopwatch start;
   RenderResult result = render(scene, method, options);
-  seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  seconds = start.seconds();
   return result;
 }
 

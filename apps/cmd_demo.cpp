@@ -4,9 +4,9 @@
 #include "progress_bar.h"
 
 #include <haze/core/error.h>
+#include <haze/core/stopwatch.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cstdio>
 #include <iostream>
 
@@ -53,9 +53,9 @@ int run(const DemoArgs& a) {
       ProgressBar bar(stem + " " + method.name);
       options.progress = bar.callback();
       try {
-        auto start = std::chrono::steady_clock::now();
+        Stopwatch start;
         RenderResult result = render(scene, method.name, options);
-        double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        double seconds = start.seconds();
         auto exr = std::filesystem::path(a.out) / (stem + "_" + method.name + ".exr");
         save_result(result, method.name, seconds, exr, true);
         ++rendered;

@@ -7,8 +7,9 @@
 namespace haze::app {
 
 std::string methods_help() {
-  std::string out = "Methods and their settings (--set key=value; particle scenes also take particle_resolution, default 96,\n"
-                    "the grid the particles' density is sampled on for methods other than network):\n";
+  std::string out =
+      "Methods and their settings (--set key=value; particle scenes also take particle_resolution, default 96,\n"
+      "the grid the particles' density is sampled on for methods other than network):\n";
   for (const MethodInfo& m : registered_methods()) out += m.name + ": " + m.summary + "\n" + settings_help(m);
   return out;
 }
@@ -29,9 +30,8 @@ Command add_methods(CLI::App& app) {
                 continue;
               }
               const MethodHandles& h = m.handles;
-              std::cout << m.name << ": " << m.summary << "\n  media: " << h.media << "\n  lights: " << h.lights
-                        << "\n  surfaces: " << h.surfaces << "\n  scattering: " << (h.multiple_scattering ? "multiple" : "single")
-                        << "\n  settings:\n"
+              std::cout << m.name << ": " << m.summary << "\n  media: " << h.media << "\n  lights: " << h.lights << "\n  surfaces: " << h.surfaces
+                        << "\n  scattering: " << (h.multiple_scattering ? "multiple" : "single") << "\n  settings:\n"
                         << settings_help(m);
             }
             if (!found) create_method(*name);  // the error lists the available methods

@@ -4,9 +4,9 @@
 #include "commands.h"
 
 #include <haze/core/airlight.h>
+#include <haze/core/stopwatch.h>
 #include <haze/core/error.h>
 
-#include <chrono>
 #include <cstdio>
 #include <set>
 
@@ -21,10 +21,6 @@ struct TablesArgs {
   int threads = 0;
 };
 
-double seconds_since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
-
 int run(const TablesArgs& a) {
   std::filesystem::path out = a.out.empty() ? default_cache_dir() : std::filesystem::path(a.out);
   std::vector<std::filesystem::path> scenes(a.scenes.begin(), a.scenes.end());
@@ -33,18 +29,18 @@ int run(const TablesArgs& a) {
       if (entry.path().extension() == ".json") scenes.push_back(entry.path());
   std::sort(scenes.begin(), scenes.end());
 
-  auto total_start = std::chrono::steady_clock::now();
+  Stopwatch total_start;
   std::set<std::string> done;
   std::printf("%-16s %-44s %10s %9s\n", "table", "for", "size", "seconds");
   for (const auto& path : scenes) {
     Scene scene = Scene::load(path);
     if (!scene.medium || !std::holds_alternative<ConstantDensity>(scene.medium->density)) continue;
     const PhaseFunction& phase = scene.medium->phase;
-    auto start = std::chrono::steady_clock::now();
+    Stopwatch start;
     bool hit = false;
     AirlightTable airlight = AirlightTable::cached(phase, out, 256, 512, a.threads, &hit);
     if (done.insert(airlight.key()).second)
-      std::printf("%-16s %-44s %10s %9.3f%s\n", "airlight", phase.key().c_str(), "256x512", seconds_since(start),
+      std::printf("%-16s %-44s %10s %9.3f%s\n", "airlight", phase.key().c_str(), "256x512", start.seconds(),
                   hit ? " (cached)" : "");
     std::set<double> exponents;
     for (const auto& s : scene.surfaces) {
@@ -52,15 +48,15 @@ int run(const TablesArgs& a) {
       if (s.ks != Rgb(0.0)) exponents.insert(s.shininess);
     }
     for (double n : exponents) {
-      start = std::chrono::steady_clock::now();
+      start.restart();
       SurfaceAirlightTable j = SurfaceAirlightTable::cached(airlight, n, out, 64, 64, a.threads, &hit);
       char label[32];
       std::snprintf(label, sizeof label, n == 0.0 ? "surface J1" : "surface J%g", n);
       if (done.insert(airlight.key() + label).second)
-        std::printf("%-16s %-44s %10s %9.3f%s\n", label, phase.key().c_str(), "64x64", seconds_since(start), hit ? " (cached)" : "");
+        std::printf("%-16s %-44s %10s %9.3f%s\n", label, phase.key().c_str(), "64x64", start.seconds(), hit ? " (cached)" : "");
     }
   }
-  std::printf("%zu tables in %s, %.3f s in all\n", done.size(), out.string().c_str(), seconds_since(total_start));
+  std::printf("%zu tables in %s, %.3f s in all\n", done.size(), out.string().c_str(), total_start.seconds());
   return 0;
 }
 

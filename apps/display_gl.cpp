@@ -2,6 +2,7 @@
 #include "commands.h"
 
 #include <haze/core/error.h>
+#include <haze/core/stopwatch.h>
 
 #ifdef HAZE_WITH_GL
 #include <haze/gl/context.h>
@@ -9,7 +10,6 @@
 #include <haze/grids/dom.h>
 #include <haze/grids/propagation.h>
 
-#include <chrono>
 #endif
 
 namespace haze::app {
@@ -22,29 +22,29 @@ RenderResult render_gl(const Scene& scene, const std::string& method, const Rend
   gl::DisplaySettings settings;
   nlohmann::json stats;
   std::optional<gl::VolumeDisplay> display;
-  auto start = std::chrono::steady_clock::now();
+  Stopwatch start;
   if (method == "propagation") {
     grids::PropagationFields fields = grids::propagation_fields(scene, options);
     settings.step_cells = fields.march.step_cells;
-    start = std::chrono::steady_clock::now();
+    start.restart();
     display.emplace(scene, fields.volume, fields.depths, settings);
     stats = std::move(fields.stats);
   } else {
     grids::DomFields fields = grids::dom_fields(scene, options);
     settings.step_cells = fields.step_cells;
-    start = std::chrono::steady_clock::now();
+    start.restart();
     display.emplace(scene, fields.volume, fields.delta_depths, settings);
     display->show_dom(fields.solution);
     stats = std::move(fields.stats);
   }
-  const double upload_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  start = std::chrono::steady_clock::now();
+  const double upload_seconds = start.seconds();
+  start.restart();
   RenderResult result{display->render(scene.camera), std::nullopt, std::move(stats)};
   result.stats["gl"] = {{"backend", context.info().backend},
                         {"renderer", context.info().renderer},
                         {"version", context.info().version},
                         {"upload_seconds", upload_seconds},
-                        {"display_seconds", std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()}};
+                        {"display_seconds", start.seconds()}};
   return result;
 }
 #else

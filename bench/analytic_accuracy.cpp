@@ -3,10 +3,10 @@
 // .); scripts/plot-analytic turns the CSV into docs/analytic_error.png.
 // Run: build/release/bench/haze_analytic_accuracy OUT_DIR
 #include <haze/core/airlight.h>
+#include <haze/core/stopwatch.h>
 #include <haze/core/rng.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -35,10 +35,6 @@ Errors measure(const PhaseFunction& phase, const AirlightTable& table, int n, st
   return {errors.back(), errors[errors.size() / 2], std::sqrt(sum2 / static_cast<double>(errors.size()))};
 }
 
-double seconds_since(std::chrono::steady_clock::time_point t) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -52,9 +48,9 @@ int main(int argc, char** argv) {
   for (auto [na, ne] : std::vector<std::pair<int, int>>{{64, 128}, {128, 256}, {256, 512}, {512, 1024}}) {
     for (double g : {0.0, 0.5, 0.95}) {
       PhaseFunction phase = PhaseFunction::henyey_greenstein(g);
-      auto start = std::chrono::steady_clock::now();
+      Stopwatch start;
       AirlightTable table(phase, na, ne);
-      double build = seconds_since(start);
+      double build = start.seconds();
       Errors e = measure(phase, table, samples, 11);
       res << na << "," << ne << "," << g << "," << build << "," << e.worst << "," << e.median << "," << e.rms << "\n";
       std::printf("| %d x %d | %.2f | %.2f | %.1e | %.1e | %.1e |\n", na, ne, g, build, e.worst, e.median, e.rms);
@@ -64,9 +60,9 @@ int main(int argc, char** argv) {
   std::ofstream leg(out / "analytic_legendre.csv");
   leg << "g,terms,bound,worst,median,rms\n";
   std::printf("\n| g | Legendre orders | bound | worst | median | RMS |\n|---|---|---|---|---|---|\n");
-  auto start = std::chrono::steady_clock::now();
+  Stopwatch start;
   LegendreAirlightTables legendre(48, 256, 512);
-  std::printf("(48 Legendre tables of 256 x 512 built in %.2f s)\n", seconds_since(start));
+  std::printf("(48 Legendre tables of 256 x 512 built in %.2f s)\n", start.seconds());
   for (double g : {0.3, 0.5, 0.7}) {
     PhaseFunction phase = PhaseFunction::henyey_greenstein(g);
     for (int terms : {3, 6, 9, 12, 18, 24, 32, 40, 48}) {

@@ -6,13 +6,13 @@
 // Not a Google Benchmark: it measures error, and the time each setting costs on this machine.
 // Run: build/release/bench/haze_dom_accuracy build/dom
 #include <haze/core/method.h>
+#include <haze/core/stopwatch.h>
 #include <haze/grids/dom.h>
 #include <haze/grids/methods.h>
 #include <haze/grids/optical_depth.h>
 
 #include "cloud_scene.h"  // tests/grids: the scene the dom tests measure
 
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -23,10 +23,6 @@ using namespace haze;
 using namespace haze::grids;
 
 namespace {
-
-double seconds_since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
 
 // The reference test's slab as a 9 x 9 x nz grid, 400 wide (the centre column sees no edge).
 Scene slab_scene(int nz) {
@@ -47,13 +43,13 @@ Scene slab_scene(int nz) {
 void slab(std::FILE* csv, int directions, int terms, int nz, bool delta_m = true) {
   const double mus[3] = {1.0, 0.5, 0.1}, published[3] = {0.0395460, 0.101103, 0.151159};
   Scene scene = slab_scene(nz);
-  auto start = std::chrono::steady_clock::now();
+  Stopwatch start;
   const ExtinctionVolume volume = make_extinction_volume(scene);
   const std::vector<DenseGrid> depths{optical_depth(volume.density, scene.lights[0], {DepthScheme::exact})};
   DomSettings settings;
   settings.directions = directions, settings.terms = terms, settings.tolerance = 1e-5, settings.delta_m = delta_m;
   const DomSolution solution = solve_dom(volume, scene.lights, depths, settings);
-  const double solve = seconds_since(start);
+  const double solve = start.seconds();
   double error[3];
   for (int i = 0; i < 3; ++i) {
     const Vec3 emergent(std::sqrt(1 - mus[i] * mus[i]), 0.0, mus[i]), top(0.0, 0.0, 1.0);
@@ -72,9 +68,9 @@ void cloud(std::FILE* csv, const Scene& scene, const RenderResult& reference, co
            double tolerance, const char* storage = "float32") {
   RenderOptions options;
   options.settings = {{"resolution", resolution}, {"directions", directions}, {"terms", terms}, {"tolerance", tolerance}, {"storage", storage}};
-  auto start = std::chrono::steady_clock::now();
+  Stopwatch start;
   const RenderResult dom = render(scene, "dom", options);
-  const double seconds = seconds_since(start);
+  const double seconds = start.seconds();
   const LitPixelError e = lit_pixel_error(dom.radiance, reference.radiance, &*reference.std_error);
   std::printf("| %s | %d | %d | %d | %g | %.2f%% | %.2f%% | %+.2f%% | %.2f | %d |\n", varied, resolution, directions,
               dom.stats["terms"].get<int>(), tolerance, 100 * e.mean_abs, 100 * e.rms_noise_removed, 100 * e.signed_mean, seconds,
@@ -105,7 +101,7 @@ int main(int argc, char** argv) {
   const Scene scene = lit_cloud(true, 24, 18);  // the dom tests' RBF cloud, a point light and a sun
   RenderOptions reference_options;
   reference_options.settings = {{"spp", 65536}, {"seed", 11}};
-  auto start = std::chrono::steady_clock::now();
+  Stopwatch start;
   const RenderResult reference = render(scene, "reference", reference_options);
   double noise = 0.0, peak = 0.0;
   int count = 0;
@@ -119,7 +115,7 @@ int main(int argc, char** argv) {
   std::printf("\nRBF cloud, 24 x 18 pixels, against the reference path tracer at 65536 spp (%.0f s; its mean relative standard\n"
               "error over the %d lit pixels is %.2f%%). Error columns: mean |relative error|, the rms with the reference's\n"
               "variance subtracted, the signed mean. Seconds: the whole render on 2 threads (3 channels).\n\n",
-              seconds_since(start), count, 100 * noise / count);
+              start.seconds(), count, 100 * noise / count);
   std::printf("| varied | cells | D | N | tolerance | mean abs | rms, noise removed | signed | seconds | sweeps |\n"
               "|---|---|---|---|---|---|---|---|---|---|\n");
   std::fprintf(cloud_csv, "varied,resolution,directions,terms,tolerance,mean_abs,rms_corrected,signed,seconds,sweeps\n");

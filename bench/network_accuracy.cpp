@@ -7,10 +7,10 @@
 // Not a Google Benchmark: it measures error, and the time each setting costs on this machine.
 // Run: build/release/bench/haze_network_accuracy build/network
 #include <haze/core/method.h>
+#include <haze/core/stopwatch.h>
 #include <haze/core/rng.h>
 #include <haze/particles/methods.h>
 
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -20,10 +20,6 @@ using namespace haze;
 
 namespace {
 
-double seconds_since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
-
 struct Reference {
   RenderResult result;
   double seconds = 0.0;
@@ -32,9 +28,9 @@ struct Reference {
 Reference reference(const Scene& scene, long long spp, int max_scattering = -1) {
   RenderOptions options;
   options.settings = {{"spp", spp}, {"seed", 7}, {"max_scattering", max_scattering}};
-  const auto start = std::chrono::steady_clock::now();
+  Stopwatch start;
   Reference r{render(scene, "reference", options)};
-  r.seconds = seconds_since(start);
+  r.seconds = start.seconds();
   return r;
 }
 
@@ -42,9 +38,9 @@ void row(std::FILE* csv, const char* scene_name, const Scene& scene, const Refer
          int iterations, int terms = 0) {
   RenderOptions options;
   options.settings = {{"directions", directions}, {"iterations", iterations}, {"terms", terms}};
-  const auto start = std::chrono::steady_clock::now();
+  Stopwatch start;
   const RenderResult network = render(scene, "network", options);
-  const double seconds = seconds_since(start);
+  const double seconds = start.seconds();
   const LitPixelError e = lit_pixel_error(network.radiance, ref.result.radiance, &*ref.result.std_error);
   const auto particles = network.stats["particles"].get<long long>();
   std::printf("| %s | %s | %lld | %d | %d | %s | %.1f%% | %.1f%% | %+.1f%% | %.1f%% | %.3f |\n", scene_name, varied, particles, directions,

@@ -4,10 +4,10 @@
 // homogeneous and a heterogeneous 64^3 medium, lights inside and outside and directional.
 // Not a Google Benchmark: it measures error, not speed. Run: build/release/bench/haze_propagation_accuracy
 #include <haze/grids/optical_depth.h>
+#include <haze/core/stopwatch.h>
 #include <haze/grids/rbf.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 
@@ -36,9 +36,9 @@ struct Row {
 };
 
 Row measure(const DenseGrid& density, const Light& light, const DepthOptions& options, const DenseGrid& exact) {
-  auto start = std::chrono::steady_clock::now();
+  Stopwatch start;
   DenseGrid approx = optical_depth(density, light, options);
-  double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  double seconds = start.seconds();
   std::vector<double> rel;
   double sum_abs = 0.0, sum = 0.0;
   for (size_t c = 0; c < exact.values().size(); ++c) {
@@ -68,9 +68,9 @@ int main() {
   for (bool heterogeneous : {false, true}) {
     const DenseGrid density = medium(n, heterogeneous);
     for (const auto& [light_name, light] : lights) {
-      auto start = std::chrono::steady_clock::now();
+      Stopwatch start;
       const DenseGrid exact = optical_depth(density, light, {DepthScheme::exact});
-      double exact_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      double exact_seconds = start.seconds();
       struct Config {
         const char* label;
         DepthOptions options;

@@ -12,7 +12,8 @@ if(HAZE_SANITIZE)
 endif()
 
 # haze_module(NAME folder-target SOURCES ... DEPS ...): one static library per top-level folder,
-# public headers in <folder>/include, exported as haze::<name>.
+# public headers in <folder>/include, exported as haze::<name> in an export set of its own (the
+# package's component <name>: find_package(haze COMPONENTS core) loads only what core needs).
 function(haze_module name)
   cmake_parse_arguments(ARG "" "" "SOURCES;PUBLIC_DEPS;PRIVATE_DEPS" ${ARGN})
   add_library(haze_${name} STATIC ${ARG_SOURCES})
@@ -23,7 +24,8 @@ function(haze_module name)
     $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}>
     PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/src)
   target_link_libraries(haze_${name} PUBLIC ${ARG_PUBLIC_DEPS} PRIVATE ${ARG_PRIVATE_DEPS} $<BUILD_INTERFACE:haze_warnings>)
-  install(TARGETS haze_${name} EXPORT hazeTargets
+  install(TARGETS haze_${name} EXPORT haze_${name}Targets
     ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR})
+  set_property(GLOBAL APPEND PROPERTY HAZE_COMPONENTS ${name})
   install(DIRECTORY include/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
 endfunction()

@@ -11,7 +11,6 @@
 #include <haze/core/stopwatch.h>
 
 #include <algorithm>
-#include <chrono>
 
 namespace haze::internal {
 

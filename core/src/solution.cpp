@@ -15,10 +15,10 @@ namespace haze {
 struct Solution::State {
   MethodInfo info;
   std::unique_ptr<Method> method;
-  Scene scene;                  // the caller's, with every update applied
-  RenderOptions options;        // as prepared: settings merged, no progress
+  Scene scene;                                // the caller's, with every update applied
+  RenderOptions options;                      // as prepared: settings merged, no progress
   std::optional<MediumDesc> particle_medium;  // the particles' medium, for a method that does not read them
-  std::vector<size_t> kept;     // the method's light k is scene.lights[kept[k]]
+  std::vector<size_t> kept;                   // the method's light k is scene.lights[kept[k]]
   nlohmann::json culled = nlohmann::json::array();
   std::unique_ptr<MethodSolution> solution;
 
@@ -40,8 +40,10 @@ struct Solution::State {
     culled = nlohmann::json::array();
     for (size_t i = 0, c = 0; i < scene.lights.size(); ++i) {
       // A scene whose lights all reach nothing renders as it is.
-      if (c < found.size() && found[c].index == i && found.size() < scene.lights.size()) culled.push_back({{"index", i}, {"why", found[c++].why}});
-      else kept_now.push_back(i);
+      if (c < found.size() && found[c].index == i && found.size() < scene.lights.size())
+        culled.push_back({{"index", i}, {"why", found[c++].why}});
+      else
+        kept_now.push_back(i);
     }
     const bool changed = kept_now != kept;
     kept = std::move(kept_now);
@@ -85,8 +87,7 @@ struct Solution::State {
     }
   }
   size_t method_light(size_t light) const {
-    if (light >= scene.lights.size())
-      throw Error("light", to_text(light), "an index into the scene's " + to_text(scene.lights.size()) + " lights");
+    if (light >= scene.lights.size()) throw Error("light", to_text(light), "an index into the scene's " + to_text(scene.lights.size()) + " lights");
     const auto it = std::find(kept.begin(), kept.end(), light);
     if (it == kept.end()) throw Error("light", to_text(light), "a light the solution kept (lights[" + to_text(light) + "] reaches nothing: culled)");
     return static_cast<size_t>(it - kept.begin());
@@ -123,7 +124,8 @@ UpdateReport Solution::update(const SceneChange& change, const RenderOptions& op
   const Stopwatch watch;
   Scene next = s.scene;
   if (change.medium) {
-    if (s.particle_medium) throw Error("change.medium", "a medium for a particle scene", "a scene with a medium (particles change through their set)");
+    if (s.particle_medium)
+      throw Error("change.medium", "a medium for a particle scene", "a scene with a medium (particles change through their set)");
     check_medium(*change.medium, "change.medium");
     next.medium = change.medium;
   }
@@ -143,8 +145,10 @@ UpdateReport Solution::update(const SceneChange& change, const RenderOptions& op
     std::optional<UpdateReport> done = s.naming_lights([&] { return s.solution->update(s.method_scene(), method_change, o); });
     if (done) {
       report = std::move(*done);
-      if (!s.culled.empty()) s.solution->stats["culled_lights"] = s.culled;
-      else s.solution->stats.erase("culled_lights");
+      if (!s.culled.empty())
+        s.solution->stats["culled_lights"] = s.culled;
+      else
+        s.solution->stats.erase("culled_lights");
     } else {
       s.prepare(options.progress);
       report.rebuilt = true;
@@ -181,7 +185,8 @@ Solution prepare(const Scene& scene, const std::string& method_name, RenderOptio
   state->scene = scene;
   nlohmann::json settings = nlohmann::json::object();
   if (scene.method_name() == name) settings = scene.method;
-  if (!options.settings.is_null() && !options.settings.is_object()) throw Error("settings", options.settings.dump(), "an object of " + name + " settings");
+  if (!options.settings.is_null() && !options.settings.is_object())
+    throw Error("settings", options.settings.dump(), "an object of " + name + " settings");
   for (const auto& [key, value] : options.settings.items()) settings[key] = value;
   settings.erase("name");
   if (!scene.particles.is_null() && !state->info.reads_particles) {

@@ -2,6 +2,7 @@
 // transport (step characteristics), source iteration or GMRES on the moments, and the paper's
 // one-cell-per-iteration scheme.
 #include <haze/grids/dom.h>
+#include <haze/core/stopwatch.h>
 
 #include <haze/core/error.h>
 #include <haze/simd/phase_batch.h>
@@ -9,7 +10,6 @@
 #include "dom_internal.h"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <fstream>
 #include <iterator>
@@ -278,7 +278,7 @@ DomSolution solve_dom(const ExtinctionVolume& volume, const std::vector<Light>& 
 
   bool grey = is_grey(volume.sigma_t_scale) && is_grey(volume.albedo);
   for (const Light& l : lights) grey = grey && is_grey(l);
-  const auto start = std::chrono::steady_clock::now();
+  Stopwatch start;
   DomSolution out;
   out.channels = grey ? 1 : 3;
   out.resolution = volume.density.resolution();
@@ -349,7 +349,7 @@ DomSolution solve_dom(const ExtinctionVolume& volume, const std::vector<Light>& 
   out.converged = !out.changes.empty() && out.changes.back() < settings.tolerance;
   out.sweep_seconds = transport.seconds();
   out.skipped_fraction = transport.skipped_fraction();
-  out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  out.seconds = start.seconds();
   return out;
 }
 

@@ -3,10 +3,10 @@
 #include "dom_internal.h"
 
 #include <haze/core/error.h>
+#include <haze/core/stopwatch.h>
 #include <haze/simd/phase_batch.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 
 namespace haze::grids::dom {
@@ -81,7 +81,7 @@ Transport::Transport(const DenseGrid& density, const DirectionSet& directions, c
 
 void Transport::sweep(const Channel& ch, const FirstCollision* first, const float* m_in, float boundary, float* m_out, int threads) const {
   const auto nx = n_[0], ny = n_[1], nz = n_[2];
-  const auto start = std::chrono::steady_clock::now();
+  Stopwatch start;
   const size_t size = cells_ * static_cast<size_t>(n_terms_);
   scratch_.resize(size);
   const auto row_kernel = scalar_kernel_ ? simd::dom_sweep_row_reference : simd::dom_sweep_row;
@@ -141,7 +141,7 @@ void Transport::sweep(const Channel& ch, const FirstCollision* first, const floa
   for (size_t i = 0; i < size; ++i) m_out[i] += scratch_[i];
   cells_skipped_ += skipped[0] + skipped[1];
   cells_visited_ += 8 * static_cast<long long>(cells_);
-  seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  seconds_ += start.seconds();
 }
 
 FirstCollision Transport::first_collision(const ExtinctionVolume& volume, const std::vector<Light>& lights,
@@ -222,7 +222,7 @@ std::vector<float> Transport::paper(const Channel& ch, const FirstCollision& fir
     });
   }
   const size_t sx = 1, sy = static_cast<size_t>(nx), sz = static_cast<size_t>(nx) * static_cast<size_t>(ny);
-  const auto start = std::chrono::steady_clock::now();
+  Stopwatch start;
   for (int it = 0; it < settings.max_iterations; ++it) {
     // In-scattering, seed 000 eq. 6 (full matrix) or eq. 9 (separable), as two products per block.
     parallel_for(static_cast<long long>(cells_), settings.threads, 4096, [&](long long c0, long long c1) {
@@ -268,7 +268,7 @@ std::vector<float> Transport::paper(const Channel& ch, const FirstCollision& fir
     if (settings.progress && !settings.progress(std::min(1.0, (it + 1.0) / settings.max_iterations))) throw Cancelled();
     if (changes.back() < settings.tolerance) break;
   }
-  seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  seconds_ += start.seconds();
   return moments;
 }
 

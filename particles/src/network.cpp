@@ -1,6 +1,7 @@
 // Visibility network, direct light and the illumination-network iteration (seed 001 sections
 // 3.1-3.3; network.h says what Haze does past the paper).
 #include <haze/core/error.h>
+#include <haze/core/stopwatch.h>
 #include <haze/particles/network.h>
 #include <haze/simd/phase_batch.h>
 
@@ -9,7 +10,6 @@
 #include <Eigen/Core>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <numeric>
 
@@ -206,16 +206,16 @@ NetworkSolution solve_network(const ParticleField& field, const std::vector<Ligh
   if (!(settings.tolerance > 0.0)) throw Error("tolerance", to_text(settings.tolerance), "a relative change > 0");
   const MaterialDesc& material = field.particles().material;
   NetworkSolution out;
-  auto start = std::chrono::steady_clock::now();
+  Stopwatch start;
   out.directions = std::make_shared<DirectionSet>(DirectionSet::fibonacci(settings.directions));
   out.matrix = std::make_shared<PhaseMatrix>(material.phase, *out.directions);
   const auto n = field.size(), d = static_cast<size_t>(out.directions->size());
   out.rho = field.density_at_particles(settings.threads);
   out.visibility = build_visibility(field, out.rho, *out.directions, network_window(field, settings.window ? settings.window : default_window(field)),
                                     settings.threads);
-  out.build_seconds = seconds_since(start);
+  out.build_seconds = start.seconds();
 
-  start = std::chrono::steady_clock::now();
+  start.restart();
   const std::vector<const Light*> delta = delta_lights(lights, out.sky);
   for (const Light* l : delta) out.light_maps.emplace_back(field, *l, settings.threads);
   out.channels = grey_scene(material, out.sky, delta) ? 1 : 3;
@@ -223,10 +223,10 @@ NetworkSolution solve_network(const ParticleField& field, const std::vector<Ligh
   std::vector<int> all(n);
   std::iota(all.begin(), all.end(), 0);
   direct_light(out, field, delta, all, settings.threads);
-  out.direct_seconds = seconds_since(start);
+  out.direct_seconds = start.seconds();
 
   // The iteration's state: the in-scattering product, each gap's transmittance, a warm start.
-  start = std::chrono::steady_clock::now();
+  start.restart();
   out.albedo = material.albedo;
   const int keep = settings.terms > 0 ? std::min(settings.terms, static_cast<int>(d)) : [&] {
     const Eigen::VectorXd eigenvalues = SeparablePhase(*out.matrix, 1).all_eigenvalues();
@@ -247,7 +247,7 @@ NetworkSolution solve_network(const ParticleField& field, const std::vector<Ligh
   for (size_t c = 0; c < static_cast<size_t>(out.channels); ++c)
     out.incoming[c] = warm_fits && !warm->incoming[c].empty() ? warm->incoming[c] : std::vector<float>(n * d, 0.0f);
   iterate(out, settings);
-  out.iterate_seconds = seconds_since(start);
+  out.iterate_seconds = start.seconds();
   remember(out, field, delta);
   return out;
 }

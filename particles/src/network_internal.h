@@ -5,7 +5,6 @@
 #include <haze/particles/network.h>
 
 #include <array>
-#include <chrono>
 #include <cmath>
 #include <utility>
 #include <vector>
@@ -13,10 +12,6 @@
 namespace haze::particles::network_internal {
 
 constexpr double kCut = 3.0;  // as field.h: each Gaussian ends at 3 h
-
-inline double seconds_since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
 
 // Direction w's view of the window: a particle's pixel (its column) and its depth along w.
 struct Projector {

@@ -6,7 +6,6 @@
 #include "erf_table.h"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 
 namespace haze::particles {

@@ -1,5 +1,6 @@
 // The networks of moved particles, updated where the particles changed (network.h, update_network).
 #include <haze/core/error.h>
+#include <haze/core/stopwatch.h>
 #include <haze/particles/network.h>
 
 #include "network_internal.h"
@@ -27,7 +28,7 @@ NetworkSolution update_network(NetworkSolution s, const ParticleField& field, co
   if (material.sigma_t != s.sigma_t || material.albedo != s.albedo) return rebuild("the extinction or the albedo changed");
   if ((grey_scene(material, sky, delta) ? 1 : 3) != s.channels) return rebuild("the lights' colours changed the channel count");
 
-  auto start = std::chrono::steady_clock::now();
+  Stopwatch start;
   NetworkSolution::Update& u = s.update;
   u = {};
   std::vector<int> changed;
@@ -138,11 +139,11 @@ NetworkSolution update_network(NetworkSolution s, const ParticleField& field, co
   size_t dirty_total = 0;
   for (const size_t c : dirty_columns) dirty_total += c;
   u.columns = d && pixels ? static_cast<double>(dirty_total) / static_cast<double>(d * pixels) : 0.0;
-  s.build_seconds = seconds_since(start);
+  s.build_seconds = start.seconds();
 
   // Depth maps: the old Gaussians out, the new ones in; a light that moved gets a new map. Then
   // the direct light of every particle that reads a changed texel.
-  start = std::chrono::steady_clock::now();
+  start.restart();
   bool all_direct = delta.size() != s.light_maps.size();
   if (all_direct) {
     s.light_maps.clear();
@@ -173,11 +174,11 @@ NetworkSolution update_network(NetworkSolution s, const ParticleField& field, co
   direct_light(s, field, delta, relight, settings.threads);
   u.direct = relight.size();
   s.sky = sky;
-  s.direct_seconds = seconds_since(start);
+  s.direct_seconds = start.seconds();
 
-  start = std::chrono::steady_clock::now();
+  start.restart();
   iterate(s, settings);
-  s.iterate_seconds = seconds_since(start);
+  s.iterate_seconds = start.seconds();
   remember(s, field, delta);
   return s;
 }

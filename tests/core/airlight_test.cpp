@@ -1,13 +1,13 @@
 // The angle-formulated airlight (seed 002 sec. 4.2.1): the quadrature yardstick against closed
 // forms and the adaptive integrator against known integrals.
 #include <haze/core/airlight.h>
+#include <haze/core/stopwatch.h>
 #include <haze/core/error.h>
 #include <haze/core/integrate.h>
 #include <haze/core/rng.h>
 
 #include <gtest/gtest.h>
 
-#include <chrono>
 #include <filesystem>
 #include <unistd.h>
 
@@ -78,9 +78,9 @@ TEST(Airlight, TableMatchesQuadratureOverRandomSweep) {
   int total = 0;
   for (double g : {-0.95, -0.5, 0.0, 0.5, 0.8, 0.95}) {
     PhaseFunction phase = PhaseFunction::henyey_greenstein(g);
-    auto start = std::chrono::steady_clock::now();
+    Stopwatch start;
     AirlightTable table(phase);
-    double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    double seconds = start.seconds();
     SweepStats stats = sweep(phase, table, 1700, static_cast<std::uint64_t>(1000 * (g + 1)));
     total += stats.count;
     std::printf("HG g %+.2f: table %.2f s; %d configurations, worst relative error %.2e (d_sv %.3g gamma %.9g d_vp %.3g sigma_t %.3g)\n",
@@ -165,16 +165,16 @@ TEST(Airlight, SurfaceTablesMatchBruteForce) {
 // Dynamic g: Legendre tables built once, recombined for each g, against the exact HG airlight.
 // With terms_for's bound the measured error stays below the tolerance plus the table's own error.
 TEST(Airlight, LegendreTablesFollowGWithinTheTruncationBound) {
-  auto start = std::chrono::steady_clock::now();
+  Stopwatch start;
   LegendreAirlightTables legendre(32, 128, 512);
-  double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  double seconds = start.seconds();
   for (double g : {-0.3, 0.2, 0.5}) {
     const double tolerance = 1e-2;
     int terms = LegendreAirlightTables::terms_for(g, tolerance, 32);
     ASSERT_LT(terms, 32) << g;
-    start = std::chrono::steady_clock::now();
+    start.restart();
     AirlightTable table = legendre.combine_hg(g, terms);
-    double combine_ms = 1e3 * std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    double combine_ms = 1e3 * start.seconds();
     SweepStats stats = sweep(PhaseFunction::henyey_greenstein(g), table, 400, 7);
     std::printf("Legendre (32 orders of 128 x 512, built in %.2f s): g %+.1f, tolerance %.0e -> %d terms (bound %.1e), "
                 "combined in %.1f ms, worst relative error %.2e\n",

@@ -21,8 +21,8 @@ TEST(Docs, MethodsMdHoldsEveryMethodsSettingsTable) {
   doc << in.rdbuf();
   for (const MethodInfo& m : registered_methods()) {
     if (m.name == "toy") continue;  // tests/toy's
-    EXPECT_NE(doc.str().find(settings_markdown(m)), std::string::npos)
-        << m.name << ": regenerate with `haze methods " << m.name << " --markdown`:\n" << settings_markdown(m);
+    EXPECT_NE(doc.str().find(settings_markdown(m)), std::string::npos) << m.name << ": regenerate with `haze methods " << m.name << " --markdown`:\n"
+                                                                       << settings_markdown(m);
   }
 }
 

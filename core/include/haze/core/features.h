@@ -13,8 +13,8 @@ struct SceneFeatures {
   bool bounded = false;      // the medium has finite bounds
   bool surfaces = false;
   bool sky = false, directional = false;  // light types besides point and spot
-  double optical_diameter = 0.0;  // largest density integral through the medium's centre along x, y or z, times the largest sigma_t
-  double albedo = 0.0;            // largest channel
+  double optical_diameter = 0.0;          // largest density integral through the medium's centre along x, y or z, times the largest sigma_t
+  double albedo = 0.0;                    // largest channel
   // The share of the image's light scattered more than once, estimated as albedo (1 - e^(-tau / 2)):
   // the chance that light scattered once meets the medium again before it leaves.
   double multiple_share = 0.0;
@@ -23,9 +23,6 @@ SceneFeatures scene_features(const Scene& scene);
 
 // Single scattering is enough when the multiple-scattering share is under half the tolerance (for
 // particles the share is not estimated: never).
-inline bool single_scattering_suffices(const SceneFeatures& f, double tolerance) {
-  return !f.particles && f.multiple_share < 0.5 * tolerance;
-}
-
+inline bool single_scattering_suffices(const SceneFeatures& f, double tolerance) { return !f.particles && f.multiple_share < 0.5 * tolerance; }
 
 }  // namespace haze

@@ -44,7 +44,7 @@ struct View {
 
 struct RenderResult {
   Image radiance;
-  std::optional<Image> std_error;  // per-pixel standard error, for Monte Carlo methods
+  std::optional<Image> std_error;                   // per-pixel standard error, for Monte Carlo methods
   nlohmann::json stats = nlohmann::json::object();  // method-specific figures for --json
 };
 
