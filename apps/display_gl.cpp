@@ -7,44 +7,28 @@
 #ifdef HAZE_WITH_GL
 #include <haze/gl/context.h>
 #include <haze/gl/display.h>
-#include <haze/grids/dom.h>
-#include <haze/grids/propagation.h>
-
+#include <haze/grids/solution.h>
 #endif
 
 namespace haze::app {
 
 #ifdef HAZE_WITH_GL
 RenderResult render_gl(const Scene& scene, const std::string& method, const RenderOptions& options) {
-  if (method != "propagation" && method != "dom")
-    throw Error("--display gl", "method \"" + method + "\"", "method propagation or dom (the methods with grid fields to display)");
   gl::HeadlessContext context;
-  gl::DisplaySettings settings;
-  nlohmann::json stats;
-  std::optional<gl::VolumeDisplay> display;
-  Stopwatch start;
-  if (method == "propagation") {
-    grids::PropagationFields fields = grids::propagation_fields(scene, options);
-    settings.step_cells = fields.march.step_cells;
-    start.restart();
-    display.emplace(scene, fields.volume, fields.depths, settings);
-    stats = std::move(fields.stats);
-  } else {
-    grids::DomFields fields = grids::dom_fields(scene, options);
-    settings.step_cells = fields.step_cells;
-    start.restart();
-    display.emplace(scene, fields.volume, fields.delta_depths, settings);
-    display->show_dom(fields.solution);
-    stats = std::move(fields.stats);
-  }
-  const double upload_seconds = start.seconds();
-  start.restart();
-  RenderResult result{display->render(scene.camera), std::nullopt, std::move(stats)};
+  RenderOptions prepared = options;
+  prepared.single_view = true;
+  const Solution solution = prepare(scene, method, prepared);
+  const auto* grid = dynamic_cast<const grids::GridSolution*>(&solution.method_solution());
+  if (!grid) throw Error("--display gl", "method \"" + method + "\"", "a method whose solution keeps grid fields (propagation, dom)");
+  Stopwatch watch;
+  gl::VolumeDisplay display(*grid);
+  const double upload_seconds = watch.lap();
+  RenderResult result{display.render(scene.camera), std::nullopt, solution.stats()};
   result.stats["gl"] = {{"backend", context.info().backend},
                         {"renderer", context.info().renderer},
                         {"version", context.info().version},
                         {"upload_seconds", upload_seconds},
-                        {"display_seconds", start.seconds()}};
+                        {"display_seconds", watch.seconds()}};
   return result;
 }
 #else

@@ -58,6 +58,7 @@ class AutoSolution final : public MethodSolution {
   Rgb transmittance(size_t light, const Vec3& x) const override { return chosen_.transmittance(light, x); }
   Rgb fluence(const Vec3& x) const override { return chosen_.fluence(x); }
   Rgb inscattered(const Vec3& x, const Vec3& w) const override { return chosen_.inscattered(x, w); }
+  const MethodSolution& fields_owner() const override { return chosen_.method_solution(); }
 
  private:
   Solution chosen_;

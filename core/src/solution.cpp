@@ -102,6 +102,7 @@ Solution::~Solution() = default;
 const std::string& Solution::method() const { return state_->info.name; }
 const Scene& Solution::scene() const { return state_->scene; }
 const nlohmann::json& Solution::stats() const { return state_->solution->stats; }
+const MethodSolution& Solution::method_solution() const { return state_->solution->fields_owner(); }
 
 RenderResult Solution::render(const View& view, const RenderOptions& options) const {
   const State& s = *state_;

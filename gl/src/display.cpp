@@ -341,6 +341,11 @@ VolumeDisplay::VolumeDisplay(const Scene& scene, const grids::ExtinctionVolume& 
   internal::check(d.gl, "display set-up");
 }
 
+VolumeDisplay::VolumeDisplay(const grids::GridSolution& solution, DisplaySettings settings)
+    : VolumeDisplay(solution.scene(), solution.volume(), solution.depths(), (settings.step_cells = solution.step_cells(), settings)) {
+  if (const grids::DomSolution* dom = solution.dom()) show_dom(*dom);
+}
+
 VolumeDisplay::~VolumeDisplay() = default;
 
 void VolumeDisplay::show_dom(const grids::DomSolution& solution) {

@@ -5,6 +5,7 @@
 #include <haze/gl/context.h>
 #include <haze/gl/display.h>
 #include <haze/grids/dom.h>
+#include <haze/grids/methods.h>
 #include <haze/grids/optical_depth.h>
 #include <haze/grids/propagation.h>
 
@@ -125,6 +126,24 @@ TEST(VolumeDisplay, AddsTheDomMultipleScatteringTermWithinOnePercent) {
   EXPECT_GT(e.pixels, 64 * 48 / 3);
   EXPECT_LT(e.mean_abs, 0.01);
   EXPECT_GT(lit_pixel_error(single, reference).mean_abs, 0.1);  // the multiple-scattering term matters here
+}
+
+// Any grid method's solution displays as it is (no method name): the DOM's through its moments,
+// within 1% of the solution's own CPU render.
+TEST(VolumeDisplay, ShowsAnyGridSolution) {
+  grids::register_methods();
+  HeadlessContext context;
+  const Scene scene = grids::lit_cloud(true, 64, 48);
+  RenderOptions options;
+  options.settings = {{"resolution", 24}, {"directions", 48}, {"terms", 16}};
+  const Solution solution = prepare(scene, "dom", options);
+  const auto* grid = dynamic_cast<const grids::GridSolution*>(&solution.method_solution());
+  ASSERT_NE(grid, nullptr);
+  VolumeDisplay display(*grid);
+  const LitPixelError e = lit_pixel_error(display.render(scene.camera), solution.render().radiance);
+  EXPECT_GT(e.pixels, 64 * 48 / 3);
+  EXPECT_LT(e.mean_abs, 0.01);
+  EXPECT_EQ(dynamic_cast<const grids::GridSolution*>(&prepare(scene, "reference").method_solution()), nullptr);
 }
 
 TEST(VolumeDisplay, RefusesMismatchedFields) {

@@ -146,6 +146,11 @@ class Solution {
   // is not part of a solution.
   UpdateReport update(const SceneChange& change, const RenderOptions& options = {});
 
+  // What the method prepared (MethodSolution::fields_owner: the chosen method's for auto), e.g.
+  // for a display that reads a grid method's fields (grids::GridSolution). Its lights are the
+  // kept ones.
+  const MethodSolution& method_solution() const;
+
   // The method's fields (solution.h: MethodSolution), lights indexed as in scene().lights.
   Rgb transmittance(size_t light, const Vec3& x) const;
   Rgb fluence(const Vec3& x) const;

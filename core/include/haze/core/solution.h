@@ -90,6 +90,10 @@ class MethodSolution {
   // S(x, w) = integral p(wi . w) L(x, wi) dwi, so that a host's ray march adds sigma_s(x) S ds.
   virtual Rgb inscattered(const Vec3& x, const Vec3& w) const;
 
+  // The solution whose fields these are: itself, or for a method that delegates (auto) the
+  // chosen method's.
+  virtual const MethodSolution& fields_owner() const { return *this; }
+
   // What prepare computed and measured (merged into every render's stats).
   nlohmann::json stats = nlohmann::json::object();
 };

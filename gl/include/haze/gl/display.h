@@ -14,6 +14,7 @@
 #include <haze/gl/texture.h>
 #include <haze/grids/dom.h>
 #include <haze/grids/propagation.h>
+#include <haze/grids/solution.h>
 
 #include <memory>
 #include <span>
@@ -37,6 +38,9 @@ class VolumeDisplay {
   // kMaxSurfaces surfaces, or a shader the driver rejects (with its log).
   VolumeDisplay(const Scene& scene, const grids::ExtinctionVolume& volume, const std::vector<grids::DenseGrid>& depths,
                 const DisplaySettings& settings = {});
+  // A grid method's solution (propagation, dom or any other GridSolution): its scene, volume and
+  // depths, its march step, and its DOM moments when it has them (settings.step_cells ignored).
+  explicit VolumeDisplay(const grids::GridSolution& solution, DisplaySettings settings = {});
   ~VolumeDisplay();
   VolumeDisplay(const VolumeDisplay&) = delete;
   VolumeDisplay& operator=(const VolumeDisplay&) = delete;
