@@ -1,5 +1,7 @@
-// haze demo: every built-in scene (examples/*.json) with every registered method, EXR + PNG each,
-// and a table of method, time and error against the reference.
+// haze demo: every built-in scene (examples/*.json) with every registered method against a
+// reference that resolves their errors (rendered once, then cached), EXR + PNG each, a contact
+// sheet per scene with error maps, and a table of time and error. The time it will take is said
+// before anything renders.
 #include "commands.h"
 #include "progress_bar.h"
 
@@ -7,8 +9,11 @@
 #include <haze/core/stopwatch.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
-#include <iostream>
+#include <fstream>
+#include <iterator>
+#include <sstream>
 
 namespace haze::app {
 
@@ -28,74 +33,213 @@ struct DemoArgs {
   std::string out = "haze-demo";
   std::string examples = HAZE_EXAMPLES_DIR;
   int threads = 0;
+  double reference_seconds = 30.0;
 };
+
+constexpr long long kPilotSpp = 64;
+
+// What the demo renders a scene at, and the reference it compares with: the finest of 1%
+// noise and what reference_seconds buys, at twice the scene's size where that still reaches 2%.
+struct Plan {
+  std::filesystem::path scene_file;
+  int scale = 1;
+  long long spp = 0;
+  double expected_seconds = 0.0;  // of the reference; 0 when cached
+  std::filesystem::path reference;  // its EXR in the cache (with the standard-error layer)
+};
+
+Scene scaled(Scene scene, int scale) {
+  scene.camera.width_px *= scale, scene.camera.height_px *= scale;
+  return scene;
+}
+
+RenderResult reference_render(const Scene& scene, long long spp, int threads, const std::string& label) {
+  RenderOptions options;
+  options.threads = threads;
+  options.settings = {{"spp", spp}, {"seed", 1}};
+  ProgressBar bar(label);
+  options.progress = bar.callback();
+  return render(scene, "reference", options);
+}
+
+Plan plan(const std::filesystem::path& file, const DemoArgs& a) {
+  std::ifstream in(file);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const auto dir = default_cache_dir() / "demo";
+  const std::string key = file.stem().string() + "_" + to_text(std::hash<std::string>{}(text)) + "_" + to_text(a.reference_seconds) + "s";
+  Plan p{file, 1, 0, 0.0, dir / (key + ".exr")};
+  if (std::ifstream cached(dir / (key + ".json")); cached && std::filesystem::exists(p.reference)) {
+    const nlohmann::json j = nlohmann::json::parse(cached);
+    p.scale = j.at("scale"), p.spp = j.at("spp");
+    return p;
+  }
+  const Scene scene = Scene::load(file);
+  Stopwatch watch;
+  const RenderResult pilot = reference_render(scene, kPilotSpp, a.threads, file.stem().string() + " pilot");
+  const double seconds = watch.seconds();
+  const double noise = std::max(lit_pixel_error(pilot.radiance, pilot.radiance, &*pilot.std_error).noise_rms, 1e-6);
+  // Noise falls as 1 / sqrt(spp); time grows with spp and pixels.
+  auto spp_for = [&](double target) { return kPilotSpp * (noise / target) * (noise / target); };
+  auto affordable = [&](int scale) { return kPilotSpp * a.reference_seconds / (seconds * scale * scale); };
+  p.scale = std::min(spp_for(0.01), affordable(2)) >= spp_for(0.02) ? 2 : 1;
+  const double spp = std::clamp(std::min(spp_for(0.01), affordable(p.scale)), 256.0, 1e9);
+  p.spp = static_cast<long long>(std::ceil(spp / 64.0)) * 64;
+  p.expected_seconds = seconds * p.scale * p.scale * static_cast<double>(p.spp) / kPilotSpp;
+  return p;
+}
+
+// Display colours written through write_png's tone map (exposure 1, Reinhard, sRGB) unchanged.
+Rgb untonemap(const Rgb& display) {
+  Rgb out;
+  for (int c = 0; c < 3; ++c) {
+    const double s = std::clamp(display[c], 0.0, 0.998);
+    const double linear = s <= 0.04045 ? s / 12.92 : std::pow((s + 0.055) / 1.055, 2.4);
+    out[c] = linear / (1.0 - linear);
+  }
+  return out;
+}
+
+double luminance(const Rgb& c) { return 0.2126 * c.r + 0.7152 * c.g + 0.0722 * c.b; }
+
+// Relative error -> black (0), red (5%), yellow (10%), white (20% and more).
+Rgb error_colour(double e) {
+  const double t = std::clamp(e / 0.2, 0.0, 1.0);
+  if (t < 0.25) return {t / 0.25, 0.0, 0.0};
+  if (t < 0.5) return {1.0, (t - 0.25) / 0.25, 0.0};
+  return {1.0, 1.0, (t - 0.5) / 0.5};
+}
+
+// Top row: the reference, then each method; bottom row: the reference's own noise, then each
+// method's error against it, per pixel (|image - reference| over the reference's luminance, at
+// least 1% of its peak).
+void write_sheet(const std::filesystem::path& path, const Image& reference, const Image& noise, const std::vector<Image>& images) {
+  const int w = reference.width(), h = reference.height(), n = static_cast<int>(images.size()) + 1;
+  std::vector<double> lum;
+  double peak = 0.0;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) lum.push_back(luminance(reference.at(x, y))), peak = std::max(peak, lum.back());
+  std::vector<double> sorted = lum;
+  std::sort(sorted.begin(), sorted.end());
+  const double exposure = 1.0 / std::max(sorted[sorted.size() * 95 / 100], 1e-12);
+  Image sheet(n * w, 2 * h);
+  for (int i = 0; i < n; ++i) {
+    const Image& top = i == 0 ? reference : images[static_cast<size_t>(i - 1)];
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) {
+        const double scale = std::max(lum[static_cast<size_t>(y * w + x)], 0.01 * peak);
+        const double e = i == 0 ? luminance(noise.at(x, y)) / scale : luminance(glm::abs(top.at(x, y) - reference.at(x, y))) / scale;
+        sheet.set(i * w + x, y, top.at(x, y) * exposure);
+        sheet.set(i * w + x, h + y, untonemap(error_colour(e)));
+      }
+  }
+  write_png(path, sheet);
+}
+
+std::string percent(double v) {
+  char s[32];
+  std::snprintf(s, sizeof s, "%.1f%%", 100.0 * v);
+  return s;
+}
 
 int run(const DemoArgs& a) {
   const std::vector<std::filesystem::path> scenes = scene_files(a.examples, "--examples");
-
   auto methods = registered_methods();
-  // auto is a chooser, not a method of its own: the demo shows the methods it chooses from.
-  std::erase_if(methods, [](const MethodInfo& m) { return m.name == "auto"; });
-  bool has_reference = std::any_of(methods.begin(), methods.end(), [](const auto& m) { return m.name == "reference"; });
-  // The reference renders first so the others can be compared with it.
-  std::stable_partition(methods.begin(), methods.end(), [](const auto& m) { return m.name == "reference"; });
+  // auto is a chooser and the reference the yardstick: the rows are the methods auto chooses from.
+  std::erase_if(methods, [](const MethodInfo& m) { return m.name == "auto" || m.name == "reference"; });
 
-  std::printf("%-22s %-12s %10s %14s  %s\n", "scene", "method", "seconds", "rel. error", "output");
+  std::vector<Plan> plans;
+  for (const auto& file : scenes) plans.push_back(plan(file, a));
+  double reference_seconds = 0.0;
+  int to_render = 0;
+  for (const Plan& p : plans) reference_seconds += p.expected_seconds, to_render += p.expected_seconds > 0.0;
+  std::printf("haze demo: %zu scenes x %zu methods against path-traced references (%d cached, %d to render: about %.0f s,\n"
+              "from 64-spp pilots); each method takes from milliseconds to a few seconds.\n\n",
+              plans.size(), methods.size(), static_cast<int>(plans.size()) - to_render, to_render, reference_seconds);
+  std::fflush(stdout);
+
+  std::printf("%-16s %-12s %9s %10s %9s  %s\n", "scene", "method", "size", "seconds", "error", "output");
   int rendered = 0;
-  for (const auto& path : scenes) {
-    Scene scene = Scene::load(path);
-    std::optional<Image> reference;
+  for (const Plan& p : plans) {
+    const std::string stem = p.scene_file.stem().string();
+    const Scene scene = scaled(Scene::load(p.scene_file), p.scale);
+    const std::string size = to_text(scene.camera.width_px) + "x" + to_text(scene.camera.height_px);
+    Image reference, noise;
+    double seconds = 0.0;
+    if (std::filesystem::exists(p.reference)) {
+      std::optional<Image> se;
+      reference = read_exr(p.reference, &se);
+      noise = *se;
+    } else {
+      Stopwatch watch;
+      RenderResult r = reference_render(scene, p.spp, a.threads, stem + " reference " + to_text(p.spp) + " spp");
+      seconds = watch.seconds();
+      std::filesystem::create_directories(p.reference.parent_path());
+      write_exr(p.reference, r.radiance, &*r.std_error);
+      std::ofstream(std::filesystem::path(p.reference).replace_extension(".json")) << nlohmann::json{{"scale", p.scale}, {"spp", p.spp}}.dump();
+      reference = std::move(r.radiance), noise = std::move(*r.std_error);
+    }
+    const double reference_noise = lit_pixel_error(reference, reference, &noise).noise_rms;
+    const auto ref_exr = std::filesystem::path(a.out) / (stem + "_reference.exr");
+    save_result({reference, noise, {}}, "reference", seconds, ref_exr, true);
+    char took[32];
+    std::snprintf(took, sizeof took, "%.3f", seconds);
+    std::printf("%-16s %-12s %9s %10s %9s  %s (%lld spp%s)\n", stem.c_str(), "reference", size.c_str(), seconds > 0 ? took : "cached",
+                ("noise " + percent(reference_noise)).c_str(), ref_exr.string().c_str(), p.spp, seconds > 0 ? "" : ", from the cache");
+    if (reference_noise > 0.05)
+      std::printf("%-16s %-12s   errors under %s are not resolved; --reference-seconds %.0f would bring the noise to about 5%%\n", "", "",
+                  percent(1.5 * reference_noise).c_str(),
+                  a.reference_seconds * (reference_noise / 0.05) * (reference_noise / 0.05));
+    std::vector<Image> images;
+    std::string order = "reference";
     for (const auto& method : methods) {
-      std::string stem = path.stem().string();
       RenderOptions options;
       options.threads = a.threads;
       options.cache_dir = default_cache_dir();
       ProgressBar bar(stem + " " + method.name);
       options.progress = bar.callback();
       try {
-        Stopwatch start;
+        Stopwatch watch;
         RenderResult result = render(scene, method.name, options);
-        double seconds = start.seconds();
+        seconds = watch.seconds();
         auto exr = std::filesystem::path(a.out) / (stem + "_" + method.name + ".exr");
         save_result(result, method.name, seconds, exr, true);
         ++rendered;
-        std::string error = has_reference ? "-" : "n/a (no ref.)";
-        if (method.name == "reference") {
-          reference = result.radiance;
-          // Its own noise on the same scale: RMS standard error over RMS radiance.
-          char buf[32];
-          std::snprintf(buf, sizeof buf, "noise %.4f", result.std_error ? rms(*result.std_error) / rms(result.radiance) : 0.0);
-          error = buf;
-        } else if (reference) {
-          char buf[32];
-          std::snprintf(buf, sizeof buf, "%.4f", relative_rmse(result.radiance, *reference));
-          error = buf;
-        }
-        std::printf("%-22s %-12s %10.3f %14s  %s\n", stem.c_str(), method.name.c_str(), seconds, error.c_str(),
-                    exr.string().c_str());
+        const double error = lit_pixel_error(result.radiance, reference, &noise).mean_abs;
+        // Within 1.5x the reference's noise the error is not resolved: say so.
+        const std::string shown = error < 1.5 * reference_noise ? "~noise" : percent(error);
+        std::printf("%-16s %-12s %9s %10.3f %9s  %s\n", stem.c_str(), method.name.c_str(), size.c_str(), seconds, shown.c_str(), exr.string().c_str());
+        images.push_back(std::move(result.radiance));
+        order += " | " + method.name;
       } catch (const Cancelled&) {
         throw;
       } catch (const Error& e) {
-        std::printf("%-22s %-12s %10s %14s  not applicable: %s\n", stem.c_str(), method.name.c_str(), "-", "-", e.what());
+        std::printf("%-16s %-12s %9s %10s %9s  not applicable: %s\n", stem.c_str(), method.name.c_str(), size.c_str(), "-", "-", e.what());
       }
       std::fflush(stdout);
     }
+    const auto sheet = std::filesystem::path(a.out) / (stem + "_sheet.png");
+    write_sheet(sheet, reference, noise, images);
+    std::printf("%-16s %-12s %9s %10s %9s  %s: %s\n\n", stem.c_str(), "sheet", "", "", "", sheet.string().c_str(), order.c_str());
   }
-  std::printf("rel. error: RMSE over pixels and channels divided by the reference's RMS; the reference's row\n"
-              "gives its own noise (RMS standard error over RMS radiance) on the same scale. The reference\n"
-              "solves the full transport: single-scattering methods (analytic, propagation, quadrature) also differ by the\n"
-              "multiple scattering and shadows they leave out.\n");
+  std::printf("error: mean relative error over the lit pixels (those above 1%% of the reference's peak) against the\n"
+              "reference, whose own noise is its row's figure; \"~noise\" marks errors within 1.5x that noise. The\n"
+              "reference solves the full transport: single-scattering methods also differ by the multiple scattering\n"
+              "and shadows they leave out (docs/METHODS.md). Sheets: images on top (the order printed), error maps\n"
+              "below (the reference's noise first; black 0, red 5%%, yellow 10%%, white 20%% and more).\n");
   return rendered > 0 ? 0 : 1;
 }
 
 }  // namespace
 
 Command add_demo(CLI::App& app) {
-  auto* sub = app.add_subcommand("demo", "Render the built-in scenes with every method; EXR + PNG and a table");
+  auto* sub = app.add_subcommand("demo", "Render the built-in scenes with every method against a cached reference; EXR + PNG, contact sheets, a table");
   auto a = std::make_shared<DemoArgs>();
   sub->add_option("--out", a->out, "Output directory")->capture_default_str();
   sub->add_option("--examples", a->examples, "Directory of scene files")->capture_default_str();
   sub->add_option("--threads", a->threads, "Thread cap (0: all cores)")->check(CLI::NonNegativeNumber);
+  sub->add_option("--reference-seconds", a->reference_seconds, "Time each uncached reference may take (it stops at 1% noise sooner)")
+      ->capture_default_str()
+      ->check(CLI::Range(1.0, 86400.0));
   return {sub, [a] { return run(*a); }};
 }
 
