@@ -1,5 +1,6 @@
 #include <haze/core/error.h>
 #include <haze/core/medium.h>
+#include <haze/core/progress.h>
 
 #include <algorithm>
 #include <sstream>
@@ -165,9 +166,28 @@ class GridMedium final : public Medium {
   double max_ = 0.0, feature_ = 1.0;
 };
 
+// A module's density field (FieldDensity) with the medium's coefficients.
+class FieldMedium final : public Medium {
+ public:
+  FieldMedium(const MediumDesc& desc, std::shared_ptr<const DensityField> field)
+      : Medium(desc.sigma_t, desc.albedo, desc.phase), field_(std::move(field)) {}
+  Aabb bounds() const override { return field_->bounds(); }
+  double density(const Vec3& x) const override { return field_->density(x); }
+  double max_density(const Aabb& region) const override { return field_->max_density(region); }
+  double feature_size() const override { return field_->feature_size(); }
+  double density_integral(const Vec3& a, const Vec3& b) const override {
+    if (const std::optional<double> exact = field_->density_integral(a, b)) return *exact;
+    return Medium::density_integral(a, b);
+  }
+
+ private:
+  std::shared_ptr<const DensityField> field_;
+};
+
 }  // namespace
 
 Aabb medium_bounds(const MediumDesc& desc) {
+  if (const auto* f = std::get_if<FieldDensity>(&desc.density); f && f->field) return f->field->bounds();
   const auto* rbf = std::get_if<RbfDensity>(&desc.density);
   if (!rbf || desc.bounds.bounded() || rbf->blobs.empty()) return desc.bounds;
   // Beyond 6 / sharpness a blob's density is below weight * e^-36: treat it as zero.
@@ -208,6 +228,8 @@ void check_medium(const MediumDesc& desc, const std::string& path) {
       if (!(std::isfinite(blob.weight) && blob.weight >= 0.0)) throw Error(at + ".weight", to_text(blob.weight), "a finite weight >= 0");
       if (!(std::isfinite(blob.sharpness) && blob.sharpness > 0.0)) throw Error(at + ".sharpness", to_text(blob.sharpness), "a finite sharpness > 0");
     }
+  } else if (const auto* f = std::get_if<FieldDensity>(&desc.density)) {
+    if (!f->field) throw Error(path + ".density", "a " + f->type + " field without data", "a density field");
   } else {
     const auto& grid = std::get<GridDensity>(desc.density);
     if (unbounded) throw Error(path + ".bounds", "unbounded", "bounds for a grid density");
@@ -229,9 +251,31 @@ void check_medium(const MediumDesc& desc, const std::string& path) {
   }
 }
 
+GridDensity sample_grid(const DensityField& field, int resolution, int threads) {
+  const Aabb bounds = field.bounds();
+  const Vec3 e = bounds.extent();
+  const double cell = std::max({e.x, e.y, e.z}) / resolution;
+  std::array<int, 3> r{};
+  for (int a = 0; a < 3; ++a) r[static_cast<size_t>(a)] = std::max(2, static_cast<int>(std::ceil(e[a] / cell)));
+  GridDensity grid{r, std::vector<float>(static_cast<size_t>(r[0]) * static_cast<size_t>(r[1]) * static_cast<size_t>(r[2]), 0.0f)};
+  const Vec3 size = e / Vec3(r[0], r[1], r[2]);
+  parallel_for(r[2], threads, 1, [&](long long k0, long long k1) {
+    for (auto k = static_cast<int>(k0); k < k1; ++k)
+      for (int j = 0; j < r[1]; ++j)
+        for (int i = 0; i < r[0]; ++i)
+          grid.values[(static_cast<size_t>(k) * static_cast<size_t>(r[1]) + static_cast<size_t>(j)) * static_cast<size_t>(r[0]) + static_cast<size_t>(i)] =
+              static_cast<float>(field.density(bounds.lo + (Vec3(i, j, k) + 0.5) * size));
+  });
+  return grid;
+}
+
 std::unique_ptr<Medium> make_medium(const MediumDesc& desc) {
   if (auto* c = std::get_if<ConstantDensity>(&desc.density)) return std::make_unique<ConstantMedium>(desc, c->value);
   if (auto* r = std::get_if<RbfDensity>(&desc.density)) return std::make_unique<RbfMedium>(desc, *r);
+  if (auto* f = std::get_if<FieldDensity>(&desc.density)) {
+    if (!f->field) throw Error("medium.density", "a " + f->type + " field without data", "a density field");
+    return std::make_unique<FieldMedium>(desc, f->field);
+  }
   return std::make_unique<GridMedium>(desc, std::get<GridDensity>(desc.density));
 }
 

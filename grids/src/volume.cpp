@@ -40,6 +40,11 @@ ExtinctionVolume make_extinction_volume(const Scene& scene, int resolution, doub
     volume.density = DenseGrid(cells_for(bounds, resolution), bounds);
     InjectionReport injected = inject_rbf(rbf->blobs, volume.density, cutoff, threads);
     if (report) report->truncation_bound = injected.truncation_bound;
+  } else if (const auto* field = std::get_if<FieldDensity>(&desc.density)) {
+    if (!field->field) throw Error("medium.density", "a " + field->type + " field without data", "a density field");
+    const GridDensity grid = sample_grid(*field->field, field->grid_resolution > 0 ? field->grid_resolution : resolution, threads);
+    volume.density = DenseGrid(grid.resolution, field->field->bounds());
+    volume.density.values() = grid.values;
   } else if (const auto* grid = std::get_if<GridDensity>(&desc.density)) {
     volume.density = DenseGrid(grid->resolution, bounds);
     volume.density.values().assign(grid->samples().begin(), grid->samples().end());

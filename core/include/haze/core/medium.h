@@ -7,6 +7,7 @@
 
 #include <array>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <variant>
@@ -41,7 +42,26 @@ struct GridDensity {
   static GridDensity viewing(const std::array<int, 3>& resolution, std::span<const float> samples) { return {resolution, {}, samples}; }
 };
 
-using Density = std::variant<ConstantDensity, RbfDensity, GridDensity>;
+// A density a module supplies in its own form (the particles' Gaussians): core renders it through
+// this interface, the grid methods sample it at their cells' centres.
+class DensityField {
+ public:
+  virtual ~DensityField() = default;
+  virtual Aabb bounds() const = 0;  // where the density may be non-zero (finite)
+  virtual double density(const Vec3& x) const = 0;
+  virtual double max_density(const Aabb& region) const = 0;  // an upper bound over the region
+  virtual double feature_size() const = 0;                   // a length over which it changes little
+  // integral along a -> b; by default Medium's composite Simpson.
+  virtual std::optional<double> density_integral(const Vec3& /*a*/, const Vec3& /*b*/) const { return std::nullopt; }
+};
+struct FieldDensity {
+  std::string type;  // what supplies it, for messages ("particles")
+  std::shared_ptr<const DensityField> field;
+  // Cells along the longest side when a grid method samples it (0: the method's own resolution).
+  int grid_resolution = 0;
+};
+
+using Density = std::variant<ConstantDensity, RbfDensity, GridDensity, FieldDensity>;
 
 struct MediumDesc {
   Aabb bounds;  // unbounded unless given; a grid density needs bounds
@@ -86,6 +106,10 @@ class Medium {
   Rgb sigma_t_, albedo_;
   PhaseFunction phase_;
 };
+
+// The field's density at the cell centres of `resolution` cells along the longest side of its
+// bounds (each axis ceil(extent / cell), at least 2), x fastest: what the grid methods solve on.
+GridDensity sample_grid(const DensityField& field, int resolution, int threads = 0);
 
 // Checks what a caller built in code as Scene::from_json checks a file: bounds, coefficients,
 // phase, and the density (a grid's sample count against its resolution, every sample finite and

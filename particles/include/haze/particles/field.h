@@ -40,6 +40,8 @@ class ParticleField {
   Aabb bounds() const { return bounds_; }
 
   double density(const Vec3& x) const;
+  // An upper bound of rho over the region: the peaks of the Gaussians whose support can reach it.
+  double max_density(const Aabb& region) const;
   // The particles within `radius` of x (a FLANN radius query), in no particular order.
   std::vector<size_t> within(const Vec3& x, double radius) const;
   std::vector<float> density_at_particles(int threads) const;
@@ -48,7 +50,7 @@ class ParticleField {
   double density_integral(const Vec3& x, const Vec3& direction, double length) const;
   // rho at the cell centres of `resolution` cells over bounds(), x fastest (a grid medium).
   GridDensity to_grid(const std::array<int, 3>& resolution, int threads) const;
-  // The medium the field stands for: the grid over bounds() with the particles' material.
+  // The medium the field stands for, sampled: the grid over bounds() with the particles' material.
   MediumDesc to_medium(int resolution, int threads) const;
 
  private:
@@ -63,5 +65,37 @@ class ParticleField {
   // FLANN's radius search around x (one query; unsorted), for density() and within().
   void radius_query(const Vec3& x, double radius, std::vector<std::vector<size_t>>& found, std::vector<std::vector<float>>& dist2) const;
 };
+
+// The particles' own density as core's DensityField (it owns the set and its field): what every
+// method but the network renders a particle scene with. The reference and quadrature read the
+// Gaussians themselves (line integrals in closed form); the grid methods sample them at
+// `grid_resolution` cells along the longest side.
+class ParticleDensity final : public DensityField {
+ public:
+  ParticleDensity(ParticleSet set, int neighbours = 8);
+  const ParticleField& field() const { return field_; }
+  Aabb bounds() const override;
+  // rho(x) as ParticleField::density, from a uniform grid of the particles (cells of the largest
+  // support, 3 h_max): 27 cells a lookup, no allocation (the path tracer calls it at every
+  // tentative collision).
+  double density(const Vec3& x) const override;
+  double max_density(const Aabb& region) const override;
+  double feature_size() const override { return field_.size() ? field_.mean_h() : 1.0; }
+  std::optional<double> density_integral(const Vec3& a, const Vec3& b) const override;
+
+ private:
+  ParticleSet set_;
+  ParticleField field_;  // views set_
+  // The particles by cell: cell c holds order_[start_[c] .. start_[c + 1]).
+  Vec3 origin_{0.0};
+  double cell_ = 1.0;
+  std::array<int, 3> n_{1, 1, 1};
+  std::vector<unsigned> start_, order_;
+  template <class F>
+  void for_cells(const Vec3& lo, const Vec3& hi, const F& f) const;
+};
+
+// The medium of a particle set with its material: a FieldDensity over a ParticleDensity.
+MediumDesc particle_medium(ParticleSet set, int grid_resolution = 96, int neighbours = 8);
 
 }  // namespace haze::particles

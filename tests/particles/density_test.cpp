@@ -1,0 +1,52 @@
+// ParticleDensity, the particles' own density as core's DensityField: the same rho as the FLANN
+// field, majorants that bound it, and the grid the grid methods sample from it.
+#include <haze/core/rng.h>
+#include <haze/particles/field.h>
+
+#include <gtest/gtest.h>
+
+namespace haze::particles {
+namespace {
+
+ParticleSet cloud(int count) {
+  ParticleSet set;
+  Rng rng(4);
+  while (static_cast<int>(set.positions.size()) < count) {
+    const Vec3 x(2.0 * rng.uniform() - 1.0, 2.0 * rng.uniform() - 1.0, 2.0 * rng.uniform() - 1.0);
+    if (glm::dot(x, x) < 1.0) set.positions.emplace_back(x), set.density.push_back(static_cast<float>(1.0 + x.x));
+  }
+  set.material.sigma_t = Rgb(2.0);
+  return set;
+}
+
+TEST(ParticleDensity, MatchesTheFieldAndItsMajorantsBoundIt) {
+  const ParticleSet set = cloud(2000);
+  const ParticleField field(set.view());
+  const ParticleDensity density(set);
+  Rng rng(8);
+  for (int i = 0; i < 200; ++i) {
+    const Vec3 x = density.bounds().lo + Vec3(rng.uniform(), rng.uniform(), rng.uniform()) * density.bounds().extent();
+    EXPECT_NEAR(density.density(x), field.density(x), 1e-6 * (1.0 + field.density(x)));  // FLANN squares distances in float
+    // A box around x: no point in it above the bound.
+    const Aabb box{x - Vec3(0.1), x + Vec3(0.1)};
+    const double bound = density.max_density(box);
+    for (int s = 0; s < 8; ++s) {
+      const Vec3 y = box.lo + Vec3(rng.uniform(), rng.uniform(), rng.uniform()) * box.extent();
+      EXPECT_LE(density.density(y), bound * (1.0 + 1e-12));
+    }
+  }
+  // The grid methods' sampling is the field's own grid (to_medium), to float rounding.
+  const GridDensity sampled = sample_grid(density, 24, 2);
+  const MediumDesc grid = field.to_medium(24, 2);
+  const auto& values = std::get<GridDensity>(grid.density).values;
+  ASSERT_EQ(sampled.resolution, std::get<GridDensity>(grid.density).resolution);
+  for (size_t i = 0; i < values.size(); ++i) EXPECT_NEAR(sampled.values[i], values[i], 1e-5f * (1.0f + values[i]));
+  // And as a medium: the closed-form line integral.
+  const MediumDesc medium = particle_medium(set, 24);
+  const auto m = make_medium(medium);
+  EXPECT_NEAR(m->density_integral(Vec3(-2.0, 0.1, 0.0), Vec3(2.0, 0.1, 0.0)),
+              field.density_integral(Vec3(-2.0, 0.1, 0.0), Vec3(1.0, 0.0, 0.0), 4.0), 1e-9);
+}
+
+}  // namespace
+}  // namespace haze::particles
