@@ -8,8 +8,9 @@ namespace haze::app {
 
 std::string methods_help() {
   std::string out =
-      "Methods and their settings (--set key=value; particle scenes also take particle_resolution, default 96,\n"
-      "the grid the particles' density is sampled on for methods other than network):\n";
+      "Methods and their settings (--set key=value). Particle scenes rendered by a method other than network also take\n"
+      "particle_resolution (96: the grid their density is sampled on) and particle_density (\"grid\", or \"gaussians\": the\n"
+      "reference and quadrature read the Gaussians themselves, about 100x slower):\n";
   for (const MethodInfo& m : registered_methods()) out += m.name + ": " + m.summary + "\n" + settings_help(m);
   return out;
 }

@@ -35,9 +35,10 @@ std::string methods_help();
 nlohmann::json save_result(const RenderResult& result, const std::string& method, double seconds,
                            const std::filesystem::path& exr, bool png);
 
-// `haze render --display gl`: the method's fields computed on the CPU (methods propagation and
-// dom), shown by haze::gl's ray-march display in a headless context, read back. Throws
-// haze::Error for another method, or when the build has no GL (HAZE_WITH_GL=OFF).
+// `haze render --display gl`: the method's solution prepared on the CPU and, when it keeps grid
+// fields (grids::GridSolution: propagation, dom), shown by haze::gl's ray-march display in a
+// headless context, read back. Throws haze::Error for a method without grid fields, or when the
+// build has no GL (HAZE_WITH_GL=OFF).
 RenderResult render_gl(const Scene& scene, const std::string& method, const RenderOptions& options);
 
 // The .json scene files in a directory, sorted; throws haze::Error naming `option` when it is not

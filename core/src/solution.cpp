@@ -135,6 +135,7 @@ UpdateReport Solution::update(const SceneChange& change, const RenderOptions& op
   if (change.surfaces) next.surfaces = *change.surfaces;
   std::swap(s.scene, next);
   const std::vector<size_t> kept_before = s.kept;
+  const nlohmann::json culled_before = s.culled;
   UpdateReport report;
   try {
     const bool kept_changed = s.cull();
@@ -158,7 +159,7 @@ UpdateReport Solution::update(const SceneChange& change, const RenderOptions& op
     }
   } catch (...) {  // a change that cannot be applied leaves the solution as it was
     std::swap(s.scene, next);
-    s.kept = kept_before;
+    s.kept = kept_before, s.culled = culled_before;
     throw;
   }
   report.seconds = watch.seconds();

@@ -143,7 +143,8 @@ class Solution {
   RenderResult render(const RenderOptions& options = {}) const { return render(View{scene().camera}, options); }
   // Redoes only what the change reaches (the method says what in the report); a change nothing
   // can be reused for prepares again (report.rebuilt). The scene's camera may change freely: it
-  // is not part of a solution.
+  // is not part of a solution. A change that throws haze::Error (checked before anything is
+  // redone: the medium, the lights a method cannot take) leaves the solution as it was.
   UpdateReport update(const SceneChange& change, const RenderOptions& options = {});
 
   // What the method prepared (MethodSolution::fields_owner: the chosen method's for auto), e.g.
