@@ -1,8 +1,9 @@
-#include "majorant.h"
+#include <haze/core/majorant.h>
+#include <haze/core/medium.h>
 
 #include <algorithm>
 
-namespace haze::internal {
+namespace haze {
 
 MajorantGrid::MajorantGrid(const Medium& medium, int cells) : bounds_(medium.bounds()) {
   if (medium.homogeneous() || !bounds_.bounded()) {
@@ -64,4 +65,4 @@ bool MajorantGrid::Iterator::next(MajorantSegment& segment) {
   return true;
 }
 
-}  // namespace haze::internal
+}  // namespace haze

@@ -1,4 +1,5 @@
 #include <haze/core/error.h>
+#include <haze/core/majorant.h>
 #include <haze/core/medium.h>
 #include <haze/core/progress.h>
 
@@ -20,6 +21,13 @@ double Medium::density_integral(const Vec3& a, const Vec3& b) const {
   double sum = density(ray.at(t0)) + density(ray.at(t1));
   for (int i = 1; i < n; ++i) sum += (i % 2 ? 4.0 : 2.0) * density(ray.at(t0 + i * h));
   return sum * h / 3.0;
+}
+
+std::shared_ptr<const MajorantGrid> Medium::make_majorants() const { return std::make_shared<MajorantGrid>(*this); }
+
+const MajorantGrid& Medium::majorants() const {
+  std::call_once(majorants_once_, [&] { majorants_ = make_majorants(); });
+  return *majorants_;
 }
 
 Rgb Medium::transmittance(const Vec3& a, const Vec3& b) const {

@@ -4,9 +4,9 @@
 // directional lights and the sky with ratio-tracked transmittance (exact for homogeneous media),
 // phase-function importance sampling, Russian roulette; planes and spheres block and reflect.
 #include "builtin_methods.h"
-#include "majorant.h"
 
 #include <haze/core/error.h>
+#include <haze/core/majorant.h>
 #include <haze/core/stopwatch.h>
 #include <haze/core/image.h>
 
@@ -46,7 +46,7 @@ Rgb beer(const Rgb& sigma, double length) {
 struct Tracer {
   const Scene& scene;
   const Medium* medium;
-  std::optional<MajorantGrid> majorants;
+  const MajorantGrid* majorants = nullptr;  // the medium's
   double sigma_max = 0.0;  // largest channel of the medium's sigma_t scale
   Rgb sky{0.0};
   int max_scattering = -1;  // medium scattering events per path; -1 unlimited
@@ -311,11 +311,11 @@ class ReferenceSolution final : public MethodSolution {
       : scene_(scene),
         settings_(s),
         medium_(scene.medium ? make_medium(*scene.medium) : nullptr),
-        tracer_{scene_, medium_.get(), std::nullopt, 0.0, Rgb(0.0), s.max_scattering, s.max_bounces, false, s.view_scattering,
+        tracer_{scene_, medium_.get(), nullptr, 0.0, Rgb(0.0), s.max_scattering, s.max_bounces, false, s.view_scattering,
                 false, Aabb{}, Rgb(0.0)} {
     const Stopwatch watch;
     if (medium_) {
-      tracer_.majorants.emplace(*medium_);
+      tracer_.majorants = &medium_->majorants();
       tracer_.sigma_max = max3(medium_->sigma_t_scale());
       tracer_.homogeneous = medium_->homogeneous();
       tracer_.bounds = medium_->bounds();

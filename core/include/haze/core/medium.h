@@ -7,6 +7,7 @@
 
 #include <array>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <span>
 #include <string>
@@ -14,6 +15,8 @@
 #include <vector>
 
 namespace haze {
+
+class MajorantGrid;
 
 struct ConstantDensity {
   double value = 1.0;
@@ -86,6 +89,11 @@ class Medium {
   // integral of density along the segment a -> b, clipped to bounds(). Exact for constant density;
   // otherwise composite Simpson with steps of at most feature_size() / 4.
   virtual double density_integral(const Vec3& a, const Vec3& b) const;
+  // The majorant iterator along a ray (pbrt-v4's SampleT_maj over a DDA majorant grid): segments
+  // of the ray with an upper bound of the density on each. Built on first use from max_density
+  // (16^3 cells; one for homogeneous or unbounded media), thread-safe; a medium with a better
+  // structure overrides make_majorants.
+  const MajorantGrid& majorants() const;
 
   const Rgb& sigma_t_scale() const { return sigma_t_; }
   const Rgb& albedo() const { return albedo_; }
@@ -101,10 +109,13 @@ class Medium {
  protected:
   Medium(const Rgb& sigma_t, const Rgb& albedo, const PhaseFunction& phase)
       : sigma_t_(sigma_t), albedo_(albedo), phase_(phase) {}
+  virtual std::shared_ptr<const MajorantGrid> make_majorants() const;
 
  private:
   Rgb sigma_t_, albedo_;
   PhaseFunction phase_;
+  mutable std::once_flag majorants_once_;
+  mutable std::shared_ptr<const MajorantGrid> majorants_;
 };
 
 // The field's density at the cell centres of `resolution` cells along the longest side of its

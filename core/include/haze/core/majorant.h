@@ -1,17 +1,20 @@
 // A coarse grid of density majorants over a medium's bounds and a DDA that walks a ray through it,
-// in the spirit of pbrt-v4's DDAMajorantIterator. Internal to the reference path tracer.
+// in the spirit of pbrt-v4's DDAMajorantIterator: the majorant iterator of every haze::Medium
+// (Medium::majorants), which the reference path tracer walks.
 #pragma once
 
-#include <haze/core/medium.h>
+#include <haze/core/math.h>
 
 #include <vector>
 
-namespace haze::internal {
+namespace haze {
 
 struct MajorantSegment {
   double t0, t1;
   double density;  // an upper bound of the density on [t0, t1)
 };
+
+class Medium;
 
 class MajorantGrid {
  public:
@@ -43,4 +46,4 @@ class MajorantGrid {
   }
 };
 
-}  // namespace haze::internal
+}  // namespace haze
