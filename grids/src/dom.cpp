@@ -7,7 +7,6 @@
 #include <haze/core/error.h>
 #include <haze/core/stopwatch.h>
 #include <haze/grids/optical_depth.h>
-#include <haze/grids/rbf.h>
 #include <haze/grids/solution.h>
 
 #include "dom_internal.h"
@@ -145,8 +144,8 @@ class DomMethodSolution final : public GridSolution {
     return result;
   }
 
-  // A new density (re-injected by region for an RBF over the same bounds) redoes every light's
-  // depth, new lights only those that differ; the moments then iterate from the previous ones
+  // A new density (re-injected by region where it can: replace_volume) redoes every light's depth,
+  // new lights only those that differ; the moments then iterate from the previous ones
   // (warm_iterations sweeps, or to the tolerance).
   std::optional<UpdateReport> update(const Scene& scene, const SceneChange& change, const RenderOptions& options) override {
     UpdateReport report;
@@ -159,19 +158,9 @@ class DomMethodSolution final : public GridSolution {
       if (!std::holds_alternative<SkyLight>(l)) delta.push_back(l);
     bool all = false;
     if (change.medium) {
-      const auto* old_rbf = std::get_if<RbfDensity>(&scene_.medium->density);
-      const auto* rbf = std::get_if<RbfDensity>(&change.medium->density);
-      if (old_rbf && rbf && change.region && medium_bounds(*change.medium) == medium_bounds(*scene_.medium) &&
-          injection_cutoff(rbf->blobs) == injection_cutoff(old_rbf->blobs)) {
-        const size_t cells = reinject_region(rbf->blobs, volume_.density, *change.region, injection_cutoff(rbf->blobs), 8, options.threads);
-        report.redone.push_back("extinction volume: " + to_text(cells) + " of " + to_text(volume_.density.cell_count()) + " cells re-injected");
-      } else {
-        const ExtinctionVolume fresh = make_extinction_volume(scene, resolution_, 0.0, options.threads);
-        if (fresh.density.resolution() != volume_.density.resolution()) return std::nullopt;  // a new shape: solve again
-        volume_.density = fresh.density;
-        report.redone.push_back("extinction volume");
-      }
-      volume_.sigma_t_scale = change.medium->sigma_t, volume_.albedo = change.medium->albedo, volume_.phase = change.medium->phase;
+      const std::array<int, 3> shape = volume_.density.resolution();
+      report.redone.push_back(replace_volume(scene, change, resolution_, 0.0, options.threads));
+      if (volume_.density.resolution() != shape) return std::nullopt;  // a new shape: solve again
       all = true;
     }
     depths_.resize(delta.size(), DenseGrid(volume_.density.resolution(), volume_.density.bounds()));

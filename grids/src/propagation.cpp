@@ -9,7 +9,6 @@
 #include <haze/core/method.h>
 #include <haze/grids/optical_depth.h>
 #include <haze/core/stopwatch.h>
-#include <haze/grids/rbf.h>
 #include <haze/grids/solution.h>
 
 namespace haze::grids {
@@ -37,8 +36,8 @@ class PropagationSolution final : public GridSolution {
     return result;
   }
 
-  // A new RBF density over the same bounds re-injects only the bricks in change.region; any new
-  // density redoes every light's depth, new lights only the lights that differ.
+  // A new density (re-injected by region where it can: replace_volume) redoes every light's depth,
+  // new lights only the lights that differ.
   std::optional<UpdateReport> update(const Scene& scene, const SceneChange& change, const RenderOptions& options) override {
     for (size_t i = 0; i < scene.lights.size(); ++i)
       if (std::holds_alternative<SkyLight>(scene.lights[i]))
@@ -48,17 +47,7 @@ class PropagationSolution final : public GridSolution {
     depth_.threads = options.threads;
     std::vector<bool> redo(scene.lights.size(), false);
     if (change.medium) {
-      const auto* old_rbf = std::get_if<RbfDensity>(&scene_.medium->density);
-      const auto* rbf = std::get_if<RbfDensity>(&change.medium->density);
-      if (old_rbf && rbf && change.region && medium_bounds(*change.medium) == medium_bounds(*scene_.medium) &&
-          injection_cutoff(rbf->blobs, cutoff_) == injection_cutoff(old_rbf->blobs, cutoff_)) {
-        const size_t cells = reinject_region(rbf->blobs, volume_.density, *change.region, injection_cutoff(rbf->blobs, cutoff_), 8, options.threads);
-        report.redone.push_back("extinction volume: " + to_text(cells) + " of " + to_text(volume_.density.cell_count()) + " cells re-injected");
-      } else {
-        volume_.density = make_extinction_volume(scene, resolution_, cutoff_, options.threads).density;
-        report.redone.push_back("extinction volume");
-      }
-      volume_.sigma_t_scale = change.medium->sigma_t, volume_.albedo = change.medium->albedo, volume_.phase = change.medium->phase;
+      report.redone.push_back(replace_volume(scene, change, resolution_, cutoff_, options.threads));
       report.stats["inject_seconds"] = watch.lap();
       redo.assign(redo.size(), true);
     }

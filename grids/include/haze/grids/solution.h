@@ -34,6 +34,11 @@ class GridSolution : public MethodSolution {
   GridSolution(const Scene& scene, ExtinctionVolume volume, std::vector<DenseGrid> depths, double step_cells)
       : scene_(scene), volume_(std::move(volume)), depths_(std::move(depths)), step_cells_(step_cells) {}
 
+  // The extinction volume of change.medium (`scene`, the changed scene): an RBF over the same
+  // bounds with the same cutoff re-injects only the bricks in change.region, anything else is
+  // made again (make_extinction_volume). Returns what was redone, for the UpdateReport.
+  std::string replace_volume(const Scene& scene, const SceneChange& change, int resolution, double cutoff, int threads);
+
   Scene scene_;
   ExtinctionVolume volume_;
   std::vector<DenseGrid> depths_;
