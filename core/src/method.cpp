@@ -51,7 +51,8 @@ void register_particle_medium(ParticleMediumFactory factory) {
   r.particle_medium = std::move(factory);
 }
 
-std::unique_ptr<Method> create_method(const std::string& name) {
+// The registry's entry for a method (builtin_methods.h).
+MethodInfo method_info(const std::string& name) {
   auto& r = registry();
   std::lock_guard lock(r.mutex);
   auto it = r.methods.find(name);
@@ -60,22 +61,16 @@ std::unique_ptr<Method> create_method(const std::string& name) {
     for (const auto& [n, info] : r.methods) names += (names.empty() ? "" : ", ") + n;
     throw Error("method.name", "\"" + name + "\"", "one of the available methods: " + names);
   }
-  return it->second.create();
+  return it->second;
 }
+
+std::unique_ptr<Method> create_method(const std::string& name) { return method_info(name).create(); }
 
 std::filesystem::path default_cache_dir() {
   if (const char* dir = std::getenv("HAZE_CACHE_DIR"); dir && *dir) return dir;
   if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg && *xdg) return std::filesystem::path(xdg) / "haze";
   if (const char* home = std::getenv("HOME"); home && *home) return std::filesystem::path(home) / ".cache" / "haze";
   return std::filesystem::temp_directory_path() / "haze";
-}
-
-// Registry look-ups for solution.cpp.
-MethodInfo method_info(const std::string& name) {
-  create_method(name);  // the error lists the available methods
-  auto& r = registry();
-  std::lock_guard lock(r.mutex);
-  return r.methods.at(name);
 }
 
 ParticleMediumFactory particle_medium_factory() {

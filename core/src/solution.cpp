@@ -20,30 +20,24 @@ struct Solution::State {
   std::optional<MediumDesc> particle_medium;  // the particles' medium, for a method that does not read them
   std::vector<size_t> kept;                   // the method's light k is scene.lights[kept[k]]
   nlohmann::json culled = nlohmann::json::array();
+  // The scene the method sees: the particles' medium where it needs one, the kept lights only.
+  Scene seen;
   std::unique_ptr<MethodSolution> solution;
 
-  // The scene the method sees: the particles' medium where it needs one, the kept lights only.
-  Scene method_scene() const {
-    Scene s = scene;
-    if (particle_medium) s.medium = particle_medium;
-    s.lights.clear();
-    for (size_t i : kept) s.lights.push_back(scene.lights[i]);
-    return s;
-  }
-
-  // Decides which lights the method sees; true when that changed.
+  // Decides which lights the method sees (made again from `scene`); true when that changed.
   bool cull() {
-    Scene s = scene;
-    if (particle_medium) s.medium = particle_medium;
-    const std::vector<CulledLight> found = culled_lights(s, info.single_scattering && options.single_view);
+    seen = scene;
+    if (particle_medium) seen.medium = particle_medium;
+    const std::vector<CulledLight> found = culled_lights(seen, info.single_scattering && options.single_view);
     std::vector<size_t> kept_now;
     culled = nlohmann::json::array();
+    seen.lights.clear();
     for (size_t i = 0, c = 0; i < scene.lights.size(); ++i) {
       // A scene whose lights all reach nothing renders as it is.
       if (c < found.size() && found[c].index == i && found.size() < scene.lights.size())
         culled.push_back({{"index", i}, {"why", found[c++].why}});
       else
-        kept_now.push_back(i);
+        kept_now.push_back(i), seen.lights.push_back(scene.lights[i]);
     }
     const bool changed = kept_now != kept;
     kept = std::move(kept_now);
@@ -72,7 +66,7 @@ struct Solution::State {
   void prepare(const ProgressCallback& progress) {
     RenderOptions o = options;
     o.progress = progress;
-    solution = naming_lights([&] { return method->prepare(method_scene(), o); });
+    solution = naming_lights([&] { return method->prepare(seen, o); });
     if (!culled.empty()) solution->stats["culled_lights"] = culled;
   }
 
@@ -93,6 +87,17 @@ struct Solution::State {
     return static_cast<size_t>(it - kept.begin());
   }
 };
+
+Scene view_scene(const Scene& scene, const Camera& camera) {
+  Scene seen;
+  seen.camera = camera;
+  seen.directory = scene.directory;
+  seen.lights = scene.lights;
+  seen.surfaces = scene.surfaces;
+  seen.background = scene.background;
+  seen.method = scene.method;
+  return seen;
+}
 
 Solution::Solution(std::unique_ptr<State> state) : state_(std::move(state)) {}
 Solution::Solution(Solution&&) noexcept = default;
@@ -134,17 +139,15 @@ UpdateReport Solution::update(const SceneChange& change, const RenderOptions& op
   if (change.lights) next.lights = *change.lights;
   if (change.surfaces) next.surfaces = *change.surfaces;
   std::swap(s.scene, next);
-  const std::vector<size_t> kept_before = s.kept;
-  const nlohmann::json culled_before = s.culled;
   UpdateReport report;
   try {
     const bool kept_changed = s.cull();
     SceneChange method_change = change;
-    if (change.lights || kept_changed) method_change.lights = s.method_scene().lights;
+    if (change.lights || kept_changed) method_change.lights = s.seen.lights;
     RenderOptions o = s.options;
     o.threads = options.threads;
     o.progress = options.progress;
-    std::optional<UpdateReport> done = s.naming_lights([&] { return s.solution->update(s.method_scene(), method_change, o); });
+    std::optional<UpdateReport> done = s.naming_lights([&] { return s.solution->update(s.seen, method_change, o); });
     if (done) {
       report = std::move(*done);
       if (!s.culled.empty())
@@ -159,7 +162,7 @@ UpdateReport Solution::update(const SceneChange& change, const RenderOptions& op
     }
   } catch (...) {  // a change that cannot be applied leaves the solution as it was
     std::swap(s.scene, next);
-    s.kept = kept_before, s.culled = culled_before;
+    s.cull();
     throw;
   }
   report.seconds = watch.seconds();

@@ -137,8 +137,7 @@ class DomMethodSolution final : public GridSolution {
 
   RenderResult render(const View& view, const RenderOptions& options) const override {
     const Stopwatch watch;
-    Scene seen = scene_;
-    seen.camera = view.camera;
+    const Scene seen = view_scene(scene_, view.camera);
     RenderResult result{render_dom(seen, volume_, depths_, solution_, step_cells_, options), std::nullopt, {}};
     result.stats["render_seconds"] = watch.seconds();
     return result;
@@ -151,24 +150,12 @@ class DomMethodSolution final : public GridSolution {
     UpdateReport report;
     Stopwatch watch;
     depth_.threads = settings_.threads = options.threads;
-    std::vector<Light> old_delta, delta;
-    for (const Light& l : scene_.lights)
-      if (!std::holds_alternative<SkyLight>(l)) old_delta.push_back(l);
-    for (const Light& l : scene.lights)
-      if (!std::holds_alternative<SkyLight>(l)) delta.push_back(l);
-    bool all = false;
     if (change.medium) {
       const std::array<int, 3> shape = volume_.density.resolution();
       report.redone.push_back(replace_volume(scene, change, resolution_, 0.0, options.threads));
       if (volume_.density.resolution() != shape) return std::nullopt;  // a new shape: solve again
-      all = true;
     }
-    depths_.resize(delta.size(), DenseGrid(volume_.density.resolution(), volume_.density.bounds()));
-    for (size_t i = 0; i < delta.size(); ++i) {
-      if (!all && i < old_delta.size() && delta[i] == old_delta[i]) continue;
-      depths_[i] = optical_depth(volume_.density, delta[i], depth_);
-      report.redone.push_back("optical depth of delta light " + std::to_string(i));
-    }
+    update_depths(scene, change.medium.has_value(), depth_, report);
     report.stats["depth_seconds"] = watch.lap();
     const bool relit = change.medium || change.lights;
     if (relit) {

@@ -15,22 +15,27 @@ namespace haze::grids {
 
 namespace {
 
+void check_lights(const std::vector<Light>& lights) {
+  for (size_t i = 0; i < lights.size(); ++i)
+    if (std::holds_alternative<SkyLight>(lights[i]))
+      throw Error("lights[" + std::to_string(i) + "].type", "sky", "point, spot or directional lights for the propagation method");
+}
+
 // Prepared: the extinction volume and one optical-depth volume per light.
 class PropagationSolution final : public GridSolution {
  public:
-  PropagationSolution(const Scene& scene, PropagationFields fields, DepthOptions depth, int resolution, double cutoff)
+  PropagationSolution(const Scene& scene, PropagationFields fields)
       : GridSolution(scene, std::move(fields.volume), std::move(fields.depths), fields.march.step_cells),
         march_(fields.march),
-        depth_(depth),
-        resolution_(resolution),
-        cutoff_(cutoff) {
+        depth_(fields.depth),
+        resolution_(fields.resolution),
+        cutoff_(fields.cutoff) {
     stats = std::move(fields.stats);
   }
 
   RenderResult render(const View& view, const RenderOptions& options) const override {
     const Stopwatch watch;
-    Scene seen = scene_;
-    seen.camera = view.camera;
+    const Scene seen = view_scene(scene_, view.camera);
     RenderResult result{march_image(seen, volume_, depths_, march_, options), std::nullopt, {}};
     result.stats["march_seconds"] = watch.seconds();
     return result;
@@ -39,25 +44,15 @@ class PropagationSolution final : public GridSolution {
   // A new density (re-injected by region where it can: replace_volume) redoes every light's depth,
   // new lights only the lights that differ.
   std::optional<UpdateReport> update(const Scene& scene, const SceneChange& change, const RenderOptions& options) override {
-    for (size_t i = 0; i < scene.lights.size(); ++i)
-      if (std::holds_alternative<SkyLight>(scene.lights[i]))
-        throw Error("lights[" + std::to_string(i) + "].type", "sky", "point, spot or directional lights for the propagation method");
+    check_lights(scene.lights);
     UpdateReport report;
     Stopwatch watch;
     depth_.threads = options.threads;
-    std::vector<bool> redo(scene.lights.size(), false);
     if (change.medium) {
       report.redone.push_back(replace_volume(scene, change, resolution_, cutoff_, options.threads));
       report.stats["inject_seconds"] = watch.lap();
-      redo.assign(redo.size(), true);
     }
-    for (size_t i = 0; i < scene.lights.size(); ++i) redo[i] = redo[i] || i >= scene_.lights.size() || !(scene.lights[i] == scene_.lights[i]);
-    depths_.resize(scene.lights.size(), DenseGrid(volume_.density.resolution(), volume_.density.bounds()));
-    for (size_t i = 0; i < scene.lights.size(); ++i) {
-      if (!redo[i]) continue;
-      depths_[i] = optical_depth(volume_.density, scene.lights[i], depth_);
-      report.redone.push_back("optical depth of lights[" + std::to_string(i) + "]");
-    }
+    update_depths(scene, change.medium.has_value(), depth_, report);
     report.stats["propagate_seconds"] = watch.lap();
     scene_ = scene;
     return report;
@@ -73,14 +68,7 @@ class PropagationSolution final : public GridSolution {
 class PropagationMethod final : public Method {
  public:
   std::unique_ptr<MethodSolution> prepare(const Scene& scene, const RenderOptions& options) const override {
-    PropagationFields fields = propagation_fields(scene, options);
-    // The settings again, for updates (propagation_fields checked them).
-    const int resolution = options.settings.value("resolution", 64);
-    const double cutoff = options.settings.value("cutoff", 0.0);
-    DepthOptions depth;
-    depth.scheme = depth_scheme_from_name(options.settings.value("optical_depth", std::string("sweep")));
-    depth.sweep_layers = options.settings.value("sweep_layers", depth.sweep_layers);
-    return std::make_unique<PropagationSolution>(scene, std::move(fields), depth, resolution, cutoff);
+    return std::make_unique<PropagationSolution>(scene, propagation_fields(scene, options));
   }
 };
 
@@ -97,9 +85,7 @@ PropagationFields propagation_fields(const Scene& scene, const RenderOptions& op
   const double cutoff = settings.number("cutoff");
   settings.reject_unknown();
 
-  for (size_t i = 0; i < scene.lights.size(); ++i)
-    if (std::holds_alternative<SkyLight>(scene.lights[i]))
-      throw Error("lights[" + std::to_string(i) + "].type", "sky", "point, spot or directional lights for the propagation method");
+  check_lights(scene.lights);
   Stopwatch watch;
   VolumeReport report;
   PropagationFields fields{make_extinction_volume(scene, resolution, cutoff, options.threads, &report), {}, MarchSettings{step_cells}, {}};
@@ -113,6 +99,7 @@ PropagationFields propagation_fields(const Scene& scene, const RenderOptions& op
                   {"truncation_bound", report.truncation_bound},
                   {"inject_seconds", inject_seconds},
                   {"propagate_seconds", watch.seconds()}};
+  fields.resolution = resolution, fields.cutoff = cutoff, fields.depth = depth;
   return fields;
 }
 

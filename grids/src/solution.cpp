@@ -2,6 +2,7 @@
 #include <haze/grids/solution.h>
 
 #include <haze/core/error.h>
+#include <haze/grids/optical_depth.h>
 #include <haze/grids/rbf.h>
 
 #include "trilinear.h"
@@ -54,6 +55,24 @@ std::string GridSolution::replace_volume(const Scene& scene, const SceneChange& 
   }
   volume_.sigma_t_scale = next.sigma_t, volume_.albedo = next.albedo, volume_.phase = next.phase;
   return redone;
+}
+
+void GridSolution::update_depths(const Scene& scene, bool all, const DepthOptions& depth, UpdateReport& report) {
+  std::vector<const Light*> before;
+  for (const Light& l : scene_.lights)
+    if (!std::holds_alternative<SkyLight>(l)) before.push_back(&l);
+  size_t d = 0;
+  for (size_t i = 0; i < scene.lights.size(); ++i) {
+    const Light& light = scene.lights[i];
+    if (std::holds_alternative<SkyLight>(light)) continue;
+    if (d == depths_.size()) depths_.emplace_back(volume_.density.resolution(), volume_.density.bounds());
+    if (all || d >= before.size() || !(light == *before[d])) {
+      depths_[d] = optical_depth(volume_.density, light, depth);
+      report.redone.push_back("optical depth of lights[" + std::to_string(i) + "]");
+    }
+    ++d;
+  }
+  depths_.resize(d, DenseGrid(volume_.density.resolution(), volume_.density.bounds()));
 }
 
 size_t GridSolution::depth_index(size_t light) const {

@@ -201,8 +201,7 @@ class NetworkMethodSolution final : public MethodSolution {
 
   RenderResult render(const View& view, const RenderOptions& options) const override {
     const Stopwatch watch;
-    Scene seen = scene_;
-    seen.camera = view.camera;
+    const Scene seen = view_scene(scene_, view.camera);
     RenderResult result{render_network(seen, field_, solution_, options), std::nullopt, {}};
     result.stats["render_seconds"] = watch.seconds();
     return result;

@@ -48,6 +48,11 @@ struct RenderResult {
   nlohmann::json stats = nlohmann::json::object();  // method-specific figures for --json
 };
 
+// What a prepared method's renderer needs of `scene` seen from `camera`: its lights, surfaces,
+// background and directory, without the medium and particles (which the solution holds in its own
+// form, and which a render need not copy).
+Scene view_scene(const Scene& scene, const Camera& camera);
+
 // What changed since a solution was prepared (or last updated); unset fields are unchanged.
 struct SceneChange {
   std::optional<MediumDesc> medium = std::nullopt;  // the new medium: density, coefficients, phase

@@ -7,6 +7,7 @@
 #include <haze/core/method.h>
 #include <haze/core/scene.h>
 #include <haze/grids/grid.h>
+#include <haze/grids/optical_depth.h>
 
 #include <memory>
 #include <vector>
@@ -56,6 +57,10 @@ struct PropagationFields {
   std::vector<DenseGrid> depths;  // one per light
   MarchSettings march;
   nlohmann::json stats;
+  // The settings they were made with, for updates.
+  int resolution = 64;
+  double cutoff = 0.0;
+  DepthOptions depth = {};
 };
 PropagationFields propagation_fields(const Scene& scene, const RenderOptions& options);
 
