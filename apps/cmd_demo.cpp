@@ -37,6 +37,7 @@ struct DemoArgs {
 };
 
 constexpr long long kPilotSpp = 64;
+constexpr double kCheapSeconds = 0.5;  // a method this quick at the reference's size is shown at twice it
 
 // What the demo renders a scene at, and the reference it compares with: the finest of 1%
 // noise and what reference_seconds buys, at twice the scene's size where that still reaches 2%.
@@ -109,11 +110,24 @@ Rgb error_colour(double e) {
   return {1.0, 1.0, (t - 0.5) / 0.5};
 }
 
-// Top row: the reference, then each method; bottom row: the reference's own noise, then each
-// method's error against it, per pixel (|image - reference| over the reference's luminance, at
-// least 1% of its peak).
-void write_sheet(const std::filesystem::path& path, const Image& reference, const Image& noise, const std::vector<Image>& images) {
-  const int w = reference.width(), h = reference.height(), n = static_cast<int>(images.size()) + 1;
+// A 2x image averaged over 2 x 2 pixels: what it shows at the reference's size.
+Image downsample2(const Image& image) {
+  Image out(image.width() / 2, image.height() / 2);
+  for (int y = 0; y < out.height(); ++y)
+    for (int x = 0; x < out.width(); ++x)
+      out.set(x, y, 0.25 * (image.at(2 * x, 2 * y) + image.at(2 * x + 1, 2 * y) + image.at(2 * x, 2 * y + 1) + image.at(2 * x + 1, 2 * y + 1)));
+  return out;
+}
+
+// Top row: the reference, then each method (`shown`, at the reference's size or twice it; the
+// cells take the largest, smaller images enlarged); bottom row: the reference's own noise, then
+// each method's error against it (`compared`, at the reference's size), per pixel: |image -
+// reference| over the reference's luminance, at least 1% of its peak.
+void write_sheet(const std::filesystem::path& path, const Image& reference, const Image& noise, const std::vector<Image>& shown,
+                 const std::vector<Image>& compared) {
+  const int w = reference.width(), h = reference.height(), n = static_cast<int>(shown.size()) + 1;
+  int f = 1;  // the cells' scale over the reference's pixels
+  for (const Image& image : shown) f = std::max(f, image.width() / w);
   std::vector<double> lum;
   double peak = 0.0;
   for (int y = 0; y < h; ++y)
@@ -121,15 +135,18 @@ void write_sheet(const std::filesystem::path& path, const Image& reference, cons
   std::vector<double> sorted = lum;
   std::sort(sorted.begin(), sorted.end());
   const double exposure = 1.0 / std::max(sorted[sorted.size() * 95 / 100], 1e-12);
-  Image sheet(n * w, 2 * h);
+  Image sheet(n * f * w, 2 * f * h);
   for (int i = 0; i < n; ++i) {
-    const Image& top = i == 0 ? reference : images[static_cast<size_t>(i - 1)];
-    for (int y = 0; y < h; ++y)
-      for (int x = 0; x < w; ++x) {
-        const double scale = std::max(lum[static_cast<size_t>(y * w + x)], 0.01 * peak);
-        const double e = i == 0 ? luminance(noise.at(x, y)) / scale : luminance(glm::abs(top.at(x, y) - reference.at(x, y))) / scale;
-        sheet.set(i * w + x, y, top.at(x, y) * exposure);
-        sheet.set(i * w + x, h + y, untonemap(error_colour(e)));
+    const Image& top = i == 0 ? reference : shown[static_cast<size_t>(i - 1)];
+    const int g = top.width() / w;  // this image's scale
+    for (int y = 0; y < f * h; ++y)
+      for (int x = 0; x < f * w; ++x) {
+        const int rx = x / f, ry = y / f;
+        const double scale = std::max(lum[static_cast<size_t>(ry * w + rx)], 0.01 * peak);
+        const double e = i == 0 ? luminance(noise.at(rx, ry)) / scale
+                                : luminance(glm::abs(compared[static_cast<size_t>(i - 1)].at(rx, ry) - reference.at(rx, ry))) / scale;
+        sheet.set(i * f * w + x, y, top.at(x * g / f, y * g / f) * exposure);
+        sheet.set(i * f * w + x, f * h + y, untonemap(error_colour(e)));
       }
   }
   write_png(path, sheet);
@@ -189,26 +206,42 @@ int run(const DemoArgs& a) {
       std::printf("%-16s %-12s   errors under %s are not resolved; --reference-seconds %.0f would bring the noise to about 5%%\n", "", "",
                   percent(1.5 * reference_noise).c_str(),
                   a.reference_seconds * (reference_noise / 0.05) * (reference_noise / 0.05));
-    std::vector<Image> images;
+    std::vector<Image> shown, compared;
     std::string order = "reference";
     for (const auto& method : methods) {
-      RenderOptions options;
-      options.threads = a.threads;
-      options.cache_dir = default_cache_dir();
-      ProgressBar bar(stem + " " + method.name);
-      options.progress = bar.callback();
-      try {
-        Stopwatch watch;
-        RenderResult result = render(scene, method.name, options);
+      auto timed = [&](const Scene& at, const std::string& label) {
+        RenderOptions options;
+        options.threads = a.threads;
+        options.cache_dir = default_cache_dir();
+        ProgressBar bar(label);
+        options.progress = bar.callback();
+        const Stopwatch watch;
+        RenderResult r = render(at, method.name, options);
         seconds = watch.seconds();
+        return r;
+      };
+      try {
+        RenderResult result = timed(scene, stem + " " + method.name);
+        Image at_reference = result.radiance;
+        std::string shown_size = size;
+        // Where the method is cheap and the reference small, show it at twice the size (compared
+        // with the reference averaged back over 2 x 2 pixels).
+        if (p.scale == 1 && seconds < kCheapSeconds) {
+          const Scene large = scaled(scene, 2);
+          result = timed(large, stem + " " + method.name + " 2x");
+          at_reference = downsample2(result.radiance);
+          shown_size = to_text(large.camera.width_px) + "x" + to_text(large.camera.height_px);
+        }
         auto exr = std::filesystem::path(a.out) / (stem + "_" + method.name + ".exr");
         save_result(result, method.name, seconds, exr, true);
         ++rendered;
-        const double error = lit_pixel_error(result.radiance, reference, &noise).mean_abs;
+        const double error = lit_pixel_error(at_reference, reference, &noise).mean_abs;
         // Within 1.5x the reference's noise the error is not resolved: say so.
-        const std::string shown = error < 1.5 * reference_noise ? "~noise" : percent(error);
-        std::printf("%-16s %-12s %9s %10.3f %9s  %s\n", stem.c_str(), method.name.c_str(), size.c_str(), seconds, shown.c_str(), exr.string().c_str());
-        images.push_back(std::move(result.radiance));
+        const std::string error_text = error < 1.5 * reference_noise ? "~noise" : percent(error);
+        std::printf("%-16s %-12s %9s %10.3f %9s  %s\n", stem.c_str(), method.name.c_str(), shown_size.c_str(), seconds, error_text.c_str(),
+                    exr.string().c_str());
+        shown.push_back(std::move(result.radiance));
+        compared.push_back(std::move(at_reference));
         order += " | " + method.name;
       } catch (const Cancelled&) {
         throw;
@@ -218,11 +251,12 @@ int run(const DemoArgs& a) {
       std::fflush(stdout);
     }
     const auto sheet = std::filesystem::path(a.out) / (stem + "_sheet.png");
-    write_sheet(sheet, reference, noise, images);
+    write_sheet(sheet, reference, noise, shown, compared);
     std::printf("%-16s %-12s %9s %10s %9s  %s: %s\n\n", stem.c_str(), "sheet", "", "", "", sheet.string().c_str(), order.c_str());
   }
   std::printf("error: mean relative error over the lit pixels (those above 1%% of the reference's peak) against the\n"
-              "reference, whose own noise is its row's figure; \"~noise\" marks errors within 1.5x that noise. The\n"
+              "reference, whose own noise is its row's figure; \"~noise\" marks errors within 1.5x that noise. Methods\n"
+              "quick at the reference's size are rendered at twice it and compared averaged over 2 x 2 pixels. The\n"
               "reference solves the full transport: single-scattering methods also differ by the multiple scattering\n"
               "and shadows they leave out (docs/METHODS.md). Sheets: images on top (the order printed), error maps\n"
               "below (the reference's noise first; black 0, red 5%%, yellow 10%%, white 20%% and more).\n");

@@ -7,10 +7,7 @@
 namespace haze::app {
 
 std::string methods_help() {
-  std::string out =
-      "Methods and their settings (--set key=value). Particle scenes rendered by a method other than network also take\n"
-      "particle_resolution (96: the grid their density is sampled on) and particle_density (\"grid\", or \"gaussians\": the\n"
-      "reference and quadrature read the Gaussians themselves, about 100x slower):\n";
+  std::string out = "Methods and their settings (--set key=value):\n";
   for (const MethodInfo& m : registered_methods()) out += m.name + ": " + m.summary + "\n" + settings_help(m);
   return out;
 }

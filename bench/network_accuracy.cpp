@@ -9,6 +9,7 @@
 #include <haze/core/method.h>
 #include <haze/core/stopwatch.h>
 #include <haze/core/rng.h>
+#include <haze/particles/field.h>
 #include <haze/particles/methods.h>
 
 #include <cmath>
@@ -68,7 +69,8 @@ Scene three_balls(const Scene& like, int count) {
       }
   }
   Scene scene = like;
-  scene.particles = {{"positions", positions}, {"sigma_t", {6.0, 6.6, 7.2}}, {"albedo", 0.9}, {"phase", {{"type", "hg"}, {"g", 0.3}}}};
+  scene.medium = particles::particle_medium(particles::ParticleSet::from_json(
+      {{"positions", positions}, {"sigma_t", {6.0, 6.6, 7.2}}, {"albedo", 0.9}, {"phase", {{"type", "hg"}, {"g", 0.3}}}}));
   return scene;
 }
 

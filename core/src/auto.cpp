@@ -88,12 +88,19 @@ SceneFeatures scene_features(const Scene& scene) {
     f.sky = f.sky || std::holds_alternative<SkyLight>(l);
     f.directional = f.directional || std::holds_alternative<DirectionalLight>(l);
   }
-  if (!scene.medium) {
-    f.particles = !scene.particles.is_null() && !scene.particles.empty();
-    return f;
-  }
+  if (!scene.medium) return f;
   const MediumDesc& desc = *scene.medium;
   f.homogeneous = std::holds_alternative<ConstantDensity>(desc.density);
+  f.density = std::visit(
+      [](const auto& d) -> std::string {
+        using D = std::decay_t<decltype(d)>;
+        if constexpr (std::is_same_v<D, ConstantDensity>) return "constant";
+        else if constexpr (std::is_same_v<D, RbfDensity>) return "rbf";
+        else if constexpr (std::is_same_v<D, GridDensity>) return "grid";
+        else return d.type;
+      },
+      desc.density);
+  if (field_density(f)) return f;
   const auto medium = make_medium(desc);
   Aabb box = medium->bounds();
   f.bounded = box.bounded();
@@ -127,10 +134,10 @@ namespace {
 // The cheapest registered method's offer (MethodInfo::offer), else the reference.
 AutoChoice choose(const Scene& scene, double tolerance) {
   const SceneFeatures f = scene_features(scene);
-  if (!f.particles && !scene.medium) throw Error("medium", "missing", "a medium or particles for method auto");
+  if (!scene.medium) throw Error("medium", "missing", "a medium (or particles) for method auto");
   AutoChoice c;
   c.why.push_back(format("tolerance %.1f%%", 100.0 * tolerance));
-  if (f.particles) c.why.push_back("particles, no grid medium");
+  if (field_density(f)) c.why.push_back("density from the " + f.density + " module: no optical diameter estimated");
   else
     c.why.push_back(format("optical diameter %.2f, albedo %.2f: estimated multiple-scattering share %.0f%%", f.optical_diameter, f.albedo,
                            100.0 * f.multiple_share));
@@ -164,7 +171,6 @@ MethodInfo internal::auto_info() {
   info.handles = {"what the chosen method handles", "what the chosen method handles", "what the chosen method handles", true};
   info.settings = {SettingInfo::number("tolerance", 0.05, 1e-4, 0.99, "the relative error to stay under (mean over lit pixels)")};
   for (double t : {0.05, 0.02, 0.01}) info.trade_sweep.push_back({{"tolerance", t}});
-  info.reads_particles = true;  // the chosen method's own preparation decides
   return info;
 }
 

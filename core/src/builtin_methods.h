@@ -4,17 +4,15 @@
 #include <haze/core/method.h>
 
 namespace haze {
-// The registry's entry for a method (throws haze::Error listing the methods when unknown) and the
-// particle module's conversion, if registered (method.cpp, for solution.cpp).
+// The registry's entry for a method (throws haze::Error listing the methods when unknown;
+// method.cpp, for solution.cpp).
 MethodInfo method_info(const std::string& name);
-ParticleMediumFactory particle_medium_factory();
 }  // namespace haze
 
 namespace haze::internal {
 
 // The value of the haze::Error a MethodSolution without lighting fields throws.
 inline constexpr const char* kNoField = "not kept by this method";
-
 
 // Deterministic single scattering by numerical quadrature (quadrature.cpp).
 MethodInfo quadrature_info();

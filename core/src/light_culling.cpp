@@ -93,7 +93,6 @@ std::vector<CulledLight> culled_lights(const Scene& scene, bool single_scatterin
         culled.push_back({i, "spot light whose cone misses the view (the method sees single scattering only)"});
         continue;
       }
-      if (!scene.particles.is_null()) continue;
       if (scene.medium) {
         const Aabb bounds = medium_bounds(*scene.medium);
         if (!bounds.bounded()) continue;

@@ -1,4 +1,5 @@
 #include <haze/core/error.h>
+#include <haze/core/grid_walk.h>
 #include <haze/core/majorant.h>
 #include <haze/core/medium.h>
 #include <haze/core/progress.h>
@@ -125,26 +126,7 @@ class GridMedium final : public Medium {
   // Trilinear between cell centres, clamped to the outermost centres inside the bounds.
   double density(const Vec3& x) const override {
     if (!bounds_.contains(x)) return 0.0;
-    const auto& r = resolution_;
-    Vec3 u = (x - bounds_.lo) / bounds_.extent() * Vec3(r[0], r[1], r[2]) - 0.5;
-    int i0[3], i1[3];
-    double f[3];
-    for (int a = 0; a < 3; ++a) {
-      double c = std::clamp(u[a], 0.0, static_cast<double>(r[a] - 1));
-      i0[a] = std::min(static_cast<int>(c), r[a] - 1);
-      i1[a] = std::min(i0[a] + 1, r[a] - 1);
-      f[a] = c - i0[a];
-    }
-    auto at = [&](int x_, int y_, int z_) {
-      return static_cast<double>(values_[(static_cast<size_t>(z_) * static_cast<size_t>(r[1]) + static_cast<size_t>(y_)) * static_cast<size_t>(r[0]) + static_cast<size_t>(x_)]);
-    };
-    double c00 = at(i0[0], i0[1], i0[2]) * (1 - f[0]) + at(i1[0], i0[1], i0[2]) * f[0];
-    double c10 = at(i0[0], i1[1], i0[2]) * (1 - f[0]) + at(i1[0], i1[1], i0[2]) * f[0];
-    double c01 = at(i0[0], i0[1], i1[2]) * (1 - f[0]) + at(i1[0], i0[1], i1[2]) * f[0];
-    double c11 = at(i0[0], i1[1], i1[2]) * (1 - f[0]) + at(i1[0], i1[1], i1[2]) * f[0];
-    double c0 = c00 * (1 - f[1]) + c10 * f[1];
-    double c1 = c01 * (1 - f[1]) + c11 * f[1];
-    return c0 * (1 - f[2]) + c1 * f[2];
+    return TrilinearStencil(bounds_, resolution_, x).apply(values_.data());
   }
   // The largest sample among the cells whose centres the region's trilinear lookups can touch.
   double max_density(const Aabb& region) const override {
@@ -186,6 +168,12 @@ class FieldMedium final : public Medium {
   double density_integral(const Vec3& a, const Vec3& b) const override {
     if (const std::optional<double> exact = field_->density_integral(a, b)) return *exact;
     return Medium::density_integral(a, b);
+  }
+
+ protected:
+  std::shared_ptr<const MajorantGrid> make_majorants() const override {
+    if (auto own = field_->majorants()) return own;
+    return Medium::make_majorants();
   }
 
  private:

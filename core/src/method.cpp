@@ -16,7 +16,6 @@ namespace {
 struct Registry {
   std::mutex mutex;
   std::map<std::string, MethodInfo> methods;
-  ParticleMediumFactory particle_medium;
   Registry() {
     for (MethodInfo info : {internal::quadrature_info(), internal::reference_info(), internal::analytic_info(), internal::auto_info()})
       methods[info.name] = std::move(info);
@@ -45,12 +44,6 @@ std::vector<MethodInfo> registered_methods() {
   return out;
 }
 
-void register_particle_medium(ParticleMediumFactory factory) {
-  auto& r = registry();
-  std::lock_guard lock(r.mutex);
-  r.particle_medium = std::move(factory);
-}
-
 // The registry's entry for a method (builtin_methods.h).
 MethodInfo method_info(const std::string& name) {
   auto& r = registry();
@@ -71,12 +64,6 @@ std::filesystem::path default_cache_dir() {
   if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg && *xdg) return std::filesystem::path(xdg) / "haze";
   if (const char* home = std::getenv("HOME"); home && *home) return std::filesystem::path(home) / ".cache" / "haze";
   return std::filesystem::temp_directory_path() / "haze";
-}
-
-ParticleMediumFactory particle_medium_factory() {
-  auto& r = registry();
-  std::lock_guard lock(r.mutex);
-  return r.particle_medium;
 }
 
 std::optional<UpdateReport> MethodSolution::update(const Scene&, const SceneChange&, const RenderOptions&) { return std::nullopt; }

@@ -10,6 +10,8 @@
 #include <fstream>
 #include <initializer_list>
 #include <iterator>
+#include <map>
+#include <mutex>
 #include <new>
 #include <string_view>
 #include <utility>
@@ -439,17 +441,43 @@ std::vector<T> read_array(const Object& top, const char* key, Read read) {
   return out;
 }
 
+constexpr std::string_view kSceneFields[] = {"camera", "medium", "lights", "surfaces", "background", "method"};
+
+struct DensityRegistry {
+  std::mutex mutex;
+  std::map<std::string, DensityReader> readers;
+};
+DensityRegistry& densities() {
+  static DensityRegistry instance;
+  return instance;
+}
+
 Scene parse(const json& j, const fs::path& base_dir) {
   Object top(j, "");
-  top.allow({"camera", "medium", "particles", "lights", "surfaces", "background", "method"});
+  const std::vector<std::string> types = registered_densities();
+  for (const auto& [key, value] : j.items()) {
+    if (std::find(std::begin(kSceneFields), std::end(kSceneFields), key) != std::end(kSceneFields)) continue;
+    if (std::find(types.begin(), types.end(), key) != types.end()) continue;
+    std::string fields;
+    for (std::string_view f : kSceneFields) fields += (fields.empty() ? "" : ", ") + std::string(f);
+    for (const std::string& t : types) fields += ", " + t;
+    throw Error(key, "unknown field \"" + key + "\"",
+                "a field of the scene: " + fields + ", or a density type a module registers (haze::particles::register_methods() registers particles)");
+  }
   Scene scene;
   scene.directory = base_dir;
   scene.camera = read_camera(Object(top.need("camera", "a camera object"), "camera"));
   if (const json* m = top.find("medium")) scene.medium = read_medium(Object(*m, "medium"), base_dir);
-  if (const json* p = top.find("particles")) {
-    // Only its shape is checked here; the particle module validates the rest.
-    if (!p->is_object()) throw Error("particles", text(*p), "a JSON object {...}");
-    scene.particles = *p;
+  for (const std::string& type : types) {
+    const json* block = top.find(type.c_str());
+    if (!block) continue;
+    if (scene.medium) throw Error(type, "given with a medium", "one of `medium` and `" + type + "`: a scene has one medium");
+    DensityReader reader;
+    {
+      std::lock_guard lock(densities().mutex);
+      reader = densities().readers.at(type);
+    }
+    scene.medium = reader(*block, type, base_dir);
   }
   scene.lights = read_array<Light>(top, "lights", read_light);
   scene.surfaces = read_array<Surface>(top, "surfaces", read_surface);
@@ -463,6 +491,20 @@ Scene parse(const json& j, const fs::path& base_dir) {
 }
 
 }  // namespace
+
+void register_density(const std::string& type, DensityReader reader) {
+  if (type.empty() || !reader || std::find(std::begin(kSceneFields), std::end(kSceneFields), type) != std::end(kSceneFields))
+    throw Error("density.type", "\"" + type + "\"", "a name no scene field has, and a reader");
+  std::lock_guard lock(densities().mutex);
+  densities().readers[type] = std::move(reader);
+}
+
+std::vector<std::string> registered_densities() {
+  std::lock_guard lock(densities().mutex);
+  std::vector<std::string> out;
+  for (const auto& [type, reader] : densities().readers) out.push_back(type);
+  return out;
+}
 
 MaterialDesc read_material(const nlohmann::json& j, const std::string& path) {
   const Object o(j, path);

@@ -1,6 +1,6 @@
 // haze::prepare, haze::Solution and haze::render (method.h): the registry's method on the caller's
-// scene, less the lights that reach nothing (light_culling.h), with the particles turned into a
-// medium for methods that do not read them, and errors about lights naming the caller's light.
+// scene, less the lights that reach nothing (light_culling.h), and errors about lights naming the
+// caller's light.
 #include "builtin_methods.h"
 
 #include <haze/core/error.h>
@@ -15,19 +15,17 @@ namespace haze {
 struct Solution::State {
   MethodInfo info;
   std::unique_ptr<Method> method;
-  Scene scene;                                // the caller's, with every update applied
-  RenderOptions options;                      // as prepared: settings merged, no progress
-  std::optional<MediumDesc> particle_medium;  // the particles' medium, for a method that does not read them
-  std::vector<size_t> kept;                   // the method's light k is scene.lights[kept[k]]
+  Scene scene;               // the caller's, with every update applied
+  RenderOptions options;     // as prepared: settings merged, no progress
+  std::vector<size_t> kept;  // the method's light k is scene.lights[kept[k]]
   nlohmann::json culled = nlohmann::json::array();
-  // The scene the method sees: the particles' medium where it needs one, the kept lights only.
+  // The scene the method sees: the kept lights only.
   Scene seen;
   std::unique_ptr<MethodSolution> solution;
 
   // Decides which lights the method sees (made again from `scene`); true when that changed.
   bool cull() {
     seen = scene;
-    if (particle_medium) seen.medium = particle_medium;
     const std::vector<CulledLight> found = culled_lights(seen, info.single_scattering && options.single_view);
     std::vector<size_t> kept_now;
     culled = nlohmann::json::array();
@@ -130,8 +128,6 @@ UpdateReport Solution::update(const SceneChange& change, const RenderOptions& op
   const Stopwatch watch;
   Scene next = s.scene;
   if (change.medium) {
-    if (s.particle_medium)
-      throw Error("change.medium", "a medium for a particle scene", "a scene with a medium (particles change through their set)");
     check_medium(*change.medium, "change.medium");
     next.medium = change.medium;
   }
@@ -194,13 +190,6 @@ Solution prepare(const Scene& scene, const std::string& method_name, RenderOptio
     throw Error("settings", options.settings.dump(), "an object of " + name + " settings");
   for (const auto& [key, value] : options.settings.items()) settings[key] = value;
   settings.erase("name");
-  if (!scene.particles.is_null() && !state->info.reads_particles) {
-    if (scene.medium)
-      throw Error("particles", "given with a medium", "one of `medium` and `particles` for method " + name + ", which renders one medium");
-    const ParticleMediumFactory factory = particle_medium_factory();
-    if (!factory) throw Error("particles", "no particle module registered", "haze::particles::register_methods() before rendering particles");
-    state->particle_medium = factory(scene, settings);
-  }
   const ProgressCallback progress = std::move(options.progress);
   options.settings = std::move(settings);
   state->options = std::move(options);

@@ -1,11 +1,10 @@
 // The ray marcher of method "propagation" (seed 003 sec. 4.4, eq. 8-10): the float64 reference
 // one pixel at a time, and the SIMD kernel (haze/simd/march_rays.h) over each image row.
 #include <haze/core/error.h>
+#include <haze/core/grid_walk.h>
 #include <haze/grids/optical_depth.h>
 #include <haze/grids/propagation.h>
 #include <haze/simd/march_rays.h>
-
-#include "trilinear.h"
 
 #include <algorithm>
 #include <cmath>
@@ -73,7 +72,7 @@ struct Marcher {
     LightArrival a;
     for (int i = 0; i < s.count; ++i) {
       const Vec3 x = ray.at(s.t0 + (i + 0.5) * s.dt);
-      const TrilinearStencil stencil(volume.density, x);
+      const TrilinearStencil stencil(volume.density.bounds(), volume.density.resolution(), x);
       double rho = 0.0;
       for (int m = 0; m < 8; ++m) rho += stencil.weight[m] * static_cast<double>(volume.density.values()[stencil.offset[m]]);
       if (rho <= 0.0) continue;

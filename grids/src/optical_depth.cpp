@@ -1,9 +1,8 @@
 #include <haze/core/error.h>
+#include <haze/core/grid_walk.h>
 #include <haze/core/progress.h>
 #include <haze/grids/optical_depth.h>
 #include <haze/simd/sweep_cells.h>
-
-#include "trilinear.h"
 
 #include <algorithm>
 #include <atomic>
@@ -43,35 +42,9 @@ LightGeometry geometry(const Light& light) {
 // integral of the piecewise-constant density from `origin` along unit `dir` over [0, t_max]
 // (Amanatides-Woo traversal of the cells the ray crosses inside the grid).
 double integrate_ray(const DenseGrid& grid, const Vec3& origin, const Vec3& dir, double t_max) {
-  double t0 = 0.0, t1 = t_max;
-  if (!grid.bounds().clip(Ray{origin, dir}, t0, t1) || !(t1 > t0)) return 0.0;
-  const Vec3 h = grid.cell_size(), lo = grid.bounds().lo;
-  const auto& n = grid.resolution();
-  const Vec3 start = origin + dir * t0;
-  int cell[3], step[3];
-  double t_next[3], t_delta[3];
-  for (int a = 0; a < 3; ++a) {
-    cell[a] = std::clamp(static_cast<int>(std::floor((start[a] - lo[a]) / h[a])), 0, n[static_cast<size_t>(a)] - 1);
-    if (dir[a] > 0.0) {
-      step[a] = 1, t_delta[a] = h[a] / dir[a];
-      t_next[a] = t0 + (lo[a] + (cell[a] + 1) * h[a] - start[a]) / dir[a];
-    } else if (dir[a] < 0.0) {
-      step[a] = -1, t_delta[a] = -h[a] / dir[a];
-      t_next[a] = t0 + (lo[a] + cell[a] * h[a] - start[a]) / dir[a];
-    } else {
-      step[a] = 0, t_delta[a] = kInfinity, t_next[a] = kInfinity;
-    }
-  }
-  double sum = 0.0, t = t0;
-  while (t < t1) {
-    int a = t_next[0] < t_next[1] ? (t_next[0] < t_next[2] ? 0 : 2) : (t_next[1] < t_next[2] ? 1 : 2);
-    double t_end = std::min(t_next[a], t1);
-    sum += static_cast<double>(grid.at(cell[0], cell[1], cell[2])) * (t_end - t);
-    t = t_end;
-    cell[a] += step[a];
-    if (cell[a] < 0 || cell[a] >= n[static_cast<size_t>(a)]) break;
-    t_next[a] += t_delta[a];
-  }
+  GridWalk walk(grid.bounds(), grid.resolution(), Ray{origin, dir}, 0.0, t_max);
+  double sum = 0.0;
+  for (CellSegment s; walk.next(s);) sum += static_cast<double>(grid.values()[s.cell]) * (s.t1 - s.t0);
   return sum;
 }
 
@@ -357,10 +330,7 @@ double density_integral_dda(const DenseGrid& density, const Vec3& a, const Vec3&
 
 float sample_trilinear(const DenseGrid& grid, const Vec3& p) {
   if (!grid.bounds().contains(p)) return 0.0f;
-  const TrilinearStencil stencil(grid, p);
-  double v = 0.0;
-  for (int m = 0; m < 8; ++m) v += stencil.weight[m] * static_cast<double>(grid.values()[stencil.offset[m]]);
-  return static_cast<float>(v);
+  return static_cast<float>(TrilinearStencil(grid.bounds(), grid.resolution(), p).apply(grid.values().data()));
 }
 
 }  // namespace haze::grids

@@ -2,10 +2,9 @@
 #include <haze/grids/solution.h>
 
 #include <haze/core/error.h>
+#include <haze/core/grid_walk.h>
 #include <haze/grids/optical_depth.h>
 #include <haze/grids/rbf.h>
-
-#include "trilinear.h"
 
 #include <algorithm>
 
@@ -14,7 +13,7 @@ namespace haze::grids {
 namespace {
 
 double sample(const DenseGrid& grid, const Vec3& x) {
-  const TrilinearStencil stencil(grid, x);
+  const TrilinearStencil stencil(grid.bounds(), grid.resolution(), x);
   double v = 0.0;
   for (int e = 0; e < 8; ++e) v += stencil.weight[e] * static_cast<double>(grid.values()[stencil.offset[e]]);
   return v;
@@ -33,7 +32,7 @@ Eigen::VectorXd moments_at(const DomSolution& s, int channel, const TrilinearSte
 // sum_k c_k m_k(x) per channel (one channel when the solve was grey).
 Rgb project(const DomSolution& s, const DenseGrid& grid, const Vec3& x, const Eigen::VectorXd& c) {
   if (!grid.bounds().contains(x)) return Rgb(0.0);
-  const TrilinearStencil stencil(grid, x);
+  const TrilinearStencil stencil(grid.bounds(), grid.resolution(), x);
   Rgb out(0.0);
   for (int ch = 0; ch < s.channels; ++ch) out[ch] = c.dot(moments_at(s, ch, stencil));
   return s.channels == 1 ? Rgb(out[0]) : out;

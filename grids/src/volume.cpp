@@ -57,4 +57,12 @@ ExtinctionVolume make_extinction_volume(const Scene& scene, int resolution, doub
   return volume;
 }
 
+MediumDesc ExtinctionVolume::medium() const {
+  MediumDesc m;
+  m.bounds = density.bounds();
+  m.density = GridDensity::viewing(density.resolution(), density.values());
+  m.sigma_t = sigma_t_scale, m.albedo = albedo, m.phase = phase;
+  return m;
+}
+
 }  // namespace haze::grids

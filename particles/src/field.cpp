@@ -12,10 +12,6 @@
 
 namespace haze::particles {
 
-namespace {
-constexpr double kCut = 3.0;  // each Gaussian ends at 3 h
-}
-
 ParticleField::ParticleField(const ParticleView& particles, int neighbours) : view_(particles) {
   validate(particles);
   const size_t n = particles.positions.size();
@@ -127,77 +123,6 @@ double ParticleField::max_density(const Aabb& region) const {
     if (r2 < kCut * kCut) bound += w_[p] * std::exp(-r2);
   }
   return bound;
-}
-
-ParticleDensity::ParticleDensity(ParticleSet set, int neighbours) : set_(std::move(set)), field_(set_.view(), neighbours) {
-  if (field_.size() == 0) return;
-  const Aabb b = field_.bounds();
-  origin_ = b.lo;
-  cell_ = kCut * field_.max_h();
-  for (int a = 0; a < 3; ++a) n_[static_cast<size_t>(a)] = std::clamp(static_cast<int>(std::ceil((b.hi[a] - b.lo[a]) / cell_)), 1, 256);
-  auto cell_of = [&](const Vec3& x) {
-    size_t c = 0;
-    for (int a = 2; a >= 0; --a) c = c * static_cast<size_t>(n_[static_cast<size_t>(a)]) + static_cast<size_t>(std::clamp(static_cast<int>((x[a] - origin_[a]) / cell_), 0, n_[static_cast<size_t>(a)] - 1));
-    return c;
-  };
-  start_.assign(static_cast<size_t>(n_[0]) * static_cast<size_t>(n_[1]) * static_cast<size_t>(n_[2]) + 1, 0);
-  for (size_t p = 0; p < field_.size(); ++p) ++start_[cell_of(field_.position(p)) + 1];
-  for (size_t c = 1; c < start_.size(); ++c) start_[c] += start_[c - 1];
-  order_.resize(field_.size());
-  std::vector<unsigned> fill(start_.begin(), start_.end() - 1);
-  for (size_t p = 0; p < field_.size(); ++p) order_[fill[cell_of(field_.position(p))]++] = static_cast<unsigned>(p);
-}
-
-// f(p) for every particle in the cells meeting [lo, hi].
-template <class F>
-void ParticleDensity::for_cells(const Vec3& lo, const Vec3& hi, const F& f) const {
-  int c0[3], c1[3];
-  for (int a = 0; a < 3; ++a) {
-    const double u0 = (lo[a] - origin_[a]) / cell_, u1 = (hi[a] - origin_[a]) / cell_;
-    if (!(u1 >= 0.0) || !(u0 < n_[static_cast<size_t>(a)])) return;
-    c0[a] = std::max(0, static_cast<int>(std::floor(u0)));
-    c1[a] = std::min(n_[static_cast<size_t>(a)] - 1, static_cast<int>(std::floor(u1)));
-  }
-  for (int k = c0[2]; k <= c1[2]; ++k)
-    for (int j = c0[1]; j <= c1[1]; ++j)
-      for (int i = c0[0]; i <= c1[0]; ++i) {
-        const size_t c = (static_cast<size_t>(k) * static_cast<size_t>(n_[1]) + static_cast<size_t>(j)) * static_cast<size_t>(n_[0]) + static_cast<size_t>(i);
-        for (unsigned e = start_[c]; e < start_[c + 1]; ++e) f(order_[e]);
-      }
-}
-
-double ParticleDensity::density(const Vec3& x) const {
-  if (field_.size() == 0) return 0.0;
-  const Vec3 reach(kCut * field_.max_h());
-  double rho = 0.0;
-  for_cells(x - reach, x + reach, [&](size_t p) {
-    const Vec3 d = x - field_.position(p);
-    const double h = field_.h(p), r2 = glm::dot(d, d) / (h * h);
-    if (r2 < kCut * kCut) rho += field_.weight(p) * std::exp(-r2);
-  });
-  return rho;
-}
-
-double ParticleDensity::max_density(const Aabb& region) const {
-  if (field_.size() == 0) return 0.0;
-  const Vec3 reach(kCut * field_.max_h());
-  double bound = 0.0;
-  // Each Gaussian at its largest in the region: at the region's point nearest its centre.
-  for_cells(region.lo - reach, region.hi + reach, [&](size_t p) {
-    const Vec3 x = field_.position(p);
-    const Vec3 d = x - glm::clamp(x, region.lo, region.hi);
-    const double h = field_.h(p), r2 = glm::dot(d, d) / (h * h);
-    if (r2 < kCut * kCut) bound += field_.weight(p) * std::exp(-r2);
-  });
-  return bound;
-}
-
-Aabb ParticleDensity::bounds() const { return field_.size() ? field_.bounds() : Aabb{Vec3(-1.0), Vec3(1.0)}; }
-
-std::optional<double> ParticleDensity::density_integral(const Vec3& a, const Vec3& b) const {
-  const double length = glm::length(b - a);
-  if (length == 0.0) return 0.0;
-  return field_.density_integral(a, (b - a) / length, length);
 }
 
 MediumDesc particle_medium(ParticleSet set, int grid_resolution, int neighbours) {

@@ -11,8 +11,6 @@
 namespace haze::particles {
 
 namespace {
-
-constexpr double kCut = 3.0;               // as field.h: each Gaussian ends at 3 h
 constexpr double kMaxValues = 16e6;        // floats per map (64 MB): texels are widened beyond it
 
 }  // namespace

@@ -6,28 +6,18 @@ namespace haze::particles {
 
 void register_methods() {
   register_method(network_info());
-  // Every other method renders the particles' continuous density sampled on a grid of
-  // `particle_resolution` cells along the longest side (96 unless the settings say), or with
-  // `particle_density` "gaussians" the Gaussians themselves (ParticleDensity: exact, and 50x
-  // slower in the reference, docs/NETWORKS.md), which the grid methods sample the same way.
-  register_particle_medium([](const Scene& scene, nlohmann::json& settings) {
+  // A scene's `particles` block: the Gaussians' own density (ParticleDensity), which the
+  // reference and quadrature render as it is and the grid methods sample on `grid_resolution`
+  // cells along the longest side (docs/NETWORKS.md).
+  register_density("particles", [](const nlohmann::json& block, const std::string& path, const std::filesystem::path& directory) {
     int resolution = 96;
-    if (auto it = settings.find("particle_resolution"); it != settings.end()) {
-      if (!it->is_number_integer() || it->get<int>() < 2 || it->get<int>() > 1024)
-        throw Error("method.particle_resolution", it->dump(), "an integer in [2, 1024]");
-      resolution = it->get<int>();
-      settings.erase(it);
-    }
-    std::string density = "grid";
-    if (auto it = settings.find("particle_density"); it != settings.end()) {
-      if (!it->is_string() || (*it != "grid" && *it != "gaussians"))
-        throw Error("method.particle_density", it->dump(), "\"grid\" or \"gaussians\"");
-      density = it->get<std::string>();
-      settings.erase(it);
-    }
-    ParticleSet set = ParticleSet::from_json(scene.particles, scene.directory);
-    if (density == "gaussians") return particle_medium(std::move(set), resolution);
-    return ParticleField(set.view()).to_medium(resolution, 0);
+    if (block.is_object())
+      if (auto it = block.find("grid_resolution"); it != block.end()) {
+        if (!it->is_number_integer() || it->get<long long>() < 2 || it->get<long long>() > 1024)
+          throw Error(path + ".grid_resolution", it->dump(), "an integer in [2, 1024]");
+        resolution = it->get<int>();
+      }
+    return particle_medium(ParticleSet::from_json(block, directory), resolution);
   });
 }
 

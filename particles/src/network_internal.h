@@ -11,8 +11,6 @@
 
 namespace haze::particles::network_internal {
 
-constexpr double kCut = 3.0;  // as field.h: each Gaussian ends at 3 h
-
 // Direction w's view of the window: a particle's pixel (its column) and its depth along w.
 struct Projector {
   Vec3 c, w, t1, t2;

@@ -13,7 +13,6 @@ namespace haze::particles {
 namespace {
 
 constexpr int kTile = 16;
-constexpr double kCut = 3.0;  // as field.h: each Gaussian ends at 3 h
 
 // Camera::generate_ray inverted: the pixel position and footprint radius (pixels) of a sphere.
 struct Projection {
@@ -193,8 +192,10 @@ namespace {
 class NetworkMethodSolution final : public MethodSolution {
  public:
   NetworkMethodSolution(const Scene& scene, ParticleSet set, int neighbours, const NetworkSettings& settings)
-      : scene_(scene), set_(std::move(set)), field_(set_.view(), neighbours), settings_(settings) {
-    solution_ = solve_network(field_, scene_.lights, settings_);
+      : scene_(scene), neighbours_(neighbours), settings_(settings) {
+    set_ = std::make_unique<ParticleSet>(std::move(set));
+    field_ = std::make_unique<ParticleField>(set_->view(), neighbours_);
+    solution_ = solve_network(*field_, scene_.lights, settings_);
     settings_.progress = nullptr;
     describe();
   }
@@ -202,21 +203,32 @@ class NetworkMethodSolution final : public MethodSolution {
   RenderResult render(const View& view, const RenderOptions& options) const override {
     const Stopwatch watch;
     const Scene seen = view_scene(scene_, view.camera);
-    RenderResult result{render_network(seen, field_, solution_, options), std::nullopt, {}};
+    RenderResult result{render_network(seen, *field_, solution_, options), std::nullopt, {}};
     result.stats["render_seconds"] = watch.seconds();
     return result;
   }
 
-  // New lights: update_network, which rebuilds only the maps of lights that moved, then iterates
-  // from the previous I. Surfaces are not drawn; anything else prepares again.
+  // Moved particles (a new particle medium of the same count) and new lights: update_network,
+  // which redoes only what the moved particles and lights reach, then iterates from the previous
+  // I. Surfaces are not drawn; anything else prepares again.
   std::optional<UpdateReport> update(const Scene& scene, const SceneChange& change, const RenderOptions& options) override {
-    if (change.medium) return std::nullopt;
+    if (change.region) return std::nullopt;
+    std::unique_ptr<ParticleSet> set;
+    std::unique_ptr<ParticleField> field;
+    if (change.medium) {
+      const auto* f = std::get_if<FieldDensity>(&change.medium->density);
+      const auto* moved = f ? dynamic_cast<const ParticleDensity*>(f->field.get()) : nullptr;
+      if (!moved || moved->set().positions.size() != set_->positions.size()) return std::nullopt;
+      set = std::make_unique<ParticleSet>(moved->set());
+      field = std::make_unique<ParticleField>(set->view(), neighbours_);
+    }
     UpdateReport report;
-    if (change.lights) {
+    if (change.lights || change.medium) {
       NetworkSettings settings = settings_;
       settings.threads = options.threads;
       settings.progress = options.progress;
-      solution_ = update_network(std::move(solution_), field_, scene.lights, settings);
+      solution_ = update_network(std::move(solution_), field ? *field : *field_, scene.lights, settings);
+      if (field) set_ = std::move(set), field_ = std::move(field);
       const auto& u = solution_.update;
       if (u.rebuilt) report.redone.push_back("networks rebuilt: " + u.reason);
       else report.redone.push_back("light depth maps: " + to_text(u.maps) + " rebuilt; direct light of " + to_text(u.direct) + " particles");
@@ -230,7 +242,7 @@ class NetworkMethodSolution final : public MethodSolution {
 
  private:
   void describe() {
-    stats = {{"particles", field_.size()},
+    stats = {{"particles", field_->size()},
              {"directions", settings_.directions},
              {"window", solution_.visibility.window.size},
              {"terms", solution_.terms},
@@ -244,8 +256,9 @@ class NetworkMethodSolution final : public MethodSolution {
   }
 
   Scene scene_;
-  const ParticleSet set_;
-  const ParticleField field_;  // views set_
+  int neighbours_;
+  std::unique_ptr<ParticleSet> set_;
+  std::unique_ptr<ParticleField> field_;  // views *set_
   NetworkSettings settings_;
   NetworkSolution solution_;
 };
@@ -265,10 +278,11 @@ class NetworkMethod final : public Method {
     const int neighbours = static_cast<int>(settings.integer("neighbours"));
     network.threads = options.threads;
     settings.reject_unknown();
-    if (scene.particles.is_null()) throw Error("particles", "missing", "a particles block for method network");
-    if (scene.medium) throw Error("medium", "given with particles", "particles only for method network");
+    const auto* field = scene.medium ? std::get_if<FieldDensity>(&scene.medium->density) : nullptr;
+    const auto* particles = field ? dynamic_cast<const ParticleDensity*>(field->field.get()) : nullptr;
+    if (!particles) throw Error(scene.medium ? "medium" : "particles", scene.medium ? "a medium" : "missing", "a particles block for method network");
     network.progress = options.progress;
-    return std::make_unique<NetworkMethodSolution>(scene, ParticleSet::from_json(scene.particles, scene.directory), neighbours, network);
+    return std::make_unique<NetworkMethodSolution>(scene, particles->set(), neighbours, network);
   }
 };
 
@@ -290,11 +304,10 @@ MethodInfo network_info() {
   for (int directions : {32, 64, 128}) info.trade_sweep.push_back({{"directions", directions}});
   // Trade suite, particle_cloud: 5.5% at any D in 0.45 s.
   info.offer = [](const SceneFeatures& f, double tolerance) {
-    if (!f.particles) return AutoOffer{false, {}, 0.0, "needs particles"};
+    if (f.density != "particles") return AutoOffer{false, {}, 0.0, "needs particles"};
     if (tolerance < 0.06) return AutoOffer{false, {}, 0.0, "measured at 5.5% on the suite's particle cloud"};
     return AutoOffer{true, {{"directions", 64}}, 0.45, "measured at 5.5% on the suite's particle cloud"};
   };
-  info.reads_particles = true;
   return info;
 }
 

@@ -64,9 +64,10 @@ void read_csv(const std::filesystem::path& path, ParticleSet& set) {
 ParticleSet ParticleSet::from_json(const json& j, const std::filesystem::path& base_dir) {
   if (!j.is_object()) throw Error("particles", j.dump(), "a JSON object {...}");
   for (const auto& [key, value] : j.items())
-    if (key != "positions" && key != "file" && key != "density" && key != "diameter" && key != "sigma_t" && key != "albedo" && key != "phase")
+    if (key != "positions" && key != "file" && key != "density" && key != "diameter" && key != "sigma_t" && key != "albedo" && key != "phase" &&
+        key != "grid_resolution")  // the density reader's (methods.cpp)
       throw Error("particles." + key, "unknown field \"" + key + "\"",
-                  "a field of particles: positions, file, density, diameter, sigma_t, albedo, phase");
+                  "a field of particles: positions, file, density, diameter, sigma_t, albedo, phase, grid_resolution");
   ParticleSet set;
   set.material = read_material(j, "particles");
   const bool inline_positions = j.contains("positions"), file = j.contains("file");

@@ -70,7 +70,6 @@ const char* const kGoodScene = R"({
              "density": {"type": "grid", "resolution": [2, 3, 4], "file": "density.raw"},
              "sigma_t": [1, 2, 3], "albedo": 0.5,
              "phase": {"type": "double_hg", "g1": 0.7, "g2": -0.3, "w": 0.8}},
-  "particles": {"count": 10, "anything": [1, 2]},
   "lights": [{"type": "point", "position": [1, 2, 3], "intensity": [1, 2, 3]},
              {"type": "spot", "position": [0, 4, 0], "direction": [0, -2, 0], "intensity": 5},
              {"type": "directional", "direction": [1, 1, 0], "irradiance": [0.5, 0.25, 0]},
@@ -105,8 +104,6 @@ TEST_F(SceneFiles, GoodSceneFieldByField) {
   expect_vec(m.albedo, {0.5, 0.5, 0.5});  // one number fills every channel
   EXPECT_EQ(m.phase.type(), PhaseType::double_hg);
   EXPECT_NEAR(m.phase.mean_cosine(), 0.8 * 0.7 + 0.2 * -0.3, 1e-12);
-
-  EXPECT_EQ(s.particles, json::parse(R"({"count": 10, "anything": [1, 2]})"));
 
   ASSERT_EQ(s.lights.size(), 4u);
   const auto& point = std::get<PointLight>(s.lights[0]);
@@ -158,7 +155,6 @@ TEST(Scene, Defaults) {
   EXPECT_EQ(s.camera.width_px, 64);
   EXPECT_EQ(s.camera.height_px, 64);
   EXPECT_FALSE(s.medium.has_value());
-  EXPECT_TRUE(s.particles.is_null());
   EXPECT_TRUE(s.lights.empty());
   EXPECT_TRUE(s.surfaces.empty());
   expect_vec(s.background, {0, 0, 0});
@@ -300,7 +296,8 @@ std::vector<BadCase> bad_cases() {
       {"MissingCamera", drop("/camera"), "camera", "missing"},
       {"UnknownTopLevelField", edit({{"/lihgts", json::array()}}), "lihgts", "a field of the scene: camera, medium"},
       {"LightsNotArray", edit({{"/lights", json::object()}}), "lights", "an array"},
-      {"ParticlesNotObject", edit({{"/particles", 3}}), "particles", "a JSON object"},
+      // Without the particle module, a particles block is a field no registered density type reads.
+      {"ParticlesUnregistered", edit({{"/particles", json::object()}}), "particles", "haze::particles::register_methods()"},
       {"BackgroundNegative", edit({{"/background/2", -0.5}}), "background[2]", ">= 0"},
       {"BackgroundWrongLength", edit({{"/background", {0, 0}}}), "background", "[r, g, b]"},
       {"MethodWithoutName", drop("/method/name"), "method.name", "missing"},

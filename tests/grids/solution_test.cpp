@@ -1,7 +1,11 @@
 // The grid methods' solutions: updates redo only what a change reaches and give what preparing the
 // changed scene gives; the DOM's warm start advances; the fields agree with their definitions.
 #include <haze/core/error.h>
+#include <haze/core/majorant.h>
 #include <haze/core/method.h>
+#include <haze/core/rng.h>
+#include <haze/grids/optical_depth.h>
+#include <haze/grids/propagation.h>
 #include <haze/grids/methods.h>
 
 #include "cloud_scene.h"
@@ -124,6 +128,29 @@ TEST(GridSolution, TransmittanceMatchesTheMedium) {
     for (int c = 0; c < 3; ++c) EXPECT_NEAR(field[c], exact[c], 0.01) << x.x << " " << c;
   }
   EXPECT_THROW(solution.transmittance(2, Vec3(0.0)), Error);
+}
+
+// The grid methods' volume as a haze::Medium: its density is the marchers' trilinear lookup, its
+// majorant segments bound it, and its line integral converges to the volume's depth (the DDA's
+// cell-constant integral) as both resolve the same smooth density.
+TEST(ExtinctionVolume, IsAMediumOnItsOwnCells) {
+  Scene scene = cloud_scene(8, 8);
+  scene.medium->bounds = {Vec3(-1.0), Vec3(1.0)};
+  const ExtinctionVolume volume = make_extinction_volume(scene, 64);
+  const auto medium = make_medium(volume.medium());
+  EXPECT_EQ(medium->bounds().lo, volume.density.bounds().lo);
+  Rng rng(3);
+  for (int i = 0; i < 200; ++i) {
+    const Vec3 x(2.0 * rng.uniform() - 1.0, 2.0 * rng.uniform() - 1.0, 2.0 * rng.uniform() - 1.0);
+    ASSERT_NEAR(medium->density(x), static_cast<double>(sample_trilinear(volume.density, x)), 1e-6 * (1.0 + medium->density(x)));
+  }
+  const Ray ray{Vec3(-1.5, -0.2, 0.1), glm::normalize(Vec3(1.0, 0.3, -0.1))};
+  auto walk = medium->majorants().walk(ray, 0.0, 4.0);
+  MajorantSegment seg;
+  while (walk.next(seg))
+    for (double f : {0.1, 0.5, 0.9}) EXPECT_LE(medium->density(ray.at(seg.t0 + f * (seg.t1 - seg.t0))), seg.density);
+  const double dda = density_integral_dda(volume.density, ray.origin, ray.at(4.0));
+  EXPECT_NEAR(medium->density_integral(ray.origin, ray.at(4.0)), dda, 0.01 * dda);
 }
 
 }  // namespace

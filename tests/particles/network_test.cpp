@@ -15,7 +15,7 @@ namespace {
 
 // `count` particles uniform in a ball of radius 1 (sigma_t 4: optical radius 4), a sun and a point
 // light, a small camera.
-Scene ball(int count, double albedo, int width, int height, std::uint64_t seed = 3) {
+nlohmann::json ball_json(int count, double albedo, int width, int height, std::uint64_t seed = 3) {
   Rng rng(seed);
   nlohmann::json positions = nlohmann::json::array();
   while (static_cast<int>(positions.size()) < count) {
@@ -28,8 +28,14 @@ Scene ball(int count, double albedo, int width, int height, std::uint64_t seed =
       {"lights", {{{"type", "directional"}, {"direction", {-0.5, -0.7, -0.5}}, {"irradiance", 1.0}},
                   {{"type", "point"}, {"position", {1.3, -0.4, 1.2}}, {"intensity", 1.5}}}},
       {"background", {0.0, 0.0, 0.0}}};
-  return Scene::from_json(j);
+  return j;
 }
+Scene ball(int count, double albedo, int width, int height, std::uint64_t seed = 3) {
+  register_methods();  // density type "particles"
+  return Scene::from_json(ball_json(count, albedo, width, height, seed));
+}
+// The particle set a scene's `particles` block was read into.
+ParticleSet set_of(const Scene& scene) { return dynamic_cast<const ParticleDensity&>(*std::get<FieldDensity>(scene.medium->density).field).set(); }
 
 // The camera's transmittance through the particles (background 1, no lights) agrees with the
 // reference path tracer on the particles' continuous density (a 96-cell grid of it): the splat
@@ -73,7 +79,7 @@ TEST(NetworkRender, SingleScatteringMatchesTheReference) {
 // sum of the density along it.
 TEST(ParticleField, StandsForTheDensity) {
   const Scene scene = ball(2000, 0.9, 8, 8);
-  const ParticleSet set = ParticleSet::from_json(scene.particles);
+  const ParticleSet set = set_of(scene);
   const ParticleField field(set.view());
   EXPECT_NEAR(field.density(Vec3(0.0)), 1.0, 0.15);
   EXPECT_NEAR(field.density_integral(Vec3(0.0, 0.0, -3.0), Vec3(0.0, 0.0, 1.0), 6.0), 2.0, 0.3);
@@ -88,7 +94,7 @@ TEST(ParticleField, StandsForTheDensity) {
 // direction; gap depths are >= 0.
 TEST(VisibilityNetwork, UpstreamComesFirst) {
   const Scene scene = ball(500, 0.9, 8, 8);
-  const ParticleSet set = ParticleSet::from_json(scene.particles);
+  const ParticleSet set = set_of(scene);
   const ParticleField field(set.view());
   const DirectionSet dirs = DirectionSet::fibonacci(32);
   const VisibilityNetwork v = build_visibility(field, field.density_at_particles(0), dirs, network_window(field, default_window(field)), 0);
@@ -114,7 +120,7 @@ TEST(VisibilityNetwork, UpstreamComesFirst) {
 // channel, and the separable product agrees with the full matrix.
 TEST(NetworkSolve, WarmStartAndShortcuts) {
   const Scene scene = ball(1000, 0.95, 8, 8);
-  const ParticleSet set = ParticleSet::from_json(scene.particles);
+  const ParticleSet set = set_of(scene);
   const ParticleField field(set.view());
   NetworkSettings settings;
   settings.directions = 64, settings.tolerance = 1e-4;
@@ -152,7 +158,7 @@ TEST(NetworkSolve, WarmStartAndShortcuts) {
 // the I of a full solve (which differs in the window's placement and the maps' texels).
 TEST(NetworkUpdate, MatchesAFullBuild) {
   const Scene scene = ball(1000, 0.9, 8, 8);
-  ParticleSet set = ParticleSet::from_json(scene.particles);
+  ParticleSet set = set_of(scene);
   set.diameters.assign(set.positions.size(), 0.2f);
   ParticleSet next = set;
   Rng rng(5);
@@ -206,7 +212,7 @@ TEST(NetworkUpdate, MatchesAFullBuild) {
 // changed or a particle left the window's sphere.
 TEST(NetworkUpdate, RedoesOnlyWhatChanged) {
   const Scene scene = ball(400, 0.9, 8, 8);
-  ParticleSet set = ParticleSet::from_json(scene.particles);
+  ParticleSet set = set_of(scene);
   NetworkSettings settings;
   settings.directions = 16;
   const ParticleField field(set.view());
@@ -240,18 +246,44 @@ TEST(NetworkUpdate, RedoesOnlyWhatChanged) {
   EXPECT_EQ(recount.visibility.particles, 399);
 }
 
+// A simulation's next frame through the Solution: the moved particles as a new particle medium
+// (the same count) update the networks in place (not rebuilt), and the image is within 1% of
+// preparing the moved scene afresh (which places the window and the maps' texels anew).
+TEST(NetworkSolution, MovedParticlesUpdateInPlace) {
+  Scene scene = ball(1000, 0.9, 16, 12);
+  ParticleSet set = set_of(scene);
+  set.diameters.assign(set.positions.size(), 0.2f);
+  scene.medium = particle_medium(set);
+  RenderOptions options{0, {{"directions", 32}, {"tolerance", 1e-4}}, {}, {}};
+  Solution solution = prepare(scene, "network", options);
+  for (size_t p = 0; p < set.positions.size(); p += 100) set.positions[p] *= 0.9f;
+  Scene moved = scene;
+  moved.medium = particle_medium(set);
+  SceneChange change;
+  change.medium = moved.medium;
+  const UpdateReport report = solution.update(change);
+  ASSERT_FALSE(report.rebuilt);
+  ASSERT_FALSE(report.redone.empty());
+  EXPECT_EQ(report.redone[0].find("networks rebuilt"), std::string::npos) << report.redone[0];
+  const Image updated = solution.render().radiance, fresh = render(moved, "network", options).radiance;
+  double diff = 0.0, sum = 0.0;
+  for (size_t i = 0; i < fresh.data().size(); ++i)
+    diff += std::abs(static_cast<double>(updated.data()[i] - fresh.data()[i])), sum += static_cast<double>(fresh.data()[i]);
+  EXPECT_LT(diff / sum, 0.01);
+}
+
 // Degenerate particle sets: clear errors where no answer exists, finite images otherwise.
 TEST(NetworkDegenerate, HandledOrRefused) {
   register_methods();
   auto with = [](nlohmann::json particles) {
-    Scene s = ball(10, 0.9, 8, 6);
+    nlohmann::json s = ball_json(10, 0.9, 8, 6);
     particles["sigma_t"] = 2.0;
-    s.particles = particles;
+    s["particles"] = particles;
     return s;
   };
-  auto message = [](const Scene& s) {
+  auto message = [](const nlohmann::json& s) {
     try {
-      render(s, "network");
+      render(Scene::from_json(s), "network");
     } catch (const Error& e) {
       return std::string(e.what());
     }
@@ -272,13 +304,13 @@ TEST(NetworkDegenerate, HandledOrRefused) {
   EXPECT_NE(message(with({{"positions", {{0, 0, 0}, {1, 0, 0}}}, {"diameter", {0.5, nullptr}}})).find("particles.diameter"), std::string::npos);
   // A single particle with a diameter, coincident particles with one, a plane of particles, an
   // empty set, and a point light inside the cloud all render finite images.
-  EXPECT_TRUE(finite(render(with({{"positions", {{0, 0, 0}}}, {"diameter", 0.5}}), "network").radiance));
-  EXPECT_TRUE(finite(render(with({{"positions", {{0, 0, 0}, {0, 0, 0}}}, {"diameter", 0.5}}), "network").radiance));
+  EXPECT_TRUE(finite(render(Scene::from_json(with({{"positions", {{0, 0, 0}}}, {"diameter", 0.5}})), "network").radiance));
+  EXPECT_TRUE(finite(render(Scene::from_json(with({{"positions", {{0, 0, 0}, {0, 0, 0}}}, {"diameter", 0.5}})), "network").radiance));
   nlohmann::json plane = nlohmann::json::array();
   for (int i = 0; i < 10; ++i)
     for (int j = 0; j < 10; ++j) plane.push_back({0.2 * i - 1.0, 0.2 * j - 1.0, 0.0});
-  EXPECT_TRUE(finite(render(with({{"positions", plane}}), "network").radiance));
-  const Image empty = render(with({{"positions", nlohmann::json::array()}}), "network").radiance;
+  EXPECT_TRUE(finite(render(Scene::from_json(with({{"positions", plane}})), "network").radiance));
+  const Image empty = render(Scene::from_json(with({{"positions", nlohmann::json::array()}})), "network").radiance;
   EXPECT_EQ(empty.at(3, 3), Rgb(0.0));  // the scene's background
   Scene inside = ball(300, 0.9, 8, 6);
   inside.lights = {PointLight{Vec3(0.0), Rgb(1.0)}};

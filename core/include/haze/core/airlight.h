@@ -17,6 +17,8 @@
 #include <string>
 #include <vector>
 
+#pragma GCC visibility push(default)  // the public API: exported from shared builds
+
 namespace haze {
 
 // One view segment and one point light (thesis table 4.1).
@@ -232,3 +234,5 @@ class LegendreSurfaceTables {
 };
 
 }  // namespace haze
+
+#pragma GCC visibility pop

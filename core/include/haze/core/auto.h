@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#pragma GCC visibility push(default)  // the public API: exported from shared builds
+
 namespace haze {
 
 struct AutoChoice {
@@ -24,3 +26,5 @@ struct AutoChoice {
 AutoChoice choose_method(const Scene& scene, double tolerance);
 
 }  // namespace haze
+
+#pragma GCC visibility pop

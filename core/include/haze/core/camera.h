@@ -4,6 +4,8 @@
 
 #include <haze/core/math.h>
 
+#pragma GCC visibility push(default)  // the public API: exported from shared builds
+
 namespace haze {
 
 struct Camera {
@@ -24,3 +26,5 @@ struct Camera {
 };
 
 }  // namespace haze
+
+#pragma GCC visibility pop

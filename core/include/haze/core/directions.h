@@ -6,6 +6,8 @@
 #include <cstdint>
 #include <vector>
 
+#pragma GCC visibility push(default)  // the public API: exported from shared builds
+
 namespace haze {
 
 class DirectionSet {
@@ -30,3 +32,5 @@ class DirectionSet {
 };
 
 }  // namespace haze
+
+#pragma GCC visibility pop

@@ -6,6 +6,8 @@
 #include <stdexcept>
 #include <string>
 
+#pragma GCC visibility push(default)  // the public API: exported from shared builds
+
 namespace haze {
 
 // An error a caller can act on: it names the field (a JSON path such as "medium.albedo[1]" or an
@@ -56,3 +58,5 @@ namespace internal {
 #else
 #define HAZE_DCHECK(condition) HAZE_CHECK(condition)
 #endif
+
+#pragma GCC visibility pop

@@ -4,11 +4,17 @@
 
 #include <haze/core/scene.h>
 
+#include <string>
+
+#pragma GCC visibility push(default)  // the public API: exported from shared builds
+
 namespace haze {
 
 // What the choice looks at.
 struct SceneFeatures {
-  bool particles = false;    // a particles block and no medium
+  // "constant", "rbf", "grid", or the type of a module's density field (FieldDensity::type,
+  // "particles"), whose optical diameter is not estimated.
+  std::string density;
   bool homogeneous = false;  // constant density
   bool bounded = false;      // the medium has finite bounds
   bool surfaces = false;
@@ -20,9 +26,12 @@ struct SceneFeatures {
   double multiple_share = 0.0;
 };
 SceneFeatures scene_features(const Scene& scene);
+inline bool field_density(const SceneFeatures& f) { return !f.density.empty() && f.density != "constant" && f.density != "rbf" && f.density != "grid"; }
 
 // Single scattering is enough when the multiple-scattering share is under half the tolerance (for
-// particles the share is not estimated: never).
-inline bool single_scattering_suffices(const SceneFeatures& f, double tolerance) { return !f.particles && f.multiple_share < 0.5 * tolerance; }
+// a module's field the share is not estimated: never).
+inline bool single_scattering_suffices(const SceneFeatures& f, double tolerance) { return field_density(f) ? false : f.multiple_share < 0.5 * tolerance; }
 
 }  // namespace haze
+
+#pragma GCC visibility pop

@@ -10,6 +10,8 @@
 #include <optional>
 #include <vector>
 
+#pragma GCC visibility push(default)  // the public API: exported from shared builds
+
 namespace haze {
 
 class Image {
@@ -75,3 +77,5 @@ LitPixelError lit_pixel_error(const Image& image, const Image& reference, const 
                               const Image* lit = nullptr, double threshold = 0.01);
 
 }  // namespace haze
+
+#pragma GCC visibility pop

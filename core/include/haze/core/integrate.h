@@ -5,6 +5,8 @@
 #include <functional>
 #include <vector>
 
+#pragma GCC visibility push(default)  // the public API: exported from shared builds
+
 namespace haze {
 
 struct IntegrationResult {
@@ -28,3 +30,5 @@ std::vector<double> integrate_adaptive_nodes(const std::function<void(const doub
                                              double b, double rel_tol = 1e-10, int max_intervals = 4096);
 
 }  // namespace haze
+
+#pragma GCC visibility pop

@@ -8,6 +8,8 @@
 #include <variant>
 #include <vector>
 
+#pragma GCC visibility push(default)  // the public API: exported from shared builds
+
 namespace haze {
 
 struct PointLight {
@@ -56,3 +58,5 @@ bool arrival(const Light& light, const Vec3& x, LightArrival& out);
 std::vector<double> cone_crossings(const SpotLight& spot, const Ray& ray, double t_max);
 
 }  // namespace haze
+
+#pragma GCC visibility pop

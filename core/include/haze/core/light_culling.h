@@ -7,6 +7,8 @@
 #include <string>
 #include <vector>
 
+#pragma GCC visibility push(default)  // the public API: exported from shared builds
+
 namespace haze {
 
 struct CulledLight {
@@ -17,11 +19,13 @@ struct CulledLight {
 // The lights of `scene` whose light reaches neither the medium nor any surface, so that they add
 // nothing to any image, whatever the method or camera: lights of zero power, and spot lights
 // whose cone misses the medium's bounds (a bounding sphere around them) and every surface. Light
-// that reaches nothing escapes, so culling is exact. With particles (bounds unknown to the core)
-// or an unbounded medium no spot light is culled that way.
+// that reaches nothing escapes, so culling is exact. With an unbounded medium no spot light is
+// culled that way.
 // With `single_scattering` (a method whose image holds light scattered or reflected once, at
 // points the camera sees), spot lights whose cone misses the camera's view (outside one of the
 // frustum's side planes, or behind the camera) are culled too: exact for such methods.
 std::vector<CulledLight> culled_lights(const Scene& scene, bool single_scattering = false);
 
 }  // namespace haze
+
+#pragma GCC visibility pop

@@ -3,15 +3,21 @@
 // (Medium::majorants), which the reference path tracer walks.
 #pragma once
 
+#include <haze/core/grid_walk.h>
 #include <haze/core/math.h>
 
+#include <array>
+#include <cstddef>
 #include <vector>
+
+#pragma GCC visibility push(default)  // the public API: exported from shared builds
 
 namespace haze {
 
 struct MajorantSegment {
   double t0, t1;
   double density;  // an upper bound of the density on [t0, t1)
+  size_t cell;     // the grid cell, (z * ny + y) * nx + x
 };
 
 class Medium;
@@ -20,30 +26,34 @@ class MajorantGrid {
  public:
   // One cell for homogeneous media; `cells` per axis for heterogeneous ones.
   MajorantGrid(const Medium& medium, int cells = 16);
+  // Given bounds: density[(z * n[1] + y) * n[0] + x] bounds the density over cell (x, y, z).
+  MajorantGrid(const Aabb& bounds, const std::array<int, 3>& n, std::vector<double> density);
 
   // Walks the ray's [t_min, t_max] through the grid, segment by segment, in order.
   class Iterator {
    public:
     Iterator() = default;
-    Iterator(const MajorantGrid* grid, const Ray& ray, double t_min, double t_max);
-    bool next(MajorantSegment& segment);
+    Iterator(const MajorantGrid* grid, const Ray& ray, double t_min, double t_max)
+        : grid_(grid), walk_(grid->bounds_, grid->n_, ray, t_min, t_max) {}
+    bool next(MajorantSegment& segment) {
+      CellSegment s;
+      if (!walk_.next(s)) return false;
+      segment = {s.t0, s.t1, grid_->density_[s.cell], s.cell};
+      return true;
+    }
 
    private:
     const MajorantGrid* grid_ = nullptr;
-    double t_ = 0.0, t_max_ = 0.0;
-    int cell_[3] = {0, 0, 0}, step_[3] = {0, 0, 0};
-    double next_t_[3] = {0, 0, 0}, delta_t_[3] = {0, 0, 0};
-    bool done_ = true;
+    GridWalk walk_;
   };
   Iterator walk(const Ray& ray, double t_min, double t_max) const { return Iterator(this, ray, t_min, t_max); }
 
  private:
   Aabb bounds_;
-  int n_[3] = {1, 1, 1};
+  std::array<int, 3> n_{1, 1, 1};
   std::vector<double> density_;
-  double at(const int c[3]) const {
-    return density_[(static_cast<size_t>(c[2]) * static_cast<size_t>(n_[1]) + static_cast<size_t>(c[1])) * static_cast<size_t>(n_[0]) + static_cast<size_t>(c[0])];
-  }
 };
 
 }  // namespace haze
+
+#pragma GCC visibility pop

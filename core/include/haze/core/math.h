@@ -10,6 +10,8 @@
 #include <limits>
 #include <numbers>
 
+#pragma GCC visibility push(default)  // the public API: exported from shared builds
+
 namespace haze {
 
 using Vec3 = glm::dvec3;
@@ -57,3 +59,5 @@ inline double luminance(const Rgb& c) { return 0.2126 * c.r + 0.7152 * c.g + 0.0
 inline bool is_grey(const Rgb& c) { return c.r == c.g && c.g == c.b; }
 
 }  // namespace haze
+
+#pragma GCC visibility pop

@@ -14,6 +14,8 @@
 #include <variant>
 #include <vector>
 
+#pragma GCC visibility push(default)  // the public API: exported from shared builds
+
 namespace haze {
 
 class MajorantGrid;
@@ -56,6 +58,8 @@ class DensityField {
   virtual double feature_size() const = 0;                   // a length over which it changes little
   // integral along a -> b; by default Medium's composite Simpson.
   virtual std::optional<double> density_integral(const Vec3& /*a*/, const Vec3& /*b*/) const { return std::nullopt; }
+  // Its own majorant grid (Medium::majorants); by default built from max_density.
+  virtual std::shared_ptr<const MajorantGrid> majorants() const { return nullptr; }
 };
 struct FieldDensity {
   std::string type;  // what supplies it, for messages ("particles")
@@ -137,3 +141,5 @@ std::unique_ptr<Medium> make_medium(const MediumDesc& desc);
 Aabb medium_bounds(const MediumDesc& desc);
 
 }  // namespace haze
+
+#pragma GCC visibility pop

@@ -18,6 +18,8 @@
 #include <string>
 #include <vector>
 
+#pragma GCC visibility push(default)  // the public API: exported from shared builds
+
 namespace haze {
 
 // A method turns a scene into a solution (DESIGN.md, "Callers"); the solution renders views.
@@ -75,9 +77,6 @@ struct MethodInfo {
   // How the method bids for a scene in method "auto" (none: never chosen; the reference is the
   // fallback when nothing offers).
   AutoRule offer;
-  // The method reads the scene's `particles` block itself; any other method is given the
-  // particles' continuous density as the scene's medium (register_particle_medium).
-  bool reads_particles = false;
   // The image holds light scattered or reflected once only, at points the camera sees: a light
   // that reaches none of the view is left out too (light_culling.h).
   bool single_scattering = false;
@@ -88,12 +87,6 @@ struct MethodInfo {
 // The method's settings for `haze render --help` (one line each) and as a markdown table.
 std::string settings_help(const MethodInfo& info);
 std::string settings_markdown(const MethodInfo& info);
-
-// Turns a scene's `particles` block into a medium (the particle module registers one when its
-// methods are registered: the particles' continuous density sampled on a grid). `settings` are the
-// render's method settings, from which it may read (and must remove) its own keys.
-using ParticleMediumFactory = std::function<MediumDesc(const Scene& scene, nlohmann::json& settings)>;
-void register_particle_medium(ParticleMediumFactory factory);
 
 // Reads a method's settings against its registered schema (MethodInfo::settings): a bad value, or
 // a key the method never asked for, throws haze::Error naming "method.<key>", the value and the
@@ -178,3 +171,5 @@ Solution prepare(const Scene& scene, const std::string& method_name = "", Render
 RenderResult render(const Scene& scene, const std::string& method_name, RenderOptions options = {});
 
 }  // namespace haze
+
+#pragma GCC visibility pop

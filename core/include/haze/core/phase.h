@@ -10,6 +10,8 @@
 #include <variant>
 #include <vector>
 
+#pragma GCC visibility push(default)  // the public API: exported from shared builds
+
 namespace haze {
 
 enum class PhaseType { isotropic, rayleigh, henyey_greenstein, cornette_shanks, double_hg, tabulated };
@@ -98,3 +100,5 @@ double hg_legendre_truncation_error(double g, int terms);
 void gauss_legendre(int n, std::vector<double>& nodes, std::vector<double>& weights);
 
 }  // namespace haze
+
+#pragma GCC visibility pop

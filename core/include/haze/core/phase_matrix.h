@@ -6,6 +6,8 @@
 
 #include <Eigen/Core>
 
+#pragma GCC visibility push(default)  // the public API: exported from shared builds
+
 namespace haze {
 
 // P[i][j] = p(w_i . w_j) w_j, scaled symmetrically (P = S K S, S diagonal) so that every row sums to
@@ -72,3 +74,5 @@ class SeparablePhase {
 };
 
 }  // namespace haze
+
+#pragma GCC visibility pop

@@ -5,6 +5,8 @@
 #include <functional>
 #include <mutex>
 
+#pragma GCC visibility push(default)  // the public API: exported from shared builds
+
 namespace haze {
 
 // Called with the finished fraction in [0, 1]; return false to cancel. Calls are serialized but
@@ -35,3 +37,5 @@ class ProgressTracker {
 void parallel_for(long long count, int threads, long long grain, const std::function<void(long long, long long)>& body);
 
 }  // namespace haze
+
+#pragma GCC visibility pop

@@ -4,6 +4,8 @@
 
 #include <cstdint>
 
+#pragma GCC visibility push(default)  // the public API: exported from shared builds
+
 namespace haze {
 
 class Rng {
@@ -30,3 +32,5 @@ class Rng {
 };
 
 }  // namespace haze
+
+#pragma GCC visibility pop

@@ -11,9 +11,12 @@
 #include <nlohmann/json.hpp>
 
 #include <filesystem>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
+
+#pragma GCC visibility push(default)  // the public API: exported from shared builds
 
 namespace haze {
 
@@ -26,10 +29,18 @@ struct MaterialDesc {
 };
 MaterialDesc read_material(const nlohmann::json& j, const std::string& path);
 
+// A density a module supplies, read from the scene's top-level block of the type's name
+// ("particles": the particle module registers it): the block at `path` into a medium, whose
+// density is usually the module's FieldDensity; relative file names resolve against `directory`.
+// A second registration under the same type replaces the first.
+using DensityReader = std::function<MediumDesc(const nlohmann::json& block, const std::string& path, const std::filesystem::path& directory)>;
+void register_density(const std::string& type, DensityReader reader);
+std::vector<std::string> registered_densities();
+
 struct Scene {
   Camera camera;
+  // The medium: from `medium`, or from the block of a module's density type (`particles`).
   std::optional<MediumDesc> medium;
-  nlohmann::json particles;  // kept as written until the particle module reads it
   std::filesystem::path directory = ".";  // relative file names in the scene resolve against it
   std::vector<Light> lights;
   std::vector<Surface> surfaces;
@@ -46,3 +57,5 @@ struct Scene {
 };
 
 }  // namespace haze
+
+#pragma GCC visibility pop

@@ -17,6 +17,8 @@
 #include <string>
 #include <vector>
 
+#pragma GCC visibility push(default)  // the public API: exported from shared builds
+
 namespace haze {
 
 struct RenderOptions {
@@ -104,3 +106,5 @@ class MethodSolution {
 };
 
 }  // namespace haze
+
+#pragma GCC visibility pop

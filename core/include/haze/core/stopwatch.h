@@ -3,6 +3,8 @@
 
 #include <chrono>
 
+#pragma GCC visibility push(default)  // the public API: exported from shared builds
+
 namespace haze {
 
 class Stopwatch {
@@ -23,3 +25,5 @@ class Stopwatch {
 };
 
 }  // namespace haze
+
+#pragma GCC visibility pop

@@ -8,6 +8,8 @@
 #include <variant>
 #include <vector>
 
+#pragma GCC visibility push(default)  // the public API: exported from shared builds
+
 namespace haze {
 
 struct Plane {
@@ -37,3 +39,5 @@ struct Surface {
 const Surface* nearest_surface(const std::vector<Surface>& surfaces, const Ray& ray, double t_max, double& t, Vec3& normal);
 
 }  // namespace haze
+
+#pragma GCC visibility pop

@@ -4,6 +4,8 @@
 #include <memory>
 #include <string>
 
+#pragma GCC visibility push(default)  // the public API: exported from shared builds
+
 namespace haze::gl {
 
 struct GlInfo {
@@ -35,3 +37,5 @@ class HeadlessContext {
 GlInfo probe();
 
 }  // namespace haze::gl
+
+#pragma GCC visibility pop

@@ -20,6 +20,8 @@
 #include <span>
 #include <vector>
 
+#pragma GCC visibility push(default)  // the public API: exported from shared builds
+
 namespace haze::gl {
 
 struct DisplaySettings {
@@ -67,3 +69,5 @@ class VolumeDisplay {
 };
 
 }  // namespace haze::gl
+
+#pragma GCC visibility pop

@@ -12,6 +12,8 @@
 #include <span>
 #include <vector>
 
+#pragma GCC visibility push(default)  // the public API: exported from shared builds
+
 namespace haze::gl {
 
 enum class TexelFormat { float16, float32 };
@@ -67,3 +69,5 @@ class Texture {
 std::vector<Brick> changed_bricks(const std::array<int, 3>& resolution, std::span<const unsigned char> changed, int brick_size = 16);
 
 }  // namespace haze::gl
+
+#pragma GCC visibility pop

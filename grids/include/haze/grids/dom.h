@@ -16,6 +16,8 @@
 #include <string>
 #include <vector>
 
+#pragma GCC visibility push(default)  // the public API: exported from shared builds
+
 namespace haze::grids {
 
 enum class DomScheme {
@@ -146,3 +148,5 @@ size_t dom_memory_bytes(const std::array<int, 3>& resolution, int channels, cons
 MethodInfo dom_info();
 
 }  // namespace haze::grids
+
+#pragma GCC visibility pop

@@ -7,6 +7,8 @@
 #include <array>
 #include <vector>
 
+#pragma GCC visibility push(default)  // the public API: exported from shared builds
+
 namespace haze::grids {
 
 class DenseGrid {
@@ -57,3 +59,5 @@ class BrickGrid {
 };
 
 }  // namespace haze::grids
+
+#pragma GCC visibility pop

@@ -1,6 +1,8 @@
 // Registration of the grid methods (propagation, dom) with core's method registry.
 #pragma once
 
+#pragma GCC visibility push(default)  // the public API: exported from shared builds
+
 namespace haze::grids {
 
 // Registers every grid-based method this build has (today "propagation"; discrete ordinates will
@@ -8,3 +10,5 @@ namespace haze::grids {
 void register_methods();
 
 }  // namespace haze::grids
+
+#pragma GCC visibility pop

@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#pragma GCC visibility push(default)  // the public API: exported from shared builds
+
 namespace haze::grids {
 
 enum class DepthScheme {
@@ -52,3 +54,5 @@ double density_integral_dda(const DenseGrid& density, const Vec3& a, const Vec3&
 float sample_trilinear(const DenseGrid& grid, const Vec3& p);
 
 }  // namespace haze::grids
+
+#pragma GCC visibility pop

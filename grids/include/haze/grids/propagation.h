@@ -12,6 +12,8 @@
 #include <memory>
 #include <vector>
 
+#pragma GCC visibility push(default)  // the public API: exported from shared builds
+
 namespace haze::grids {
 
 // The medium's density on a grid over its bounds, with the medium's coefficients.
@@ -19,6 +21,11 @@ struct ExtinctionVolume {
   DenseGrid density;
   Rgb sigma_t_scale{1.0}, albedo{0.8};
   PhaseFunction phase;
+
+  // The volume as a haze medium: core's grid medium over a view of `density` (valid while the
+  // volume lives), the same trilinear lookup the marchers use; for the reference, quadrature or
+  // a caller's own walk (Medium::majorants) on exactly the cells a grid method solved.
+  MediumDesc medium() const;
 };
 
 struct VolumeReport {
@@ -68,3 +75,5 @@ PropagationFields propagation_fields(const Scene& scene, const RenderOptions& op
 MethodInfo propagation_info();
 
 }  // namespace haze::grids
+
+#pragma GCC visibility pop

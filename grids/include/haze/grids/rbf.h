@@ -8,6 +8,8 @@
 #include <array>
 #include <vector>
 
+#pragma GCC visibility push(default)  // the public API: exported from shared builds
+
 namespace haze::grids {
 
 struct InjectionReport {
@@ -38,3 +40,5 @@ double injection_cutoff(const std::vector<RbfBlob>& blobs, double cutoff = 0.0);
 Aabb blob_support(const RbfBlob& blob, double cutoff);
 
 }  // namespace haze::grids
+
+#pragma GCC visibility pop

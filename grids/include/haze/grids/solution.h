@@ -6,6 +6,8 @@
 #include <haze/grids/dom.h>
 #include <haze/grids/propagation.h>
 
+#pragma GCC visibility push(default)  // the public API: exported from shared builds
+
 namespace haze::grids {
 
 class GridSolution : public MethodSolution {
@@ -54,3 +56,5 @@ class GridSolution : public MethodSolution {
 };
 
 }  // namespace haze::grids
+
+#pragma GCC visibility pop

@@ -12,6 +12,8 @@
 #include <span>
 #include <vector>
 
+#pragma GCC visibility push(default)  // the public API: exported from shared builds
+
 namespace haze::particles {
 
 // One particle's Gaussian (field.h): centre, width h and peak density w.
@@ -74,3 +76,5 @@ class LightDepthMap {
 };
 
 }  // namespace haze::particles
+
+#pragma GCC visibility pop

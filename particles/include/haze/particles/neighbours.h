@@ -6,6 +6,8 @@
 
 #include <vector>
 
+#pragma GCC visibility push(default)  // the public API: exported from shared builds
+
 namespace haze::particles {
 
 struct Neighbourhoods {
@@ -20,3 +22,5 @@ struct Neighbourhoods {
 Neighbourhoods nearest_neighbours(const std::vector<Vec3f>& positions, int k);
 
 }  // namespace haze::particles
+
+#pragma GCC visibility pop

@@ -23,6 +23,8 @@
 #include <string>
 #include <vector>
 
+#pragma GCC visibility push(default)  // the public API: exported from shared builds
+
 namespace haze::particles {
 
 // The window particles are projected onto for each direction: M x M pixels over the sphere
@@ -146,3 +148,5 @@ Image render_network(const Scene& scene, const ParticleField& field, const Netwo
 MethodInfo network_info();
 
 }  // namespace haze::particles
+
+#pragma GCC visibility pop

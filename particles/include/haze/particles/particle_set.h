@@ -10,6 +10,8 @@
 #include <span>
 #include <vector>
 
+#pragma GCC visibility push(default)  // the public API: exported from shared builds
+
 namespace haze::particles {
 
 struct ParticleView {
@@ -39,3 +41,5 @@ struct ParticleSet {
 void validate(const ParticleView& particles);
 
 }  // namespace haze::particles
+
+#pragma GCC visibility pop

@@ -12,6 +12,8 @@
 
 #include <cstddef>
 
+#pragma GCC visibility push(default)  // the public API: exported from shared builds
+
 namespace haze::simd {
 
 // out[i] += airlight of segment i (best compiled target this CPU supports).
@@ -23,3 +25,5 @@ void add_airlight_reference(const AirlightTable& table, const AirlightChannel& l
 void install();
 
 }  // namespace haze::simd
+
+#pragma GCC visibility pop

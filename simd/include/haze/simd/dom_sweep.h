@@ -15,6 +15,8 @@
 
 #include <cstddef>
 
+#pragma GCC visibility push(default)  // the public API: exported from shared builds
+
 namespace haze::simd {
 
 // One octant's directions, padded to a multiple of 8 with directions that carry nothing (a = 0,
@@ -52,3 +54,5 @@ void dom_sweep_row(const DomOctant& octant, const DomRow& row);
 void dom_sweep_row_reference(const DomOctant& octant, const DomRow& row);
 
 }  // namespace haze::simd
+
+#pragma GCC visibility pop

@@ -14,6 +14,8 @@
 
 #include <cstddef>
 
+#pragma GCC visibility push(default)  // the public API: exported from shared builds
+
 namespace haze::simd {
 
 using Half = Eigen::half;  // 2 bytes, IEEE binary16
@@ -25,3 +27,5 @@ void to_half_reference(const float* from, Half* to, size_t count);
 void to_float_reference(const Half* from, float* to, size_t count);
 
 }  // namespace haze::simd
+
+#pragma GCC visibility pop

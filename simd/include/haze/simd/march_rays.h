@@ -12,6 +12,8 @@
 
 #include <cstddef>
 
+#pragma GCC visibility push(default)  // the public API: exported from shared builds
+
 namespace haze::simd {
 
 struct MarchLight {
@@ -47,3 +49,5 @@ bool march_supported(const PhaseFunction& phase);
 void march_rays(const MarchVolume& volume, const PhaseFunction& phase, const RayPacket& rays);
 
 }  // namespace haze::simd
+
+#pragma GCC visibility pop

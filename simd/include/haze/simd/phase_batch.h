@@ -14,6 +14,8 @@
 #include <string>
 #include <vector>
 
+#pragma GCC visibility push(default)  // the public API: exported from shared builds
+
 namespace haze::simd {
 
 // out[i] = phase.eval(cos_theta[i]) for i < count (the best compiled target this CPU supports).
@@ -26,3 +28,5 @@ std::vector<std::string> available_targets();
 std::string selected_target();
 
 }  // namespace haze::simd
+
+#pragma GCC visibility pop

@@ -4,6 +4,8 @@
 
 #include <haze/core/phase.h>
 
+#pragma GCC visibility push(default)  // the public API: exported from shared builds
+
 namespace haze::simd {
 
 // Every analytic phase function is written as
@@ -24,3 +26,5 @@ struct PhaseParams {
 bool params_for(const PhaseFunction& phase, PhaseParams& p);
 
 }  // namespace haze::simd
+
+#pragma GCC visibility pop

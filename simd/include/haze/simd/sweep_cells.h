@@ -16,6 +16,8 @@
 
 #include <cstddef>
 
+#pragma GCC visibility push(default)  // the public API: exported from shared builds
+
 namespace haze::simd {
 
 struct SweepVolume {
@@ -38,3 +40,5 @@ void sweep_cells(const SweepVolume& volume, int i, int j, int k, int axis, int c
 void sweep_cells_reference(const SweepVolume& volume, int i, int j, int k, int axis, int count, float* depth, float* mean);
 
 }  // namespace haze::simd
+
+#pragma GCC visibility pop
