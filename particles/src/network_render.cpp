@@ -280,7 +280,8 @@ class NetworkMethod final : public Method {
     settings.reject_unknown();
     const auto* field = scene.medium ? std::get_if<FieldDensity>(&scene.medium->density) : nullptr;
     const auto* particles = field ? dynamic_cast<const ParticleDensity*>(field->field.get()) : nullptr;
-    if (!particles) throw Error(scene.medium ? "medium" : "particles", scene.medium ? "a medium" : "missing", "a particles block for method network");
+    if (!particles)
+      throw Error("particles", scene.medium ? "a `medium` instead" : "missing", "a particles block: method network renders particle sets only");
     network.progress = options.progress;
     return std::make_unique<NetworkMethodSolution>(scene, particles->set(), neighbours, network);
   }
