@@ -20,7 +20,7 @@ using internal::Api;
 namespace {
 
 // Texture units, one per sampler: samplers of different types may not share a unit.
-enum Unit : int { kDensityUnit = 0, kDepthUnit = 1, kPhaseUnit = 5, kMomentsUnit = 6, kWeightsUnit = 7 };
+enum Unit : int { kDensityUnit = 0, kDepthUnit = 1, kPhaseUnit = 5, kMomentsUnit = 6, kWeightsUnit = 7, kVisibilityUnit = 8 };
 
 GLuint compile(const Api& gl, GLenum type, const char* source) {
   const GLuint shader = gl.CreateShader(type);
@@ -73,8 +73,9 @@ struct VolumeDisplay::Impl {
   // Bound to the units of samplers the scene does not use: a unit without a complete texture of
   // its sampler's type is undefined on some drivers.
   std::optional<Texture> unused_plane, unused_volume;
-  std::vector<Texture> depths;  // ceil(lights / 4) RGBA volumes (at least one)
-  std::vector<float> packed;    // scratch: interleaved depths of one group
+  std::vector<Texture> depths;      // ceil(lights / 4) RGBA volumes (at least one)
+  std::vector<Texture> visibility;  // the same for the surfaces' shadows (grids::surface_visibility); none without surfaces
+  std::vector<float> packed;        // scratch: interleaved values of one group
   // Multiple scattering: the solution (moments dropped) for the weights, and the camera they are for.
   std::optional<grids::DomSolution> dom;
   int ms_groups = 0;
@@ -98,21 +99,35 @@ struct VolumeDisplay::Impl {
                   "the density's " + std::to_string(cells[0]) + " x " + std::to_string(cells[1]) + " x " + std::to_string(cells[2]) + " cells");
   }
 
-  void upload_depths(const std::vector<DenseGrid>& grids, std::span<const Brick> bricks) {
-    if (grids.size() != scene.lights.size())
-      throw Error("depths", std::to_string(grids.size()) + " volumes",
-                  "one per point, spot or directional light (" + std::to_string(scene.lights.size()) + ")");
-    for (size_t l = 0; l < grids.size(); ++l) check_grid(grids[l], "depths[" + std::to_string(l) + "]");
+  // Four lights' volumes a texture, in r, g, b, a.
+  void upload_groups(const std::vector<DenseGrid>& grids, std::vector<Texture>& textures, std::span<const Brick> bricks) {
     const size_t n = grids.empty() ? 1 : grids.front().cell_count();
-    for (size_t g = 0; g < depths.size(); ++g) {
+    for (size_t g = 0; g < textures.size(); ++g) {
       packed.assign(4 * n, 0.0f);
       for (size_t c = 0; c < 4 && 4 * g + c < grids.size(); ++c) {
         const std::vector<float>& v = grids[4 * g + c].values();
         for (size_t i = 0; i < n; ++i) packed[4 * i + c] = v[i];
       }
-      if (bricks.empty()) depths[g].upload(packed);
-      else depths[g].upload(packed, bricks);
+      if (bricks.empty()) textures[g].upload(packed);
+      else textures[g].upload(packed, bricks);
     }
+  }
+
+  void upload_depths(const std::vector<DenseGrid>& grids, std::span<const Brick> bricks) {
+    if (grids.size() != scene.lights.size())
+      throw Error("depths", std::to_string(grids.size()) + " volumes",
+                  "one per point, spot or directional light (" + std::to_string(scene.lights.size()) + ")");
+    for (size_t l = 0; l < grids.size(); ++l) check_grid(grids[l], "depths[" + std::to_string(l) + "]");
+    upload_groups(grids, depths, bricks);
+  }
+
+  // The surfaces' shadows in the medium, as the CPU marchers compute them.
+  void upload_visibility(const grids::DenseGrid& like) {
+    const std::vector<DenseGrid> v = grids::surface_visibility(like, scene.lights, scene.surfaces);
+    if (v.empty()) return;
+    if (visibility.empty())
+      for (size_t g = 0; g < depths.size(); ++g) visibility.push_back(Texture::volume(cells, 4, TexelFormat::float32));
+    upload_groups(v, visibility, {});
   }
 
   void set_static_uniforms() {
@@ -125,6 +140,9 @@ struct VolumeDisplay::Impl {
     gl.Uniform1i(at("density"), kDensityUnit);
     const char* depth_names[] = {"depths0", "depths1", "depths2", "depths3"};
     for (int g = 0; g < 4; ++g) gl.Uniform1i(at(depth_names[g]), kDepthUnit + g);
+    const char* visibility_names[] = {"visibility0", "visibility1", "visibility2", "visibility3"};
+    for (int g = 0; g < 4; ++g) gl.Uniform1i(at(visibility_names[g]), kVisibilityUnit + g);
+    gl.Uniform1i(at("shadows"), visibility.empty() ? 0 : 1);
     gl.Uniform1i(at("phase_table"), kPhaseUnit);
     gl.Uniform1i(at("moments"), kMomentsUnit);
     gl.Uniform1i(at("weights"), kWeightsUnit);
@@ -294,6 +312,9 @@ struct VolumeDisplay::Impl {
     set_camera(camera);
     bind(kDensityUnit, GL_TEXTURE_3D, density->id());
     for (int g = 0; g < 4; ++g) bind(kDepthUnit + g, GL_TEXTURE_3D, depths[std::min<size_t>(static_cast<size_t>(g), depths.size() - 1)].id());
+    for (int g = 0; g < 4; ++g)
+      bind(kVisibilityUnit + g, GL_TEXTURE_3D,
+           (visibility.empty() ? *unused_volume : visibility[std::min<size_t>(static_cast<size_t>(g), visibility.size() - 1)]).id());
     bind(kPhaseUnit, GL_TEXTURE_2D, (phase_table ? *phase_table : *unused_plane).id());
     bind(kMomentsUnit, GL_TEXTURE_3D, (moments ? *moments : *unused_volume).id());
     bind(kWeightsUnit, GL_TEXTURE_2D, (weights ? *weights : *unused_plane).id());
@@ -334,6 +355,7 @@ VolumeDisplay::VolumeDisplay(const Scene& scene, const grids::ExtinctionVolume& 
   for (size_t g = 0; g < std::max<size_t>(1, (d.scene.lights.size() + 3) / 4); ++g)
     d.depths.push_back(Texture::volume(d.cells, 4, settings.format));
   d.upload_depths(depths, {});
+  d.upload_visibility(volume.density);
 
   d.program = link_program(d.gl);
   d.gl.GenVertexArrays(1, &d.vao);

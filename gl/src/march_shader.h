@@ -27,6 +27,8 @@ uniform ivec3 cells;
 uniform float step_length;
 uniform sampler3D density;
 uniform sampler3D depths0, depths1, depths2, depths3;  // lights 4i..4i+3 in r, g, b, a
+uniform sampler3D visibility0, visibility1, visibility2, visibility3;  // the surfaces' shadows, as the depths
+uniform int shadows;  // 1: the visibility volumes hold the surfaces' shadows
 uniform vec3 sigma_t_view, sigma_t_light, albedo_single, albedo_ms, background;
 
 // Phase: [c0 + c2 mu^2] [sum of lobes k / d^(3/2)], d = a + b (1 - s mu); or a table in mu.
@@ -216,13 +218,20 @@ void main() {
       if (light_count > 4) g1 = texture(depths1, uvw);
       if (light_count > 8) g2 = texture(depths2, uvw);
       if (light_count > 12) g3 = texture(depths3, uvw);
+      vec4 v0 = vec4(1.0), v1 = vec4(1.0), v2 = vec4(1.0), v3 = vec4(1.0);
+      if (shadows == 1) {
+        v0 = texture(visibility0, uvw);
+        if (light_count > 4) v1 = texture(visibility1, uvw);
+        if (light_count > 8) v2 = texture(visibility2, uvw);
+        if (light_count > 12) v3 = texture(visibility3, uvw);
+      }
       vec3 single = vec3(0.0);
       for (int l = 0; l < light_count; ++l) {
         vec3 to_light, E;
         float dist;
         arrive(l, x, to_light, dist, E);
         if (E == vec3(0.0)) continue;
-        single += phase(dot(to_light, d)) * E * exp(-sigma_t_light * pick(l, g0, g1, g2, g3));
+        single += phase(dot(to_light, d)) * E * pick(l, v0, v1, v2, v3) * exp(-sigma_t_light * pick(l, g0, g1, g2, g3));
       }
       vec3 scattered = albedo_single * single;
       if (ms_groups > 0) {
@@ -252,6 +261,12 @@ void main() {
       arrive(l, p, to_light, dist, E);
       float cos_i = dot(normal, to_light);
       if (cos_i <= 0.0) continue;
+      float t_block;
+      vec3 n_block;
+      int blocker;
+      // In a surface's shadow? From just off the surface: float32 hits the surface itself otherwise.
+      vec3 from = p + normal * (1e-4 * (1.0 + length(p)));
+      if (nearest_surface(from, to_light, t_block, n_block, blocker) && t_block < dist * (1.0 - 1e-6)) continue;
       float depth;
       if (inside_box(p)) {
         vec3 uvw = (p - box_lo) / (box_hi - box_lo);

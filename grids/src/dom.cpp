@@ -16,6 +16,16 @@ namespace haze::grids {
 
 namespace {
 
+// The depths the first-collision source reads at cell centres: those of the cells a surface hides
+// from a light made opaque (shadowed_depths); the depths themselves without surfaces.
+std::vector<DenseGrid> source_depths(const Scene& scene, const ExtinctionVolume& volume, const std::vector<DenseGrid>& depths, int threads) {
+  if (scene.surfaces.empty()) return depths;
+  std::vector<Light> delta;
+  for (const Light& l : scene.lights)
+    if (!std::holds_alternative<SkyLight>(l)) delta.push_back(l);
+  return shadowed_depths(depths, surface_visibility(volume.density, delta, scene.surfaces, threads));
+}
+
 // Along each camera ray inside the volume, up to the first surface, the formal solution of the
 // (delta-M scaled) equation for light scattered at least once:
 //   L += T' (1 - e^(-sigma_t' rho step)) [albedo' sum_k c_k(w) m_k + albedo / (1 - albedo f) q1(w)],
@@ -25,6 +35,7 @@ namespace {
 Image gather_scattered(const Scene& delta, const ExtinctionVolume& volume, const std::vector<DenseGrid>& depths,
                        const DomSolution& solution, double step_cells, const RenderOptions& options) {
   const DenseGrid& density = volume.density;
+  const std::vector<DenseGrid> visibility = surface_visibility(density, delta.lights, delta.surfaces, options.threads);
   const Vec3 h = density.cell_size();
   const double step = step_cells * std::min({h.x, h.y, h.z});
   const auto n = static_cast<size_t>(solution.terms());
@@ -72,9 +83,9 @@ Image gather_scattered(const Scene& delta, const ExtinctionVolume& volume, const
           Rgb single(0.0);
           for (size_t l = 0; l < delta.lights.size(); ++l) {
             if (!arrival(delta.lights[l], p, a) || a.irradiance == Rgb(0.0)) continue;
-            double depth = 0.0;
-            for (int e = 0; e < 8; ++e) depth += stencil.weight[e] * static_cast<double>(depths[l].values()[stencil.offset[e]]);
-            single += volume.phase.eval(-a.to_light, -ray.direction) * a.irradiance * glm::exp(-volume.sigma_t_scale * depth);
+            const double depth = stencil.apply(depths[l].values().data());
+            const double visible = visibility.empty() ? 1.0 : stencil.apply(visibility[l].values().data());
+            single += volume.phase.eval(-a.to_light, -ray.direction) * a.irradiance * visible * glm::exp(-volume.sigma_t_scale * depth);
           }
           const Rgb step_transmittance = glm::exp(-sigma_t * rho * dt);
           radiance += transmittance * (Rgb(1.0) - step_transmittance) * (albedo * inscattered + single_albedo * single);
@@ -156,13 +167,13 @@ class DomMethodSolution final : public GridSolution {
     }
     update_depths(scene, change.medium.has_value(), depth_, report);
     report.stats["depth_seconds"] = watch.lap();
-    const bool relit = change.medium || change.lights;
+    const bool relit = change.medium || change.lights || change.surfaces;  // surfaces shadow the first-collision source
     if (relit) {
       DomSettings warm = settings_;
       warm.progress = options.progress;
       // A budget of sweeps: source iteration, each sweep with the first-collision source in it.
       if (warm_iterations_ > 0) warm.max_iterations = warm_iterations_, warm.accelerator = DomAccelerator::none;
-      DomSolution next = solve_dom(volume_, scene.lights, depths_, warm, &solution_);
+      DomSolution next = solve_dom(volume_, scene.lights, source_depths(scene, volume_, depths_, options.threads), warm, &solution_);
       report.redone.push_back("moments: first-collision source and " + to_text(next.iterations) + " sweeps over " + to_text(next.channels) +
                               " channel(s) from the previous solution");
       report.stats["iterations"] = next.iterations;
@@ -225,7 +236,7 @@ DomFields dom_fields(const Scene& scene, const RenderOptions& options) {
   const double depth_seconds = watch.lap();
 
   dom.progress = options.progress;
-  DomSolution solution = solve_dom(volume, scene.lights, delta_depths, dom);
+  DomSolution solution = solve_dom(volume, scene.lights, source_depths(scene, volume, delta_depths, options.threads), dom);
   const double solve_seconds = watch.lap();
   dom.progress = nullptr;
   DomFields fields{std::move(volume), std::move(delta_depths), std::move(solution), step_cells, {}, resolution, dom, depth, warm_iterations};

@@ -1,5 +1,6 @@
 // The ray marcher of method "propagation" (seed 003 sec. 4.4, eq. 8-10): the float64 reference
-// one pixel at a time, and the SIMD kernel (haze/simd/march_rays.h) over each image row.
+// one pixel at a time, and the SIMD kernel (haze/simd/march_rays.h) over each image row. Surfaces
+// shadow the medium (surface_visibility, trilinear) and each other (a ray to each light).
 #include <haze/core/error.h>
 #include <haze/core/grid_walk.h>
 #include <haze/grids/optical_depth.h>
@@ -33,13 +34,30 @@ struct Marcher {
   double step;
   // The lights' depths interleaved (all lights of a cell together): one stencil reads 8 short runs.
   std::vector<float> packed;
+  // The same for the surfaces' shadows (surface_visibility); empty without surfaces.
+  std::vector<float> packed_visibility;
 
-  Marcher(const Scene& s, const ExtinctionVolume& v, const std::vector<DenseGrid>& d, double step_length)
-      : scene(s), volume(v), depths(d), sigma_t(v.sigma_t_scale), step(step_length) {
-    const size_t lights = depths.size(), cells = volume.density.cell_count();
-    packed.resize(cells * lights);
+  Marcher(const Scene& s, const ExtinctionVolume& v, const std::vector<DenseGrid>& d, double step_length, int threads)
+      : scene(s), volume(v), depths(d), sigma_t(v.sigma_t_scale), step(step_length), packed(interleave(d)) {
+    if (volume.albedo == Rgb(0.0)) return;  // nothing scatters: the medium's light needs no shadows
+    packed_visibility = interleave(surface_visibility(volume.density, scene.lights, scene.surfaces, threads));
+  }
+
+  // Per-light volumes interleaved, [cell * lights + l].
+  static std::vector<float> interleave(const std::vector<DenseGrid>& grids) {
+    if (grids.empty()) return {};
+    const size_t lights = grids.size(), cells = grids.front().cell_count();
+    std::vector<float> out(cells * lights);
     for (size_t c = 0; c < cells; ++c)
-      for (size_t l = 0; l < lights; ++l) packed[c * lights + l] = depths[l].values()[c];
+      for (size_t l = 0; l < lights; ++l) out[c * lights + l] = grids[l].values()[c];
+    return out;
+  }
+
+  // Whether a surface lies between p and the light.
+  bool shadowed(const Vec3& p, const LightArrival& a) const {
+    double t;
+    Vec3 normal;
+    return !scene.surfaces.empty() && nearest_surface(scene.surfaces, {p, a.to_light}, a.distance * (1.0 - 1e-9), t, normal);
   }
 
   Hit hit(const Ray& ray) const {
@@ -68,7 +86,7 @@ struct Marcher {
   void march(const Ray& ray, const Steps& s, Rgb& radiance, Rgb& transmittance) const {
     radiance = Rgb(0.0), transmittance = Rgb(1.0);
     const size_t lights = scene.lights.size();
-    std::vector<double> depth(lights);
+    std::vector<double> depth(lights), visible(lights, 1.0);
     LightArrival a;
     for (int i = 0; i < s.count; ++i) {
       const Vec3 x = ray.at(s.t0 + (i + 0.5) * s.dt);
@@ -81,10 +99,17 @@ struct Marcher {
         const float* run = packed.data() + stencil.offset[m] * lights;
         for (size_t l = 0; l < lights; ++l) depth[l] += stencil.weight[m] * static_cast<double>(run[l]);
       }
+      if (!packed_visibility.empty()) {
+        std::fill(visible.begin(), visible.end(), 0.0);
+        for (int m = 0; m < 8; ++m) {
+          const float* run = packed_visibility.data() + stencil.offset[m] * lights;
+          for (size_t l = 0; l < lights; ++l) visible[l] += stencil.weight[m] * static_cast<double>(run[l]);
+        }
+      }
       Rgb in(0.0);
       for (size_t l = 0; l < lights; ++l) {
         if (!arrival(scene.lights[l], x, a) || a.irradiance == Rgb(0.0)) continue;
-        in += volume.phase.eval(-a.to_light, -ray.direction) * a.irradiance * glm::exp(-sigma_t * depth[l]);
+        in += volume.phase.eval(-a.to_light, -ray.direction) * a.irradiance * visible[l] * glm::exp(-sigma_t * depth[l]);
       }
       const Rgb step_transmittance = glm::exp(-sigma_t * rho * s.dt);
       radiance += transmittance * volume.albedo * (Rgb(1.0) - step_transmittance) * in;
@@ -102,7 +127,7 @@ struct Marcher {
     for (size_t l = 0; l < scene.lights.size(); ++l) {
       if (!arrival(scene.lights[l], p, a)) continue;
       const double cos_i = glm::dot(h.normal, a.to_light);
-      if (cos_i <= 0.0) continue;
+      if (cos_i <= 0.0 || shadowed(p, a)) continue;
       surface += h.surface->brdf(a.to_light, -ray.direction, h.normal) * a.irradiance * cos_i * glm::exp(-sigma_t * depth_to_light(l, p, a));
     }
     return radiance + transmittance * surface;
@@ -152,6 +177,7 @@ bool simd_volume(const Marcher& m, std::vector<simd::MarchLight>& lights, simd::
   }
   v.density = density.values().data();
   v.depths = m.packed.data();
+  v.visibility = m.packed_visibility.empty() ? nullptr : m.packed_visibility.data();
   v.lights = lights.data();
   v.light_count = static_cast<int>(lights.size());
   v.channels = all_grey ? 1 : 3;
@@ -196,7 +222,7 @@ Image march_image(const Scene& scene, const ExtinctionVolume& volume, const std:
     throw Error("depths", to_text(depths.size()) + " volumes", "one per light (" + to_text(scene.lights.size()) + ")");
   if (!(settings.step_cells > 0.0)) throw Error("step", to_text(settings.step_cells), "a step > 0 cells");
   const Vec3 h = volume.density.cell_size();
-  const Marcher marcher(scene, volume, depths, settings.step_cells * std::min({h.x, h.y, h.z}));
+  const Marcher marcher(scene, volume, depths, settings.step_cells * std::min({h.x, h.y, h.z}), options.threads);
   std::vector<simd::MarchLight> lights;
   simd::MarchVolume simd_view;
   const bool use_simd = !settings.scalar && simd_volume(marcher, lights, simd_view);

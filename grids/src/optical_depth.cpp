@@ -333,4 +333,36 @@ float sample_trilinear(const DenseGrid& grid, const Vec3& p) {
   return static_cast<float>(TrilinearStencil(grid.bounds(), grid.resolution(), p).apply(grid.values().data()));
 }
 
+std::vector<DenseGrid> surface_visibility(const DenseGrid& grid, const std::vector<Light>& lights, const std::vector<Surface>& surfaces,
+                                          int threads) {
+  std::vector<DenseGrid> out;
+  if (surfaces.empty()) return out;
+  const auto& n = grid.resolution();
+  for (const Light& light : lights) {
+    DenseGrid v(n, grid.bounds());
+    parallel_for(n[2], threads, 1, [&](long long k0, long long k1) {
+      LightArrival a;
+      for (auto k = static_cast<int>(k0); k < k1; ++k)
+        for (int j = 0; j < n[1]; ++j)
+          for (int i = 0; i < n[0]; ++i) {
+            const Vec3 x = grid.cell_center(i, j, k);
+            double t;
+            Vec3 normal;
+            // The sky, or a light at x: nothing to block.
+            const bool blocked = arrival(light, x, a) && a.distance > 0.0 && nearest_surface(surfaces, {x, a.to_light}, a.distance, t, normal);
+            v.at(i, j, k) = blocked ? 0.0f : 1.0f;
+          }
+    });
+    out.push_back(std::move(v));
+  }
+  return out;
+}
+
+std::vector<DenseGrid> shadowed_depths(std::vector<DenseGrid> depths, const std::vector<DenseGrid>& visibility) {
+  for (size_t l = 0; l < depths.size() && l < visibility.size(); ++l)
+    for (size_t c = 0; c < depths[l].values().size(); ++c)
+      if (visibility[l].values()[c] == 0.0f) depths[l].values()[c] += kShadowDepth;
+  return depths;
+}
+
 }  // namespace haze::grids

@@ -101,6 +101,9 @@ Rgb GridSolution::transmittance(size_t light, const Vec3& x) const {
 
 Rgb GridSolution::unscattered(size_t light, const Vec3& x, LightArrival& a) const {
   if (!arrival(scene_.lights[light], x, a)) return Rgb(0.0);
+  double t;
+  Vec3 normal;
+  if (!scene_.surfaces.empty() && a.distance > 0.0 && nearest_surface(scene_.surfaces, {x, a.to_light}, a.distance, t, normal)) return Rgb(0.0);
   return a.irradiance * transmittance(light, x);
 }
 

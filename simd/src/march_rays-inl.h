@@ -96,6 +96,12 @@ HWY_INLINE void MarchVector(D d, const MarchVolume& v, const PhaseParams& phase,
           falloff = hn::IfThenElseZero(inside, hn::Mul(falloff, cone));
         }
       }
+      if (v.visibility) {
+        V visible = zero;
+        for (int m = 0; m < 8; ++m)
+          visible = hn::MulAdd(weight[m], hn::GatherIndex(d, v.visibility + l, hn::Mul(offset[m], lights)), visible);
+        falloff = hn::Mul(falloff, visible);
+      }
       const V mu = hn::MulAdd(to[0], dir[0], hn::MulAdd(to[1], dir[1], hn::Mul(to[2], dir[2])));
       const V weight_l = hn::Mul(EvalPhase(d, phase, mu), falloff);
       for (int c = 0; c < C; ++c)

@@ -97,6 +97,25 @@ TEST(DomSolution, WarmStartAdvancesTowardTheNewSolution) {
   EXPECT_LT(relative_difference(full.render().radiance, render(scene, "dom", with(settings)).radiance), 2e-3);
 }
 
+// Surfaces shadow the first-collision source: a sphere added by an update between the sun and
+// the cloud's centre lowers the fluence there, and the updated solution renders what preparing
+// the scene with the sphere renders (to the GMRES tolerance; without solving again it would keep
+// the unshadowed moments).
+TEST(DomSolution, NewSurfacesShadowTheSolvedLight) {
+  register_methods();
+  Scene scene = lit_cloud(true, 12, 10);
+  scene.medium->bounds = {Vec3(-1.0), Vec3(1.0)};
+  const nlohmann::json settings = {{"resolution", 20}, {"directions", 32}, {"terms", 9}};
+  Solution solution = prepare(scene, "dom", with(settings));
+  const Rgb before = solution.fluence(Vec3(0.0));
+  const Vec3 to_sun = -std::get<DirectionalLight>(scene.lights[1]).direction;
+  scene.surfaces = {Surface{Sphere{1.2 * to_sun, 0.5}, Rgb(0.5), Rgb(0.0), 1.0}};
+  const UpdateReport report = solution.update({.surfaces = scene.surfaces});
+  EXPECT_FALSE(report.rebuilt);
+  EXPECT_LT(solution.fluence(Vec3(0.0)).g, 0.9 * before.g);
+  EXPECT_LT(relative_difference(solution.render().radiance, render(scene, "dom", with(settings)).radiance), 2e-3);
+}
+
 // With an isotropic phase (no delta-M), S(x, w) = phi(x) / (4 pi) for every w: the two fields
 // take different paths (the direction weights against the phase matrix's rows).
 TEST(DomSolution, FluenceAndInscatteredAgreeForAnIsotropicPhase) {

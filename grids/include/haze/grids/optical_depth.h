@@ -5,6 +5,7 @@
 #pragma once
 
 #include <haze/core/light.h>
+#include <haze/core/surface.h>
 #include <haze/grids/grid.h>
 
 #include <string>
@@ -46,6 +47,18 @@ DenseGrid optical_depth(const DenseGrid& density, const Light& light, const Dept
 // and pass; here each light is one pass over its own volume, lights in parallel).
 std::vector<DenseGrid> optical_depths(const DenseGrid& density, const std::vector<Light>& lights, const DepthOptions& options = {},
                                       DepthStats* stats = nullptr);
+
+// Surface shadows (DESIGN.md "Surfaces are part of the transport"): per light of `lights` (point,
+// spot or directional, as optical_depths), 1 at the cell centres of `grid` that see the light past
+// every surface and 0 where a surface is in the way. Empty when there are no surfaces. Gathers
+// read it trilinear and multiply the light's E e^-tau by it; first-collision sources, at cell
+// centres, read shadowed_depths.
+std::vector<DenseGrid> surface_visibility(const DenseGrid& grid, const std::vector<Light>& lights, const std::vector<Surface>& surfaces,
+                                          int threads = 0);
+// `depths` with kShadowDepth added where `visibility` is 0 (the cells a surface hides from the
+// light: e^(-sigma_t depth) is 0 there); unchanged when visibility is empty.
+inline constexpr float kShadowDepth = 1e30f;
+std::vector<DenseGrid> shadowed_depths(std::vector<DenseGrid> depths, const std::vector<DenseGrid>& visibility);
 
 // integral of the grid's piecewise-constant density along the segment a -> b (DDA, exact).
 double density_integral_dda(const DenseGrid& density, const Vec3& a, const Vec3& b);

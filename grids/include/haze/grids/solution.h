@@ -21,10 +21,11 @@ class GridSolution : public MethodSolution {
   virtual const DomSolution* dom() const { return nullptr; }
   double step_cells() const { return step_cells_; }
 
-  // exp(-sigma_t_scale * depth) toward the light: at x inside the grid, trilinear; outside, from
-  // where the segment to the light enters the grid (1 where it misses it).
+  // exp(-sigma_t_scale * depth) toward the light, through the medium (surfaces not counted): at x
+  // inside the grid, trilinear; outside, from where the segment to the light enters the grid (1
+  // where it misses it).
   Rgb transmittance(size_t light, const Vec3& x) const override;
-  // The unscattered light of every delta light (E e^-tau), plus, for the DOM, the diffuse
+  // The unscattered light of every delta light (E e^-tau, 0 where a surface hides the light), plus, for the DOM, the diffuse
   // radiance's integral sum_k c_k m_k with c_k = sum_d w_d Q[d][k] (exact for the kept terms: the
   // constant is an eigenvector of the renormalized phase matrix).
   Rgb fluence(const Vec3& x) const override;

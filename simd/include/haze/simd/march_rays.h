@@ -4,7 +4,7 @@
 //
 // Per ray, steps s < steps of length dt from t0, at the midpoints x:
 //   rho   = trilinear density, depth_l = trilinear optical depth to light l (cell-centred, clamped),
-//   L_in  = sum_l p(to_light_l . dir) E_l(x) e^(-sigma_t depth_l),
+//   L_in  = sum_l p(to_light_l . dir) E_l(x) V_l e^(-sigma_t depth_l)   (V_l trilinear visibility, or 1),
 //   L    += T albedo (1 - e^(-sigma_t rho dt)) L_in,   T *= e^(-sigma_t rho dt)   (per channel).
 #pragma once
 
@@ -30,6 +30,7 @@ struct MarchVolume {
   float lo[3] = {0, 0, 0}, h[3] = {1, 1, 1};
   const float* density = nullptr;  // x fastest
   const float* depths = nullptr;   // depths[cell * light_count + l]
+  const float* visibility = nullptr;  // the same layout, in [0, 1] (surface shadows); null: 1
   const MarchLight* lights = nullptr;
   int light_count = 0;
   float sigma_t[3] = {1, 1, 1}, albedo[3] = {1, 1, 1};
