@@ -26,14 +26,22 @@ std::vector<DenseGrid> source_depths(const Scene& scene, const ExtinctionVolume&
   return shadowed_depths(depths, surface_visibility(volume.density, delta, scene.surfaces, threads));
 }
 
+constexpr int kSurfaceDirections = 64;  // over the sphere: the hemisphere above a surface point gets about half
+
 // Along each camera ray inside the volume, up to the first surface, the formal solution of the
 // (delta-M scaled) equation for light scattered at least once:
 //   L += T' (1 - e^(-sigma_t' rho step)) [albedo' sum_k c_k(w) m_k + albedo / (1 - albedo f) q1(w)],
-//   q1(w) = sum_lights p(w_light . w) E_light e^(-sigma_t depth_light)   (single scattering),
-// c(w) from inscatter_weights toward the eye, density, depths and moments trilinear at the step's
-// midpoint. Without delta-M (f = 0) this is the propagation marcher's estimator plus the gather.
+//   q1(w) = sum_lights p(w_light . w) E_light V_light e^(-sigma_t depth_light)   (single scattering),
+// c(w) from inscatter_weights toward the eye, density, depths, visibility and moments trilinear at
+// the step's midpoint. Without delta-M (f = 0) this is the propagation marcher's estimator plus the
+// gather. Then, where the ray meets a surface, the light the medium scatters onto it and the sky
+// through the medium, reflected toward the eye and seen through T':
+//   sum_j (4 pi / K) brdf(w_j, wo) max(0, n . w_j) [L_j + T_j sky],
+// with L_j and T_j the same integral along the ray from the surface point toward each of K
+// Fibonacci directions w_j (the first bounce, medium to surface; light the surface sends back into
+// the medium is left out).
 Image gather_scattered(const Scene& delta, const ExtinctionVolume& volume, const std::vector<DenseGrid>& depths,
-                       const DomSolution& solution, double step_cells, const RenderOptions& options) {
+                       const DomSolution& solution, double step_cells, const Rgb& sky, const RenderOptions& options) {
   const DenseGrid& density = volume.density;
   const std::vector<DenseGrid> visibility = surface_visibility(density, delta.lights, delta.surfaces, options.threads);
   const Vec3 h = density.cell_size();
@@ -43,53 +51,84 @@ Image gather_scattered(const Scene& delta, const ExtinctionVolume& volume, const
   const Rgb sigma_t = dom::delta_m_sigma_t(volume.sigma_t_scale, volume.albedo, f);
   const Rgb albedo = dom::delta_m_albedo(volume.albedo, f);
   const Rgb single_albedo = volume.albedo / (Rgb(1.0) - volume.albedo * f);
+  const DirectionSet around = DirectionSet::fibonacci(kSurfaceDirections);
+  std::vector<Eigen::VectorXd> around_weights;
+  if (!delta.surfaces.empty())
+    for (int j = 0; j < around.size(); ++j) around_weights.push_back(inscatter_weights(solution, -around[j]));
+
+  // The scattered light arriving at ray.origin from along ray.direction up to t_end (c for that
+  // direction), and the transmittance over the stretch.
+  auto scattered_along = [&](const Ray& ray, double t_end, const Eigen::VectorXd& c, std::vector<double>& m, Rgb& transmittance) {
+    Rgb radiance(0.0);
+    transmittance = Rgb(1.0);
+    double t0 = 0.0, t1 = t_end;
+    if (!density.bounds().clip(ray, t0, t1) || !(t1 > t0)) return radiance;
+    const int steps = static_cast<int>(std::ceil((t1 - t0) / step));
+    const double dt = (t1 - t0) / steps;
+    LightArrival a;
+    for (int s = 0; s < steps; ++s) {
+      const Vec3 p = ray.at(t0 + (s + 0.5) * dt);
+      const TrilinearStencil stencil(density.bounds(), density.resolution(), p);
+      const double rho = stencil.apply(density.values().data());
+      if (rho <= 0.0) continue;
+      Rgb inscattered(0.0);
+      for (int ch = 0; ch < solution.channels; ++ch) {
+        std::fill(m.begin(), m.end(), 0.0);
+        const float* moments = solution.moments[static_cast<size_t>(ch)].data();
+        for (int e = 0; e < 8; ++e) {
+          const float* cell = moments + stencil.offset[e] * n;
+          for (size_t k = 0; k < n; ++k) m[k] += stencil.weight[e] * static_cast<double>(cell[k]);
+        }
+        double j = 0.0;
+        for (size_t k = 0; k < n; ++k) j += c(static_cast<int>(k)) * m[k];
+        inscattered[ch] = j;
+      }
+      if (solution.channels == 1) inscattered = Rgb(inscattered[0]);
+      Rgb single(0.0);
+      for (size_t l = 0; l < delta.lights.size(); ++l) {
+        if (!arrival(delta.lights[l], p, a) || a.irradiance == Rgb(0.0)) continue;
+        const double depth = stencil.apply(depths[l].values().data());
+        const double visible = visibility.empty() ? 1.0 : stencil.apply(visibility[l].values().data());
+        single += volume.phase.eval(-a.to_light, -ray.direction) * a.irradiance * visible * glm::exp(-volume.sigma_t_scale * depth);
+      }
+      const Rgb step_transmittance = glm::exp(-sigma_t * rho * dt);
+      radiance += transmittance * (Rgb(1.0) - step_transmittance) * (albedo * inscattered + single_albedo * single);
+      transmittance *= step_transmittance;
+    }
+    return radiance;
+  };
+
   const Camera& camera = delta.camera;
   Image image(camera.width_px, camera.height_px);
   ProgressTracker progress(options.progress, camera.height_px);
   parallel_for(camera.height_px, options.threads, 4, [&](long long y0, long long y1) {
     std::vector<double> m(n);
-    LightArrival a;
     for (auto y = static_cast<int>(y0); y < y1 && !progress.cancelled(); ++y) {
       for (int x = 0; x < camera.width_px; ++x) {
         const Ray ray = camera.pixel_ray(x, y);
-        double t_hit = kInfinity, t0 = 0.0;
+        double t_hit = kInfinity;
         Vec3 normal;
-        nearest_surface(delta.surfaces, ray, kInfinity, t_hit, normal);
-        double t1 = t_hit;
-        if (!density.bounds().clip(ray, t0, t1) || !(t1 > t0)) continue;
-        const int steps = static_cast<int>(std::ceil((t1 - t0) / step));
-        const double dt = (t1 - t0) / steps;
-        const Eigen::VectorXd c = inscatter_weights(solution, -ray.direction);
-        Rgb radiance(0.0), transmittance(1.0);
-        for (int s = 0; s < steps; ++s) {
-          const Vec3 p = ray.at(t0 + (s + 0.5) * dt);
-          const TrilinearStencil stencil(density.bounds(), density.resolution(), p);
-          double rho = 0.0;
-          for (int e = 0; e < 8; ++e) rho += stencil.weight[e] * static_cast<double>(density.values()[stencil.offset[e]]);
-          if (rho <= 0.0) continue;
-          Rgb inscattered(0.0);
-          for (int ch = 0; ch < solution.channels; ++ch) {
-            std::fill(m.begin(), m.end(), 0.0);
-            const float* moments = solution.moments[static_cast<size_t>(ch)].data();
-            for (int e = 0; e < 8; ++e) {
-              const float* cell = moments + stencil.offset[e] * n;
-              for (size_t k = 0; k < n; ++k) m[k] += stencil.weight[e] * static_cast<double>(cell[k]);
-            }
-            double j = 0.0;
-            for (size_t k = 0; k < n; ++k) j += c(static_cast<int>(k)) * m[k];
-            inscattered[ch] = j;
+        const Surface* surface = nearest_surface(delta.surfaces, ray, kInfinity, t_hit, normal);
+        Rgb transmittance(1.0), radiance(0.0);
+        double t0 = 0.0, t1 = t_hit;
+        if (density.bounds().clip(ray, t0, t1) && t1 > t0)
+          radiance = scattered_along(ray, t_hit, inscatter_weights(solution, -ray.direction), m, transmittance);
+        if (surface) {
+          const Vec3 point = ray.at(t_hit), wo = -ray.direction;
+          Rgb reflected(0.0);
+          for (int j = 0; j < around.size(); ++j) {
+            const double cos_i = glm::dot(normal, around[j]);
+            if (cos_i <= 0.0) continue;
+            const Ray up{point, around[j]};
+            double t_next = kInfinity;
+            Vec3 unused;
+            const bool blocked = nearest_surface(delta.surfaces, up, kInfinity, t_next, unused) != nullptr;
+            Rgb t_up;
+            Rgb arriving = scattered_along(up, t_next, around_weights[static_cast<size_t>(j)], m, t_up);
+            if (!blocked) arriving += t_up * sky;
+            reflected += around.weight(j) * cos_i * surface->brdf(around[j], wo, normal) * arriving;
           }
-          if (solution.channels == 1) inscattered = Rgb(inscattered[0]);
-          Rgb single(0.0);
-          for (size_t l = 0; l < delta.lights.size(); ++l) {
-            if (!arrival(delta.lights[l], p, a) || a.irradiance == Rgb(0.0)) continue;
-            const double depth = stencil.apply(depths[l].values().data());
-            const double visible = visibility.empty() ? 1.0 : stencil.apply(visibility[l].values().data());
-            single += volume.phase.eval(-a.to_light, -ray.direction) * a.irradiance * visible * glm::exp(-volume.sigma_t_scale * depth);
-          }
-          const Rgb step_transmittance = glm::exp(-sigma_t * rho * dt);
-          radiance += transmittance * (Rgb(1.0) - step_transmittance) * (albedo * inscattered + single_albedo * single);
-          transmittance *= step_transmittance;
+          radiance += transmittance * reflected;
         }
         image.set(x, y, radiance);
       }
@@ -106,10 +145,12 @@ Image render_dom(const Scene& scene, const ExtinctionVolume& volume, const std::
                  const DomSolution& solution, double step_cells, const RenderOptions& options) {
   Scene delta = scene;
   delta.lights.clear();
+  Rgb sky(0.0);
   for (const Light& l : scene.lights) {
-    if (const auto* sky = std::get_if<SkyLight>(&l)) delta.background += sky->radiance;
+    if (const auto* s = std::get_if<SkyLight>(&l)) sky += s->radiance;
     else delta.lights.push_back(l);
   }
+  delta.background += sky;
   if (delta_depths.size() != delta.lights.size())
     throw Error("depths", to_text(delta_depths.size()) + " volumes", "one per point, spot or directional light (" + to_text(delta.lights.size()) + ")");
   // Unscattered light (surfaces, background): the marcher with albedo 0 and, under delta-M, the
@@ -122,7 +163,7 @@ Image render_dom(const Scene& scene, const ExtinctionVolume& volume, const std::
   march_options.progress = progress ? [&](double f) { return progress(0.3 * f); } : ProgressCallback();
   Image image = march_image(delta, dark, delta_depths, MarchSettings{step_cells}, march_options);
   march_options.progress = progress ? [&](double f) { return progress(0.3 + 0.7 * f); } : ProgressCallback();
-  const Image scattered = gather_scattered(delta, volume, delta_depths, solution, step_cells, march_options);
+  const Image scattered = gather_scattered(delta, volume, delta_depths, solution, step_cells, sky, march_options);
   for (int y = 0; y < image.height(); ++y)
     for (int x = 0; x < image.width(); ++x) image.set(x, y, image.at(x, y) + scattered.at(x, y));
   return image;
