@@ -37,10 +37,11 @@ struct Marcher {
   // The same for the surfaces' shadows (surface_visibility); empty without surfaces.
   std::vector<float> packed_visibility;
 
-  Marcher(const Scene& s, const ExtinctionVolume& v, const std::vector<DenseGrid>& d, double step_length, int threads)
+  Marcher(const Scene& s, const ExtinctionVolume& v, const std::vector<DenseGrid>& d, double step_length, int threads,
+          const std::vector<DenseGrid>* visibility)
       : scene(s), volume(v), depths(d), sigma_t(v.sigma_t_scale), step(step_length), packed(interleave(d)) {
-    if (volume.albedo == Rgb(0.0)) return;  // nothing scatters: the medium's light needs no shadows
-    packed_visibility = interleave(surface_visibility(volume.density, scene.lights, scene.surfaces, threads));
+    if (volume.albedo == Rgb(0.0) || scene.surfaces.empty()) return;  // no light in the medium to shadow
+    packed_visibility = interleave(visibility ? *visibility : surface_visibility(volume.density, scene.lights, scene.surfaces, threads));
   }
 
   // Per-light volumes interleaved, [cell * lights + l].
@@ -217,12 +218,14 @@ void march_row(const Marcher& m, const simd::MarchVolume& v, int y, Image& image
 }  // namespace
 
 Image march_image(const Scene& scene, const ExtinctionVolume& volume, const std::vector<DenseGrid>& depths,
-                  const MarchSettings& settings, const RenderOptions& options) {
+                  const MarchSettings& settings, const RenderOptions& options, const std::vector<DenseGrid>* visibility) {
   if (depths.size() != scene.lights.size())
     throw Error("depths", to_text(depths.size()) + " volumes", "one per light (" + to_text(scene.lights.size()) + ")");
   if (!(settings.step_cells > 0.0)) throw Error("step", to_text(settings.step_cells), "a step > 0 cells");
   const Vec3 h = volume.density.cell_size();
-  const Marcher marcher(scene, volume, depths, settings.step_cells * std::min({h.x, h.y, h.z}), options.threads);
+  if (visibility && !scene.surfaces.empty() && visibility->size() != depths.size())
+    throw Error("visibility", to_text(visibility->size()) + " volumes", "one per light (" + to_text(depths.size()) + ")");
+  const Marcher marcher(scene, volume, depths, settings.step_cells * std::min({h.x, h.y, h.z}), options.threads, visibility);
   std::vector<simd::MarchLight> lights;
   simd::MarchVolume simd_view;
   const bool use_simd = !settings.scalar && simd_volume(marcher, lights, simd_view);

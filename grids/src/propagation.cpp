@@ -31,12 +31,13 @@ class PropagationSolution final : public GridSolution {
         resolution_(fields.resolution),
         cutoff_(fields.cutoff) {
     stats = std::move(fields.stats);
+    visibility_ = surface_visibility(volume_.density, scene_.lights, scene_.surfaces, depth_.threads);
   }
 
   RenderResult render(const View& view, const RenderOptions& options) const override {
     const Stopwatch watch;
     const Scene seen = view_scene(scene_, view.camera);
-    RenderResult result{march_image(seen, volume_, depths_, march_, options), std::nullopt, {}};
+    RenderResult result{march_image(seen, volume_, depths_, march_, options, &visibility_), std::nullopt, {}};
     result.stats["march_seconds"] = watch.seconds();
     return result;
   }
@@ -54,6 +55,7 @@ class PropagationSolution final : public GridSolution {
     }
     update_depths(scene, change.medium.has_value(), depth_, report);
     report.stats["propagate_seconds"] = watch.lap();
+    if (change.medium || change.lights || change.surfaces) visibility_ = surface_visibility(volume_.density, scene.lights, scene.surfaces, options.threads);
     scene_ = scene;
     return report;
   }
@@ -63,6 +65,7 @@ class PropagationSolution final : public GridSolution {
   DepthOptions depth_;
   int resolution_;
   double cutoff_;
+  std::vector<DenseGrid> visibility_;  // surface_visibility: the surfaces' shadows, made once per prepare or update
 };
 
 class PropagationMethod final : public Method {

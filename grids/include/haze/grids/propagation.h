@@ -52,9 +52,11 @@ struct MarchSettings {
 // with density and depths trilinear at the step's midpoint and T_cam the transmittance so far
 // (the (1 - e^-tau) form keeps thick steps energy-conserving, where eq. 8's K_t step does not).
 // Surfaces (Lambert/Phong) are lit through the depth volume (or, outside it, a DDA walk through
-// the density) and seen through T_cam; no surface shadows. depths[i] belongs to scene.lights[i].
+// the density) where no other surface is in the way, and seen through T_cam; E_light is times its
+// visibility past the surfaces (surface_visibility: `visibility` when given, which a caller
+// rendering many frames keeps, else computed here). depths[i] belongs to scene.lights[i].
 Image march_image(const Scene& scene, const ExtinctionVolume& volume, const std::vector<DenseGrid>& depths,
-                  const MarchSettings& settings, const RenderOptions& options);
+                  const MarchSettings& settings, const RenderOptions& options, const std::vector<DenseGrid>* visibility = nullptr);
 
 // Everything method "propagation" computes before it marches, from the scene and the method's
 // settings in options.settings (resolution, optical_depth, sweep_layers, step, cutoff; unknown
