@@ -37,6 +37,9 @@ struct DemoArgs {
 };
 
 constexpr long long kPilotSpp = 64;
+// Part of each cached reference's key: raise it when the reference's image of a scene changes
+// (2: particle scenes render the Gaussians themselves, not a 96^3 resample).
+constexpr int kReferenceRevision = 2;
 constexpr double kCheapSeconds = 0.5;  // a method this quick at the reference's size is shown at twice it
 
 // What the demo renders a scene at, and the reference it compares with: the finest of 1%
@@ -67,7 +70,8 @@ Plan plan(const std::filesystem::path& file, const DemoArgs& a) {
   std::ifstream in(file);
   const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   const auto dir = default_cache_dir() / "demo";
-  const std::string key = file.stem().string() + "_" + to_text(std::hash<std::string>{}(text)) + "_" + to_text(a.reference_seconds) + "s";
+  const std::string key = file.stem().string() + "_" + to_text(std::hash<std::string>{}(text)) + "_" + to_text(a.reference_seconds) + "s_r" +
+                          to_text(kReferenceRevision);
   Plan p{file, 1, 0, 0.0, dir / (key + ".exr")};
   if (std::ifstream cached(dir / (key + ".json")); cached && std::filesystem::exists(p.reference)) {
     const nlohmann::json j = nlohmann::json::parse(cached);
