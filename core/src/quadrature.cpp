@@ -26,12 +26,7 @@ struct Context {
   DirectionSet sky_directions;
   int steps;
 
-  // True when a surface blocks the segment from x along dir (unit) up to distance.
-  bool occluded(const Vec3& x, const Vec3& dir, double distance) const {
-    double t;
-    Vec3 n;
-    return nearest_surface(scene.surfaces, {x, dir}, distance * (1.0 - 1e-9), t, n) != nullptr;
-  }
+  bool occluded(const Vec3& x, const Vec3& dir, double distance) const { return haze::occluded(scene.surfaces, x, dir, distance); }
 
   Rgb transmittance(const Vec3& x, const Vec3& dir, double distance) const {
     return medium ? medium->transmittance_along(x, dir, distance) : Rgb(1.0);

@@ -60,9 +60,7 @@ struct Tracer {
 
   // Transmittance from x along dir over distance (infinite for directional lights and the sky).
   Rgb transmittance(const Vec3& x, const Vec3& dir, double distance, Rng& rng) const {
-    double t;
-    Vec3 n;
-    if (nearest_surface(scene.surfaces, {x, dir}, distance * (1.0 - 1e-9), t, n)) return Rgb(0.0);
+    if (occluded(scene.surfaces, x, dir, distance)) return Rgb(0.0);
     if (!medium) return Rgb(1.0);
     if (homogeneous) {
       double t0 = 0.0, t1 = distance;

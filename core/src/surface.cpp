@@ -49,4 +49,10 @@ const Surface* nearest_surface(const std::vector<Surface>& surfaces, const Ray& 
   return hit;
 }
 
+bool occluded(const std::vector<Surface>& surfaces, const Vec3& x, const Vec3& dir, double distance) {
+  double t;
+  Vec3 n;
+  return !surfaces.empty() && nearest_surface(surfaces, {x, dir}, distance * (1.0 - 1e-9), t, n) != nullptr;
+}
+
 }  // namespace haze

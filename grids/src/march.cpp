@@ -54,12 +54,6 @@ struct Marcher {
     return out;
   }
 
-  // Whether a surface lies between p and the light.
-  bool shadowed(const Vec3& p, const LightArrival& a) const {
-    double t;
-    Vec3 normal;
-    return !scene.surfaces.empty() && nearest_surface(scene.surfaces, {p, a.to_light}, a.distance * (1.0 - 1e-9), t, normal);
-  }
 
   Hit hit(const Ray& ray) const {
     Hit h;
@@ -92,8 +86,7 @@ struct Marcher {
     for (int i = 0; i < s.count; ++i) {
       const Vec3 x = ray.at(s.t0 + (i + 0.5) * s.dt);
       const TrilinearStencil stencil(volume.density.bounds(), volume.density.resolution(), x);
-      double rho = 0.0;
-      for (int m = 0; m < 8; ++m) rho += stencil.weight[m] * static_cast<double>(volume.density.values()[stencil.offset[m]]);
+      const double rho = stencil.apply(volume.density.values().data());
       if (rho <= 0.0) continue;
       std::fill(depth.begin(), depth.end(), 0.0);
       for (int m = 0; m < 8; ++m) {
@@ -128,7 +121,7 @@ struct Marcher {
     for (size_t l = 0; l < scene.lights.size(); ++l) {
       if (!arrival(scene.lights[l], p, a)) continue;
       const double cos_i = glm::dot(h.normal, a.to_light);
-      if (cos_i <= 0.0 || shadowed(p, a)) continue;
+      if (cos_i <= 0.0 || occluded(scene.surfaces, p, a.to_light, a.distance)) continue;
       surface += h.surface->brdf(a.to_light, -ray.direction, h.normal) * a.irradiance * cos_i * glm::exp(-sigma_t * depth_to_light(l, p, a));
     }
     return radiance + transmittance * surface;

@@ -346,10 +346,8 @@ std::vector<DenseGrid> surface_visibility(const DenseGrid& grid, const std::vect
         for (int j = 0; j < n[1]; ++j)
           for (int i = 0; i < n[0]; ++i) {
             const Vec3 x = grid.cell_center(i, j, k);
-            double t;
-            Vec3 normal;
             // The sky, or a light at x: nothing to block.
-            const bool blocked = arrival(light, x, a) && a.distance > 0.0 && nearest_surface(surfaces, {x, a.to_light}, a.distance, t, normal);
+            const bool blocked = arrival(light, x, a) && a.distance > 0.0 && occluded(surfaces, x, a.to_light, a.distance);
             v.at(i, j, k) = blocked ? 0.0f : 1.0f;
           }
     });

@@ -13,10 +13,7 @@ namespace haze::grids {
 namespace {
 
 double sample(const DenseGrid& grid, const Vec3& x) {
-  const TrilinearStencil stencil(grid.bounds(), grid.resolution(), x);
-  double v = 0.0;
-  for (int e = 0; e < 8; ++e) v += stencil.weight[e] * static_cast<double>(grid.values()[stencil.offset[e]]);
-  return v;
+  return TrilinearStencil(grid.bounds(), grid.resolution(), x).apply(grid.values().data());
 }
 
 // The N moments of one channel at x, trilinear.
@@ -101,9 +98,7 @@ Rgb GridSolution::transmittance(size_t light, const Vec3& x) const {
 
 Rgb GridSolution::unscattered(size_t light, const Vec3& x, LightArrival& a) const {
   if (!arrival(scene_.lights[light], x, a)) return Rgb(0.0);
-  double t;
-  Vec3 normal;
-  if (!scene_.surfaces.empty() && a.distance > 0.0 && nearest_surface(scene_.surfaces, {x, a.to_light}, a.distance, t, normal)) return Rgb(0.0);
+  if (a.distance > 0.0 && occluded(scene_.surfaces, x, a.to_light, a.distance)) return Rgb(0.0);
   return a.irradiance * transmittance(light, x);
 }
 

@@ -95,59 +95,12 @@ double ParticleField::density_integral(const Vec3& x, const Vec3& direction, dou
   return sum;
 }
 
-GridDensity ParticleField::to_grid(const std::array<int, 3>& r, int threads) const {
-  GridDensity grid{r, std::vector<float>(static_cast<size_t>(r[0]) * static_cast<size_t>(r[1]) * static_cast<size_t>(r[2]), 0.0f)};
-  if (size() == 0) return grid;
-  const Vec3 cell = bounds_.extent() / Vec3(r[0], r[1], r[2]);
-  parallel_for(r[2], threads, 1, [&](long long k0, long long k1) {
-    for (auto k = static_cast<int>(k0); k < k1; ++k)
-      for (int j = 0; j < r[1]; ++j)
-        for (int i = 0; i < r[0]; ++i)
-          grid.values[(static_cast<size_t>(k) * static_cast<size_t>(r[1]) + static_cast<size_t>(j)) * static_cast<size_t>(r[0]) + static_cast<size_t>(i)] =
-              static_cast<float>(density(bounds_.lo + (Vec3(i, j, k) + 0.5) * cell));
-  });
-  return grid;
-}
-
-double ParticleField::max_density(const Aabb& region) const {
-  if (size() == 0) return 0.0;
-  const Vec3 centre = 0.5 * (region.lo + region.hi);
-  const double reach = 0.5 * glm::length(region.hi - region.lo) + kCut * h_max_;
-  if (!std::isfinite(reach)) return std::accumulate(w_.begin(), w_.end(), 0.0);
-  // Each Gaussian at its largest in the region: at the region's point nearest its centre.
-  double bound = 0.0;
-  for (size_t p : within(centre, reach)) {
-    const Vec3 x = position(p);
-    const Vec3 d = x - glm::clamp(x, region.lo, region.hi);
-    const double r2 = glm::dot(d, d) / (h_[p] * h_[p]);
-    if (r2 < kCut * kCut) bound += w_[p] * std::exp(-r2);
-  }
-  return bound;
-}
-
 MediumDesc particle_medium(ParticleSet set, int grid_resolution, int neighbours) {
   MediumDesc m;
   m.sigma_t = set.material.sigma_t, m.albedo = set.material.albedo, m.phase = set.material.phase;
   auto density = std::make_shared<ParticleDensity>(std::move(set), neighbours);
   m.bounds = density->bounds();
   m.density = FieldDensity{"particles", std::move(density), grid_resolution};
-  return m;
-}
-
-MediumDesc ParticleField::to_medium(int resolution, int threads) const {
-  MediumDesc m;
-  m.sigma_t = view_.material.sigma_t, m.albedo = view_.material.albedo, m.phase = view_.material.phase;
-  if (size() == 0) {  // nothing: a zero-density box
-    m.bounds = {Vec3(-1.0), Vec3(1.0)};
-    m.density = GridDensity{{1, 1, 1}, {0.0f}};
-    return m;
-  }
-  m.bounds = bounds_;
-  const Vec3 e = bounds_.extent();
-  const double cell = std::max({e.x, e.y, e.z}) / resolution;
-  std::array<int, 3> r;
-  for (int a = 0; a < 3; ++a) r[static_cast<size_t>(a)] = std::max(2, static_cast<int>(std::ceil(e[a] / cell)));
-  m.density = to_grid(r, threads);
   return m;
 }
 

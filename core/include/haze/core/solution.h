@@ -51,8 +51,8 @@ struct RenderResult {
 };
 
 // What a prepared method's renderer needs of `scene` seen from `camera`: its lights, surfaces,
-// background and directory, without the medium and particles (which the solution holds in its own
-// form, and which a render need not copy).
+// background and directory, without the medium (which the solution holds in its own form, and
+// which a render need not copy).
 Scene view_scene(const Scene& scene, const Camera& camera);
 
 // What changed since a solution was prepared (or last updated); unset fields are unchanged.

@@ -37,6 +37,9 @@ struct Surface {
 // The nearest of `surfaces` hit by the ray with t in (1e-7, t_max), or nullptr; writes its t and
 // normal (facing the ray's origin).
 const Surface* nearest_surface(const std::vector<Surface>& surfaces, const Ray& ray, double t_max, double& t, Vec3& normal);
+// Whether a surface blocks the segment from x along the unit dir over distance (infinite for the
+// sun and the sky), short of its end by 1e-9 of it: a light on a surface is not hidden by it.
+bool occluded(const std::vector<Surface>& surfaces, const Vec3& x, const Vec3& dir, double distance);
 
 }  // namespace haze
 

@@ -46,18 +46,12 @@ class ParticleField {
   Aabb bounds() const { return bounds_; }
 
   double density(const Vec3& x) const;
-  // An upper bound of rho over the region: the peaks of the Gaussians whose support can reach it.
-  double max_density(const Aabb& region) const;
   // The particles within `radius` of x (a FLANN radius query), in no particular order.
   std::vector<size_t> within(const Vec3& x, double radius) const;
   std::vector<float> density_at_particles(int threads) const;
   // integral of rho from x along the unit direction over length (may be infinite): exact for the
   // Gaussians (erf), summed over the particles whose support the segment meets.
   double density_integral(const Vec3& x, const Vec3& direction, double length) const;
-  // rho at the cell centres of `resolution` cells over bounds(), x fastest (a grid medium).
-  GridDensity to_grid(const std::array<int, 3>& resolution, int threads) const;
-  // The medium the field stands for, sampled: the grid over bounds() with the particles' material.
-  MediumDesc to_medium(int resolution, int threads) const;
 
  private:
   ParticleView view_;
