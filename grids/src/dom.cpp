@@ -10,6 +10,8 @@
 #include <haze/grids/optical_depth.h>
 #include <haze/grids/solution.h>
 
+#include "dom_gather.h"
+#include "dom_surfaces.h"
 #include "dom_internal.h"
 
 namespace haze::grids {
@@ -26,83 +28,76 @@ std::vector<DenseGrid> source_depths(const Scene& scene, const ExtinctionVolume&
   return shadowed_depths(depths, surface_visibility(volume.density, delta, scene.surfaces, threads));
 }
 
-constexpr int kSurfaceDirections = 64;  // over the sphere: the hemisphere above a surface point gets about half
+// The scene with its point, spot and directional lights only; writes the sky's radiance.
+Scene without_sky(const Scene& scene, Rgb& sky) {
+  Scene delta = scene;
+  delta.lights.clear();
+  sky = Rgb(0.0);
+  for (const Light& l : scene.lights) {
+    if (const auto* s = std::get_if<SkyLight>(&l)) sky += s->radiance;
+    else delta.lights.push_back(l);
+  }
+  return delta;
+}
 
-// Along each camera ray inside the volume, up to the first surface, the formal solution of the
-// (delta-M scaled) equation for light scattered at least once:
-//   L += T' (1 - e^(-sigma_t' rho step)) [albedo' sum_k c_k(w) m_k + albedo / (1 - albedo f) q1(w)],
-//   q1(w) = sum_lights p(w_light . w) E_light V_light e^(-sigma_t depth_light)   (single scattering),
-// c(w) from inscatter_weights toward the eye, density, depths, visibility and moments trilinear at
-// the step's midpoint. Without delta-M (f = 0) this is the propagation marcher's estimator plus the
-// gather. Then, where the ray meets a surface, the light the medium scatters onto it and the sky
-// through the medium, reflected toward the eye and seen through T':
-//   sum_j (4 pi / K) brdf(w_j, wo) max(0, n . w_j) [L_j + T_j sky],
-// with L_j and T_j the same integral along the ray from the surface point toward each of K
-// Fibonacci directions w_j (the first bounce, medium to surface; light the surface sends back into
-// the medium is left out).
+// The moments with the scene's surfaces in the transport: solve_dom (from `warm` when given),
+// then `passes` times the light the surfaces reflect from that solution (direct light and the
+// medium's, dom_surfaces.h) entering through the grid's faces, solved again from the last moments.
+// Each pass carries the light one more bounce between surfaces and medium. Progress is shared out
+// over the solves.
+struct SurfaceSolve {
+  DomSolution solution;
+  int iterations = 0, passes = 0;
+  double surface_seconds = 0.0;
+};
+SurfaceSolve solve_with_surfaces(const Scene& scene, const ExtinctionVolume& volume, const std::vector<DenseGrid>& depths, DomSettings settings,
+                                 const DomSolution* warm, int passes, double step_cells) {
+  SurfaceSolve out;
+  if (scene.surfaces.empty() || settings.scheme == DomScheme::paper) passes = 0;
+  const ProgressCallback progress = settings.progress;
+  auto share = [&](int solve) {
+    if (progress) settings.progress = [&progress, solve, passes](double f) { return progress((solve + f) / (passes + 1)); };
+  };
+  const std::vector<DenseGrid> sources = source_depths(scene, volume, depths, settings.threads);
+  share(0);
+  out.solution = solve_dom(volume, scene.lights, sources, settings, warm);
+  out.iterations = out.solution.iterations;
+  Rgb sky;
+  const Scene delta = without_sky(scene, sky);
+  for (; out.passes < passes; ++out.passes) {
+    Stopwatch watch;
+    const dom::SurfaceTexels texels = dom::surface_texels(delta, volume, depths, out.solution, sky, step_cells, settings.threads);
+    const dom::SurfaceLight light(delta, volume, depths, texels, sky, out.solution.delta_m_fraction);
+    const DomBoundary boundary = light.boundary();
+    out.surface_seconds += watch.seconds();
+    share(out.passes + 1);
+    out.solution = solve_dom(volume, scene.lights, sources, settings, &out.solution, &boundary);
+    out.iterations += out.solution.iterations;
+  }
+  if (!scene.surfaces.empty()) {
+    Stopwatch watch;
+    out.solution.surfaces =
+        std::make_shared<dom::SurfaceTexels>(dom::surface_texels(delta, volume, depths, out.solution, sky, step_cells, settings.threads));
+    out.surface_seconds += watch.seconds();
+  }
+  return out;
+}
+
+// Along each camera ray inside the volume, up to the first surface, the light scattered at least
+// once (Gather::along; without delta-M this is the propagation marcher's estimator plus the
+// gather). Then, where the ray meets a surface, the light the medium scatters onto it and the sky
+// through the medium, reflected toward the eye and seen through T' (Gather::around through the
+// BRDF: the first bounce, medium to surface), with what other surfaces reflect onto it when the
+// solution carries its surfaces' texels (one bounce between surfaces).
 Image gather_scattered(const Scene& delta, const ExtinctionVolume& volume, const std::vector<DenseGrid>& depths,
                        const DomSolution& solution, double step_cells, const Rgb& sky, const RenderOptions& options) {
-  const DenseGrid& density = volume.density;
-  const std::vector<DenseGrid> visibility = surface_visibility(density, delta.lights, delta.surfaces, options.threads);
-  const Vec3 h = density.cell_size();
-  const double step = step_cells * std::min({h.x, h.y, h.z});
-  const auto n = static_cast<size_t>(solution.terms());
-  const double f = solution.delta_m_fraction;
-  const Rgb sigma_t = dom::delta_m_sigma_t(volume.sigma_t_scale, volume.albedo, f);
-  const Rgb albedo = dom::delta_m_albedo(volume.albedo, f);
-  const Rgb single_albedo = volume.albedo / (Rgb(1.0) - volume.albedo * f);
-  const DirectionSet around = DirectionSet::fibonacci(kSurfaceDirections);
-  std::vector<Eigen::VectorXd> around_weights;
-  if (!delta.surfaces.empty())
-    for (int j = 0; j < around.size(); ++j) around_weights.push_back(inscatter_weights(solution, -around[j]));
-
-  // The scattered light arriving at ray.origin from along ray.direction up to t_end (c for that
-  // direction), and the transmittance over the stretch.
-  auto scattered_along = [&](const Ray& ray, double t_end, const Eigen::VectorXd& c, std::vector<double>& m, Rgb& transmittance) {
-    Rgb radiance(0.0);
-    transmittance = Rgb(1.0);
-    double t0 = 0.0, t1 = t_end;
-    if (!density.bounds().clip(ray, t0, t1) || !(t1 > t0)) return radiance;
-    const int steps = static_cast<int>(std::ceil((t1 - t0) / step));
-    const double dt = (t1 - t0) / steps;
-    LightArrival a;
-    for (int s = 0; s < steps; ++s) {
-      const Vec3 p = ray.at(t0 + (s + 0.5) * dt);
-      const TrilinearStencil stencil(density.bounds(), density.resolution(), p);
-      const double rho = stencil.apply(density.values().data());
-      if (rho <= 0.0) continue;
-      Rgb inscattered(0.0);
-      for (int ch = 0; ch < solution.channels; ++ch) {
-        std::fill(m.begin(), m.end(), 0.0);
-        const float* moments = solution.moments[static_cast<size_t>(ch)].data();
-        for (int e = 0; e < 8; ++e) {
-          const float* cell = moments + stencil.offset[e] * n;
-          for (size_t k = 0; k < n; ++k) m[k] += stencil.weight[e] * static_cast<double>(cell[k]);
-        }
-        double j = 0.0;
-        for (size_t k = 0; k < n; ++k) j += c(static_cast<int>(k)) * m[k];
-        inscattered[ch] = j;
-      }
-      if (solution.channels == 1) inscattered = Rgb(inscattered[0]);
-      Rgb single(0.0);
-      for (size_t l = 0; l < delta.lights.size(); ++l) {
-        if (!arrival(delta.lights[l], p, a) || a.irradiance == Rgb(0.0)) continue;
-        const double depth = stencil.apply(depths[l].values().data());
-        const double visible = visibility.empty() ? 1.0 : stencil.apply(visibility[l].values().data());
-        single += volume.phase.eval(-a.to_light, -ray.direction) * a.irradiance * visible * glm::exp(-volume.sigma_t_scale * depth);
-      }
-      const Rgb step_transmittance = glm::exp(-sigma_t * rho * dt);
-      radiance += transmittance * (Rgb(1.0) - step_transmittance) * (albedo * inscattered + single_albedo * single);
-      transmittance *= step_transmittance;
-    }
-    return radiance;
-  };
-
+  std::optional<dom::SurfaceLight> light;
+  if (solution.surfaces) light.emplace(delta, volume, depths, *solution.surfaces, sky, solution.delta_m_fraction);
+  const dom::Gather gather(delta, volume, depths, solution, step_cells, options.threads, light ? &*light : nullptr);
   const Camera& camera = delta.camera;
   Image image(camera.width_px, camera.height_px);
   ProgressTracker progress(options.progress, camera.height_px);
   parallel_for(camera.height_px, options.threads, 4, [&](long long y0, long long y1) {
-    std::vector<double> m(n);
     for (auto y = static_cast<int>(y0); y < y1 && !progress.cancelled(); ++y) {
       for (int x = 0; x < camera.width_px; ++x) {
         const Ray ray = camera.pixel_ray(x, y);
@@ -111,24 +106,12 @@ Image gather_scattered(const Scene& delta, const ExtinctionVolume& volume, const
         const Surface* surface = nearest_surface(delta.surfaces, ray, kInfinity, t_hit, normal);
         Rgb transmittance(1.0), radiance(0.0);
         double t0 = 0.0, t1 = t_hit;
-        if (density.bounds().clip(ray, t0, t1) && t1 > t0)
-          radiance = scattered_along(ray, t_hit, inscatter_weights(solution, -ray.direction), m, transmittance);
+        if (volume.density.bounds().clip(ray, t0, t1) && t1 > t0)
+          radiance = gather.along(ray, t_hit, inscatter_weights(solution, -ray.direction), transmittance);
         if (surface) {
-          const Vec3 point = ray.at(t_hit), wo = -ray.direction;
-          Rgb reflected(0.0);
-          for (int j = 0; j < around.size(); ++j) {
-            const double cos_i = glm::dot(normal, around[j]);
-            if (cos_i <= 0.0) continue;
-            const Ray up{point, around[j]};
-            double t_next = kInfinity;
-            Vec3 unused;
-            const bool blocked = nearest_surface(delta.surfaces, up, kInfinity, t_next, unused) != nullptr;
-            Rgb t_up;
-            Rgb arriving = scattered_along(up, t_next, around_weights[static_cast<size_t>(j)], m, t_up);
-            if (!blocked) arriving += t_up * sky;
-            reflected += around.weight(j) * cos_i * surface->brdf(around[j], wo, normal) * arriving;
-          }
-          radiance += transmittance * reflected;
+          const Vec3 wo = -ray.direction;
+          radiance += transmittance * gather.around(ray.at(t_hit), normal, sky,
+                                                    [&](const Vec3& wi) { return surface->brdf(wi, wo, normal); });
         }
         image.set(x, y, radiance);
       }
@@ -143,13 +126,8 @@ Image gather_scattered(const Scene& delta, const ExtinctionVolume& volume, const
 
 Image render_dom(const Scene& scene, const ExtinctionVolume& volume, const std::vector<DenseGrid>& delta_depths,
                  const DomSolution& solution, double step_cells, const RenderOptions& options) {
-  Scene delta = scene;
-  delta.lights.clear();
-  Rgb sky(0.0);
-  for (const Light& l : scene.lights) {
-    if (const auto* s = std::get_if<SkyLight>(&l)) sky += s->radiance;
-    else delta.lights.push_back(l);
-  }
+  Rgb sky;
+  Scene delta = without_sky(scene, sky);
   delta.background += sky;
   if (delta_depths.size() != delta.lights.size())
     throw Error("depths", to_text(delta_depths.size()) + " volumes", "one per point, spot or directional light (" + to_text(delta.lights.size()) + ")");
@@ -180,7 +158,8 @@ class DomMethodSolution final : public GridSolution {
         resolution_(fields.resolution),
         settings_(fields.settings),
         depth_(fields.depth),
-        warm_iterations_(fields.warm_iterations) {
+        warm_iterations_(fields.warm_iterations),
+        surface_passes_(fields.surface_passes) {
     stats = std::move(fields.stats);
   }
 
@@ -214,14 +193,15 @@ class DomMethodSolution final : public GridSolution {
       warm.progress = options.progress;
       // A budget of sweeps: source iteration, each sweep with the first-collision source in it.
       if (warm_iterations_ > 0) warm.max_iterations = warm_iterations_, warm.accelerator = DomAccelerator::none;
-      DomSolution next = solve_dom(volume_, scene.lights, source_depths(scene, volume_, depths_, options.threads), warm, &solution_);
-      report.redone.push_back("moments: first-collision source and " + to_text(next.iterations) + " sweeps over " + to_text(next.channels) +
-                              " channel(s) from the previous solution");
+      SurfaceSolve next = solve_with_surfaces(scene, volume_, depths_, warm, &solution_, surface_passes_, step_cells_);
+      report.redone.push_back("moments: first-collision source and " + to_text(next.iterations) + " sweeps over " +
+                              to_text(next.solution.channels) + " channel(s) from the previous solution" +
+                              (next.passes > 0 ? ", " + to_text(next.passes) + " surface pass(es)" : std::string()));
       report.stats["iterations"] = next.iterations;
-      report.stats["final_change"] = next.changes.empty() ? 0.0 : next.changes.back();
-      report.stats["converged"] = next.converged;
-      report.stats["sweep_seconds"] = next.sweep_seconds;
-      solution_ = std::move(next);
+      report.stats["final_change"] = next.solution.changes.empty() ? 0.0 : next.solution.changes.back();
+      report.stats["converged"] = next.solution.converged;
+      report.stats["sweep_seconds"] = next.solution.sweep_seconds;
+      solution_ = std::move(next.solution);
     }
     report.stats["solve_seconds"] = watch.lap();
     scene_ = scene;
@@ -234,6 +214,7 @@ class DomMethodSolution final : public GridSolution {
   DomSettings settings_;
   DepthOptions depth_;
   int warm_iterations_;
+  int surface_passes_;
 };
 
 class DomMethod final : public Method {
@@ -265,6 +246,7 @@ DomFields dom_fields(const Scene& scene, const RenderOptions& options) {
   depth.threads = options.threads;
   const double step_cells = settings.number("step");
   const int warm_iterations = static_cast<int>(settings.integer("warm_iterations"));
+  const int surface_passes = static_cast<int>(settings.integer("surface_passes"));
   settings.reject_unknown();
 
   Stopwatch watch;
@@ -277,10 +259,11 @@ DomFields dom_fields(const Scene& scene, const RenderOptions& options) {
   const double depth_seconds = watch.lap();
 
   dom.progress = options.progress;
-  DomSolution solution = solve_dom(volume, scene.lights, source_depths(scene, volume, delta_depths, options.threads), dom);
+  SurfaceSolve solved_surfaces = solve_with_surfaces(scene, volume, delta_depths, dom, nullptr, surface_passes, step_cells);
   const double solve_seconds = watch.lap();
   dom.progress = nullptr;
-  DomFields fields{std::move(volume), std::move(delta_depths), std::move(solution), step_cells, {}, resolution, dom, depth, warm_iterations};
+  DomFields fields{std::move(volume), std::move(delta_depths), std::move(solved_surfaces.solution), step_cells, {}, resolution, dom, depth,
+                   warm_iterations, surface_passes};
   const ExtinctionVolume& v = fields.volume;
   const DomSolution& solved = fields.solution;
   fields.stats = {{"cells", v.density.resolution()},
@@ -292,7 +275,9 @@ DomFields dom_fields(const Scene& scene, const RenderOptions& options) {
                   {"accelerator", name(dom.accelerator)},
                   {"storage", name(dom.storage)},
                   {"channels", solved.channels},
-                  {"iterations", solved.iterations},
+                  {"iterations", solved_surfaces.iterations},
+                  {"surface_passes", solved_surfaces.passes},
+                  {"surface_seconds", solved_surfaces.surface_seconds},
                   {"converged", solved.converged},
                   {"final_change", solved.changes.empty() ? 0.0 : solved.changes.back()},
                   {"skipped_fraction", solved.skipped_fraction},
@@ -323,7 +308,8 @@ MethodInfo dom_info() {
       SettingInfo::choice("storage", "float32", {"float32", "float16"}, "float16 halves the first-collision source and GMRES basis"),
       SettingInfo::choice("optical_depth", "exact", {"exact", "paper", "sweep"}, "how the depth to each light is computed"),
       SettingInfo::number("step", 0.5, 0.01, 4.0, "camera gather's ray-march step in cells"),
-      SettingInfo::integer("warm_iterations", 0, 0, 100000, "sweeps per update, each with the first-collision source in it (0: GMRES to the tolerance)")};
+      SettingInfo::integer("warm_iterations", 0, 0, 100000, "sweeps per update, each with the first-collision source in it (0: GMRES to the tolerance)"),
+      SettingInfo::integer("surface_passes", 2, 0, 100, "solves with the light surfaces reflect into the medium, one more bounce each (scheme sweep)")};
   for (auto [resolution, directions, terms] : {std::tuple{16, 32, 9}, {24, 48, 16}, {32, 80, 25}, {48, 128, 25}, {64, 128, 25}, {96, 128, 25}})
     info.trade_sweep.push_back({{"resolution", resolution}, {"directions", directions}, {"terms", terms}});
   // Trade suite, dense_cloud (albedo 0.99), against its 262144-spp reference: error 25.6% at 16^3,

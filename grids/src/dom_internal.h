@@ -33,6 +33,13 @@ struct FirstCollision {
   std::vector<float> scale;  // [cell], with `half`
 };
 
+// Radiance entering through the grid's faces (DomBoundary) for one channel: per octant and the
+// upwind face across each axis, per face cell and the octant's padded directions (P of them):
+// x faces [(k * ny + j) * P + e], y faces [(k * nx + i) * P + e], z faces [(j * nx + i) * P + e].
+struct Faces {
+  std::array<std::array<std::vector<float>, 3>, 8> values;
+};
+
 // The directions regrouped by octant (signs of x, y, z), so that each octant's directions share
 // one upwind order through the grid, with their separable-phase rows and face coefficients.
 class Transport {
@@ -43,11 +50,15 @@ class Transport {
   // One upwind sweep of every direction with the step scheme (a face carries its upwind cell's
   // value):  L_d = (sigma_s S_d + sum_e a_e L_up,e) / (sigma_t + sum_e a_e),  a_e = |w_e| / h_e,
   //   S_d = first[cell][d] + sum_k lambda_k Q[d][k] m_in[cell * N + k]   (seed 000 eq. 9),
-  // radiance `boundary` entering through every face, and the moments of the result
-  //   m_out[cell * N + k] = sum_d Q[d][k] L_d   (eq. 10).
+  // radiance `boundary` entering through every face (or, given, `faces`), and the moments of the
+  // result  m_out[cell * N + k] = sum_d Q[d][k] L_d   (eq. 10).
   // first (from first_collision) and m_in may be null. Rows run through simd::dom_sweep_row. Directions going up and
   // going down run on two threads into separate buffers, summed in a fixed order.
-  void sweep(const Channel& channel, const FirstCollision* first, const float* m_in, float boundary, float* m_out, int threads) const;
+  void sweep(const Channel& channel, const FirstCollision* first, const float* m_in, float boundary, float* m_out, int threads,
+             const Faces* faces = nullptr) const;
+
+  // The boundary's radiance at the centre of every face cell, per channel (1 or 3).
+  std::vector<Faces> faces(const DomBoundary& boundary, const DenseGrid& grid, int channels, int threads) const;
 
   // The first-collision source from point, spot and directional lights, depths[i] to lights[i],
   // per cell and direction, before the factor sigma_s:

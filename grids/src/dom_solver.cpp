@@ -257,7 +257,7 @@ size_t dom_memory_bytes(const std::array<int, 3>& resolution, int channels, cons
 }
 
 DomSolution solve_dom(const ExtinctionVolume& volume, const std::vector<Light>& lights, const std::vector<DenseGrid>& delta_depths,
-                      const DomSettings& settings, const DomSolution* warm) {
+                      const DomSettings& settings, const DomSolution* warm, const DomBoundary* boundary) {
   if (settings.directions < 8 || settings.directions > 4096)
     throw Error("directions", to_text(settings.directions), "a direction count in [8, 4096]");
   if (settings.terms < 0 || settings.terms > settings.directions)
@@ -267,6 +267,8 @@ DomSolution solve_dom(const ExtinctionVolume& volume, const std::vector<Light>& 
   if (!(settings.tolerance > 0.0)) throw Error("tolerance", to_text(settings.tolerance), "a relative change > 0");
   if (settings.storage == DomStorage::float16 && settings.scheme == DomScheme::paper)
     throw Error("storage", "float16", "float32 with scheme \"paper\" (float16 storage is for scheme \"sweep\")");
+  if (boundary && settings.scheme == DomScheme::paper)
+    throw Error("scheme", "paper", "scheme \"sweep\" with a boundary (the paper's scheme takes only the sky's radiance)");
   std::vector<Light> delta_lights;
   std::copy_if(lights.begin(), lights.end(), std::back_inserter(delta_lights), [](const Light& l) { return !std::holds_alternative<SkyLight>(l); });
   if (delta_depths.size() != delta_lights.size())
@@ -278,6 +280,7 @@ DomSolution solve_dom(const ExtinctionVolume& volume, const std::vector<Light>& 
 
   bool grey = is_grey(volume.sigma_t_scale) && is_grey(volume.albedo);
   for (const Light& l : lights) grey = grey && is_grey(l);
+  grey = grey && (!boundary || boundary->grey);
   Stopwatch start;
   DomSolution out;
   out.channels = grey ? 1 : 3;
@@ -307,12 +310,15 @@ DomSolution solve_dom(const ExtinctionVolume& volume, const std::vector<Light>& 
   out.separable = std::make_shared<SeparablePhase>(*out.matrix, kept_terms(settings));
   const dom::Transport transport(volume.density, *out.directions, *out.matrix, *out.separable, settings.scalar_kernel);
   const size_t size = volume.density.cell_count() * static_cast<size_t>(out.terms());
+  const std::vector<dom::Faces> faces = boundary ? transport.faces(*boundary, volume.density, out.channels, settings.threads)
+                                                 : std::vector<dom::Faces>();
   const bool warm_fits = warm && warm->channels == out.channels && warm->resolution == out.resolution &&
                          warm->terms() == out.terms() && warm->directions && warm->directions->size() == settings.directions;
 
   out.moments.resize(static_cast<size_t>(out.channels));
   for (int c = 0; c < out.channels; ++c) {
     const dom::Channel channel = dom::make_channel(volume, lights, c, out.delta_m_fraction);
+    const dom::Faces* entering = boundary ? &faces[static_cast<size_t>(c)] : nullptr;
     dom::FirstCollision first = transport.first_collision(volume, delta_lights, delta_depths, c, 1.0 / (1.0 - out.delta_m_fraction),
                                                           settings.storage == DomStorage::float16, settings.threads);
     std::vector<float>& x = out.moments[static_cast<size_t>(c)];
@@ -328,7 +334,7 @@ DomSolution solve_dom(const ExtinctionVolume& volume, const std::vector<Light>& 
       x = warm->moments[static_cast<size_t>(c)];
       std::vector<float> next(size);
       while (out.iterations - progress.start < settings.max_iterations) {
-        transport.sweep(channel, &first, x.data(), channel.sky, next.data(), settings.threads);
+        transport.sweep(channel, &first, x.data(), channel.sky, next.data(), settings.threads, entering);
         ++out.iterations;
         axpy(x, -1.0, next, settings.threads);
         const double change = norm(x, settings.threads) / std::max(norm(next, settings.threads), 1e-300);
@@ -340,7 +346,7 @@ DomSolution solve_dom(const ExtinctionVolume& volume, const std::vector<Light>& 
       continue;
     }
     std::vector<float> b(size);
-    transport.sweep(channel, &first, nullptr, channel.sky, b.data(), settings.threads);
+    transport.sweep(channel, &first, nullptr, channel.sky, b.data(), settings.threads, entering);
     ++out.iterations;
     first = {};
     x = warm_fits ? warm->moments[static_cast<size_t>(c)] : b;

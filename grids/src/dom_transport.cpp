@@ -79,7 +79,8 @@ Transport::Transport(const DenseGrid& density, const DirectionSet& directions, c
   }
 }
 
-void Transport::sweep(const Channel& ch, const FirstCollision* first, const float* m_in, float boundary, float* m_out, int threads) const {
+void Transport::sweep(const Channel& ch, const FirstCollision* first, const float* m_in, float boundary, float* m_out, int threads,
+                      const Faces* faces) const {
   const auto nx = n_[0], ny = n_[1], nz = n_[2];
   Stopwatch start;
   const size_t size = cells_ * static_cast<size_t>(n_terms_);
@@ -94,12 +95,23 @@ void Transport::sweep(const Channel& ch, const FirstCollision* first, const floa
         const Octant& oc = octants_[o];
         const auto p = static_cast<size_t>(oc.view.directions);
         if (p == 0) continue;
-        std::vector<float> z_plane(static_cast<size_t>(nx) * static_cast<size_t>(ny) * p, boundary), y_row(static_cast<size_t>(nx) * p),
-            x_run(p), scratch(p + static_cast<size_t>(oc.view.terms_padded));
+        // What enters through the upwind face across `axis` at face cell `cell` (its P values).
+        auto enter = [&](int axis, size_t cell, float* to) {
+          if (!faces) return std::fill(to, to + p, boundary);
+          const float* from = faces->values[o][static_cast<size_t>(axis)].data() + cell * p;
+          std::copy(from, from + p, to);
+        };
+        auto dark = [&](const float* v) { return std::all_of(v, v + p, [](float e) { return e == 0.0f; }); };
+        const auto sx = static_cast<size_t>(nx), sy = static_cast<size_t>(ny);
+        std::vector<float> z_plane(sx * sy * p), y_row(sx * p), x_run(p), scratch(p + static_cast<size_t>(oc.view.terms_padded));
         // Which upwind faces still carry exactly zero radiance (per x of the z plane and of the y
         // row): an empty cell between such faces stays dark, so a row's leading run of them is
-        // skipped. Exact; nothing is skipped when radiance enters through the boundary.
-        std::vector<char> z_dark(static_cast<size_t>(nx) * static_cast<size_t>(ny), boundary == 0.0f), y_dark(static_cast<size_t>(nx));
+        // skipped. Exact.
+        std::vector<char> z_dark(sx * sy), y_dark(sx);
+        for (size_t c = 0; c < sx * sy; ++c) {
+          enter(2, c, z_plane.data() + c * p);
+          z_dark[c] = dark(z_plane.data() + c * p);
+        }
         simd::DomRow row;
         row.step = o & 1 ? -1 : 1;
         row.density = ch.density, row.sigma_t_scale = ch.sigma_t_scale, row.albedo = ch.albedo;
@@ -110,24 +122,27 @@ void Transport::sweep(const Channel& ch, const FirstCollision* first, const floa
         row.x_run = x_run.data(), row.y_row = y_row.data(), row.scratch = scratch.data();
         for (int kk = 0; kk < nz; ++kk) {
           const int k = o & 4 ? nz - 1 - kk : kk;
-          std::fill(y_row.begin(), y_row.end(), boundary);
-          std::fill(y_dark.begin(), y_dark.end(), boundary == 0.0f);
+          for (size_t x = 0; x < sx; ++x) {
+            enter(1, static_cast<size_t>(k) * sx + x, y_row.data() + x * p);
+            y_dark[x] = dark(y_row.data() + x * p);
+          }
           for (int jj = 0; jj < ny; ++jj) {
             const int j = o & 2 ? ny - 1 - jj : jj;
-            std::fill(x_run.begin(), x_run.end(), boundary);
-            const size_t row_start = (static_cast<size_t>(k) * static_cast<size_t>(ny) + static_cast<size_t>(j)) * static_cast<size_t>(nx);
-            char* z_dark_row = z_dark.data() + static_cast<size_t>(j) * static_cast<size_t>(nx);
+            enter(0, static_cast<size_t>(k) * sy + static_cast<size_t>(j), x_run.data());
+            const size_t row_start = (static_cast<size_t>(k) * sy + static_cast<size_t>(j)) * sx;
+            char* z_dark_row = z_dark.data() + static_cast<size_t>(j) * sx;
             int skip = 0;
-            for (; skip < nx; ++skip) {
-              const auto x = static_cast<size_t>(o & 1 ? nx - 1 - skip : skip);
-              if (!(y_dark[x] && z_dark_row[x] && ch.density[row_start + x] == 0.0f)) break;
-            }
+            if (dark(x_run.data()))
+              for (; skip < nx; ++skip) {
+                const auto x = static_cast<size_t>(o & 1 ? nx - 1 - skip : skip);
+                if (!(y_dark[x] && z_dark_row[x] && ch.density[row_start + x] == 0.0f)) break;
+              }
             skipped[half] += skip;
             if (skip == nx) continue;
             row.count = nx - skip;
             row.x0 = o & 1 ? nx - 1 - skip : skip;
             row.cell0 = row_start + static_cast<size_t>(row.x0);
-            row.z_row = z_plane.data() + static_cast<size_t>(j) * static_cast<size_t>(nx) * p;
+            row.z_row = z_plane.data() + static_cast<size_t>(j) * sx * p;
             row_kernel(oc.view, row);
             for (int m = skip; m < nx; ++m) {
               const auto x = static_cast<size_t>(o & 1 ? nx - 1 - m : m);
@@ -142,6 +157,39 @@ void Transport::sweep(const Channel& ch, const FirstCollision* first, const floa
   cells_skipped_ += skipped[0] + skipped[1];
   cells_visited_ += 8 * static_cast<long long>(cells_);
   seconds_ += start.seconds();
+}
+
+std::vector<Faces> Transport::faces(const DomBoundary& boundary, const DenseGrid& grid, int channels, int threads) const {
+  std::vector<Faces> out(static_cast<size_t>(channels));
+  const Aabb& b = grid.bounds();
+  for (size_t o = 0; o < 8; ++o) {
+    const auto p = static_cast<size_t>(octants_[o].view.directions);
+    for (int axis = 0; axis < 3; ++axis) {
+      // The face across `axis` the octant's directions enter through; its cells run over the
+      // other two axes, u fastest.
+      const int u = axis == 0 ? 1 : 0, v = axis == 2 ? 1 : 2;
+      const int nu = n_[static_cast<size_t>(u)], nv = n_[static_cast<size_t>(v)];
+      const double side = o & (1u << axis) ? b.hi[axis] : b.lo[axis];
+      for (Faces& f : out) f.values[o][static_cast<size_t>(axis)].assign(static_cast<size_t>(nu) * static_cast<size_t>(nv) * p, 0.0f);
+      parallel_for(nv, threads, 1, [&](long long v0, long long v1) {
+        for (auto iv = static_cast<int>(v0); iv < v1; ++iv)
+          for (int iu = 0; iu < nu; ++iu) {
+            std::array<int, 3> cell{0, 0, 0};
+            cell[static_cast<size_t>(u)] = iu, cell[static_cast<size_t>(v)] = iv;
+            Vec3 point = grid.cell_center(cell[0], cell[1], cell[2]);
+            point[axis] = side;
+            const size_t at = (static_cast<size_t>(iv) * static_cast<size_t>(nu) + static_cast<size_t>(iu)) * p;
+            for (int i = start_[o]; i < start_[o + 1]; ++i) {
+              const Rgb r = boundary.radiance(point, directions_[static_cast<size_t>(i)]);
+              for (int c = 0; c < channels; ++c)
+                out[static_cast<size_t>(c)].values[o][static_cast<size_t>(axis)][at + static_cast<size_t>(i - start_[o])] =
+                    static_cast<float>(r[channels == 1 ? 0 : c]);
+            }
+          }
+      });
+    }
+  }
+  return out;
 }
 
 FirstCollision Transport::first_collision(const ExtinctionVolume& volume, const std::vector<Light>& lights,

@@ -18,6 +18,22 @@ std::array<int, 3> cells_for(const Aabb& bounds, int resolution) {
   return n;
 }
 
+// An infinite plane splits space into halves that exchange no light, so only the medium on the
+// camera's side can be seen: bounds an axis-aligned plane cuts end at it, on the camera's side.
+Aabb clip_to_planes(Aabb bounds, const Scene& scene) {
+  for (const Surface& s : scene.surfaces) {
+    const auto* plane = std::get_if<Plane>(&s.shape);
+    if (!plane) continue;
+    for (int a = 0; a < 3; ++a) {
+      if (std::abs(plane->normal[a]) < 1.0 - 1e-12) continue;
+      const double at = plane->point[a], eye = scene.camera.position[a];
+      if (!(at > bounds.lo[a] && at < bounds.hi[a]) || eye == at) continue;
+      (eye > at ? bounds.lo[a] : bounds.hi[a]) = at;
+    }
+  }
+  return bounds;
+}
+
 }  // namespace
 
 ExtinctionVolume make_extinction_volume(const Scene& scene, int resolution, double cutoff, int threads, VolumeReport* report) {
@@ -37,6 +53,7 @@ ExtinctionVolume make_extinction_volume(const Scene& scene, int resolution, doub
       }
       if (!bounds.bounded()) throw Error("medium.density.blobs", "weights all below the cutoff", "a blob above the injection cutoff");
     }
+    bounds = clip_to_planes(bounds, scene);
     volume.density = DenseGrid(cells_for(bounds, resolution), bounds);
     InjectionReport injected = inject_rbf(rbf->blobs, volume.density, cutoff, threads);
     if (report) report->truncation_bound = injected.truncation_bound;
@@ -51,6 +68,7 @@ ExtinctionVolume make_extinction_volume(const Scene& scene, int resolution, doub
   } else {
     const auto& constant = std::get<ConstantDensity>(desc.density);
     if (!bounds.bounded()) throw Error("medium.bounds", "unbounded", "bounds for a constant density in the propagation method");
+    bounds = clip_to_planes(bounds, scene);
     volume.density = DenseGrid(cells_for(bounds, resolution), bounds);
     std::fill(volume.density.values().begin(), volume.density.values().end(), static_cast<float>(constant.value));
   }

@@ -83,10 +83,10 @@ TEST(SurfaceShadows, ShadowVolumeProfileMatchesTheReference) {
 
 // A Lambert floor (kd 0.3) under a box cloud (optical height 2.4, albedo 0.95) lit by the sun from
 // straight above: the floor in the cloud's shadow sees little but the light the cloud scatters onto
-// it. The DOM's mean over those floor pixels is within 3% of the reference restricted to the light
-// paths the DOM has (one surface reflection per path, max_bounces 1; its own noise over them is a
-// fraction of that); without the medium-to-surface light it was 67% dark. The light the floor sends
-// back into the cloud, which the DOM leaves out, adds another 23% there (the full reference).
+// it, part of it light the floor itself sent up into the cloud. The DOM's mean over those floor
+// pixels is within 3% of the full reference (whose own noise there is 0.55%) with the default two
+// surface passes (measured -1.1%; one pass -1.7%). Without them, the floor's light left out of the
+// medium, it is 20% dark; before the first bounce onto surfaces it was 67% dark.
 TEST(SurfaceLight, FloorUnderACloudReceivesItsScatteredLight) {
   grids::register_methods();
   Scene scene;
@@ -99,14 +99,11 @@ TEST(SurfaceLight, FloorUnderACloudReceivesItsScatteredLight) {
   scene.lights.push_back(DirectionalLight{Vec3(0.0, -1.0, 0.0), Rgb(1.0)});
   scene.surfaces.push_back(Surface{Plane{Vec3(0.0, -0.2, 0.0), Vec3(0.0, 1.0, 0.0)}, Rgb(0.3), Rgb(0.0), 1.0});
   RenderOptions reference_options;
-  reference_options.settings = {{"spp", 2048}, {"seed", 4}, {"max_bounces", 1}};
+  reference_options.settings = {{"spp", 2048}, {"seed", 4}};
   const RenderResult reference = render(scene, "reference", reference_options);
-  RenderOptions dom_options;
-  dom_options.settings = {{"resolution", 24}};
-  const Image dom = render(scene, "dom", dom_options).radiance;
   // The floor pixels whose point lies in the cloud's footprint (its shadow), seen past the cloud.
-  double want = 0.0, got = 0.0, variance = 0.0;
-  int pixels = 0;
+  std::vector<std::pair<int, int>> floor;
+  double want = 0.0, variance = 0.0;
   for (int y = 0; y < scene.camera.height_px; ++y)
     for (int x = 0; x < scene.camera.width_px; ++x) {
       const Ray ray = scene.camera.pixel_ray(x, y);
@@ -116,15 +113,28 @@ TEST(SurfaceLight, FloorUnderACloudReceivesItsScatteredLight) {
       const Vec3 p = ray.at(t);
       double t0 = 0.0, t1 = t;
       if (std::abs(p.x) > 0.55 || std::abs(p.z) > 0.55 || (cloud.bounds.clip(ray, t0, t1) && t1 > t0)) continue;
-      want += reference.radiance.at(x, y).g, got += dom.at(x, y).g, variance += std::pow(reference.std_error->at(x, y).g, 2);
-      ++pixels;
+      want += reference.radiance.at(x, y).g, variance += std::pow(reference.std_error->at(x, y).g, 2);
+      floor.emplace_back(x, y);
     }
-  ASSERT_GT(pixels, 20);
+  ASSERT_GT(floor.size(), 20u);
   const double noise = std::sqrt(variance) / want;
-  std::printf("floor under the cloud, %d pixels: dom %.5f, reference %.5f (noise %.2f%%): %+.2f%%\n", pixels, got / pixels, want / pixels,
-              100.0 * noise, 100.0 * (got / want - 1.0));
   EXPECT_LT(noise, 0.01);
-  EXPECT_NEAR(got / want, 1.0, 0.03);
+  for (int passes : {0, 1, 2}) {
+    RenderOptions dom_options;
+    dom_options.settings = {{"resolution", 24}, {"surface_passes", passes}};
+    const Image dom = render(scene, "dom", dom_options).radiance;
+    double got = 0.0;
+    for (auto [x, y] : floor) got += dom.at(x, y).g;
+    std::printf("floor under the cloud, %zu pixels, %d surface passes: dom %.5f, reference %.5f (noise %.2f%%): %+.2f%%\n", floor.size(),
+                passes, got / static_cast<double>(floor.size()), want / static_cast<double>(floor.size()), 100.0 * noise,
+                100.0 * (got / want - 1.0));
+    if (passes == 0) {
+      EXPECT_LT(got / want, 0.9);  // the floor's light back through the cloud matters here
+    }
+    if (passes == 2) {
+      EXPECT_NEAR(got / want, 1.0, 0.03);
+    }
+  }
 }
 
 }  // namespace

@@ -12,6 +12,7 @@
 #include <haze/grids/optical_depth.h>
 #include <haze/grids/propagation.h>
 
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -74,6 +75,10 @@ struct DomSettings {
   ProgressCallback progress;  // once per iteration, with the fraction of max_iterations done
 };
 
+namespace dom {
+struct SurfaceTexels;  // internal: what the medium's light gives the surfaces (dom_surfaces.h)
+}
+
 // The converged diffuse radiance in moment form: per solved channel (1 when medium and lights are
 // grey, else 3) and cell, the N moments m_k = sum_d Q[d][k] L_d (seed 000 eq. 10). The in-scattered
 // radiance toward any direction w follows from them (inscatter_weights).
@@ -96,8 +101,20 @@ struct DomSolution {
   // (exact; the sweep scheme without sky light only).
   double skipped_fraction = 0.0;
   double seconds = 0.0;            // wall time of the whole solve (phase matrix, first collision, sweeps)
+  // With surfaces (dom_fields): the irradiance the medium's light gives them, which render_dom's
+  // surfaces reflect toward each other; without, surfaces light each other not at all.
+  std::shared_ptr<const dom::SurfaceTexels> surfaces;
 
   int terms() const { return separable ? separable->terms() : 0; }
+};
+
+// Radiance entering the grid through its faces from outside: radiance(point, w) for a point on a
+// face and a direction w pointing into the grid (surfaces the grid sees, the sky). Called
+// concurrently, once per face cell and direction of each solve. Without one the sky's radiance
+// enters through every face.
+struct DomBoundary {
+  std::function<Rgb(const Vec3& point, const Vec3& w)> radiance;
+  bool grey = true;  // the same in every channel: a grey medium and lights still solve one channel
 };
 
 // Checks sizes and memory (a solve that would not fit in the memory available throws haze::Error
@@ -106,8 +123,9 @@ struct DomSolution {
 // render_dom takes them; sky lights enter through the boundary and have none. `warm`, when given and of the same shape, starts the iteration from its moments (the
 // paper's one-iteration-per-frame mode when density or lights change a little); with accelerator
 // none each iteration is then one sweep with the first-collision source in it (x <- b + K x).
+// `boundary`, when given, replaces the sky's radiance at the faces.
 DomSolution solve_dom(const ExtinctionVolume& volume, const std::vector<Light>& lights, const std::vector<DenseGrid>& delta_depths,
-                      const DomSettings& settings, const DomSolution* warm = nullptr);
+                      const DomSettings& settings, const DomSolution* warm = nullptr, const DomBoundary* boundary = nullptr);
 
 // For a direction w (propagation direction of the scattered light): c_k with
 // sum_j P(w, w_j) L_j ~ sum_k c_k m_k, the row of P at w extended off the direction set
@@ -138,6 +156,7 @@ struct DomFields {
   DomSettings settings;
   DepthOptions depth;
   int warm_iterations = 0;  // sweeps per update (source iteration); 0: GMRES to the tolerance
+  int surface_passes = 2;   // solves with the surfaces' reflected light entering the grid (dom_fields)
 };
 DomFields dom_fields(const Scene& scene, const RenderOptions& options);
 

@@ -35,7 +35,9 @@ struct VolumeReport {
 // From the scene's medium: an RBF density is injected into `resolution` cells along the longest
 // axis of its bounds (the others in proportion; an unbounded RBF medium gets the box where every
 // blob has fallen below the injection cutoff), a grid density is taken as it is, a constant
-// density fills a grid over the medium's bounds (it must have bounds).
+// density fills a grid over the medium's bounds (it must have bounds). For those two, a plane
+// surface along an axis that cuts the bounds ends them at the plane, on the camera's side: the
+// other half is hidden behind the plane and exchanges no light with this one.
 // Throws haze::Error for a scene without a medium or with an unbounded constant one.
 ExtinctionVolume make_extinction_volume(const Scene& scene, int resolution = 64, double cutoff = 0.0, int threads = 0,
                                         VolumeReport* report = nullptr);

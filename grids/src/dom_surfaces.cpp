@@ -1,0 +1,107 @@
+#include "dom_surfaces.h"
+
+#include "dom_internal.h"
+
+#include <cmath>
+
+namespace haze::grids::dom {
+
+namespace {
+constexpr int kMostTexels = 48;
+}
+
+bool SurfaceTexels::Rectangle::lookup(const Vec3& p, Rgb& e) const {
+  const double fu = (glm::dot(p - origin, u) - u0) / size - 0.5, fv = (glm::dot(p - origin, v) - v0) / size - 0.5;
+  if (!(fu >= -0.5 && fu <= nu - 0.5 && fv >= -0.5 && fv <= nv - 0.5)) return false;
+  const double cu = std::clamp(fu, 0.0, nu - 1.0), cv = std::clamp(fv, 0.0, nv - 1.0);
+  const int i = std::min(static_cast<int>(cu), nu - 2), j = std::min(static_cast<int>(cv), nv - 2);
+  const double a = cu - i, b = cv - j;
+  auto at = [&](int di, int dj) { return values[static_cast<size_t>(j + dj) * static_cast<size_t>(nu) + static_cast<size_t>(i + di)]; };
+  e = (1.0 - b) * ((1.0 - a) * at(0, 0) + a * at(1, 0)) + b * ((1.0 - a) * at(0, 1) + a * at(1, 1));
+  return true;
+}
+
+SurfaceTexels surface_texels(const Scene& delta, const ExtinctionVolume& volume, const std::vector<DenseGrid>& depths,
+                             const DomSolution& solution, const Rgb& sky, double step_cells, int threads) {
+  const Aabb& bounds = volume.density.bounds();
+  const Vec3 h = volume.density.cell_size(), extent = bounds.extent(), centre = 0.5 * (bounds.lo + bounds.hi);
+  const Gather gather(delta, volume, depths, solution, step_cells, threads);
+  SurfaceTexels out;
+  out.planes.resize(delta.surfaces.size());
+  for (size_t s = 0; s < delta.surfaces.size(); ++s) {
+    const auto* plane = std::get_if<Plane>(&delta.surfaces[s].shape);
+    if (!plane) continue;
+    SurfaceTexels::Rectangle& t = out.planes[s];
+    const Vec3 n = glm::dot(centre - plane->point, plane->normal) >= 0.0 ? plane->normal : -plane->normal;
+    t.origin = plane->point;
+    t.u = glm::normalize(glm::cross(n, std::abs(n.x) < 0.9 ? Vec3(1.0, 0.0, 0.0) : Vec3(0.0, 1.0, 0.0)));
+    t.v = glm::cross(n, t.u);
+    double u1 = -kInfinity, v1 = -kInfinity;
+    t.u0 = t.v0 = kInfinity;
+    for (int c = 0; c < 8; ++c) {
+      const Vec3 corner(c & 1 ? bounds.hi.x + extent.x : bounds.lo.x - extent.x, c & 2 ? bounds.hi.y + extent.y : bounds.lo.y - extent.y,
+                        c & 4 ? bounds.hi.z + extent.z : bounds.lo.z - extent.z);
+      const double cu = glm::dot(corner - t.origin, t.u), cv = glm::dot(corner - t.origin, t.v);
+      t.u0 = std::min(t.u0, cu), t.v0 = std::min(t.v0, cv), u1 = std::max(u1, cu), v1 = std::max(v1, cv);
+    }
+    t.size = std::max(2.0 * std::max({h.x, h.y, h.z}), std::max(u1 - t.u0, v1 - t.v0) / kMostTexels);
+    t.nu = std::max(2, static_cast<int>(std::ceil((u1 - t.u0) / t.size)));
+    t.nv = std::max(2, static_cast<int>(std::ceil((v1 - t.v0) / t.size)));
+    t.values.assign(static_cast<size_t>(t.nu) * static_cast<size_t>(t.nv), Rgb(0.0));
+    parallel_for(t.nv, threads, 1, [&](long long j0, long long j1) {
+      for (auto j = static_cast<int>(j0); j < j1; ++j)
+        for (int i = 0; i < t.nu; ++i) {
+          const Vec3 p = t.origin + (t.u0 + (i + 0.5) * t.size) * t.u + (t.v0 + (j + 0.5) * t.size) * t.v;
+          t.values[static_cast<size_t>(j) * static_cast<size_t>(t.nu) + static_cast<size_t>(i)] =
+              gather.around(p, n, sky, [](const Vec3&) { return Rgb(1.0); });
+        }
+    });
+  }
+  return out;
+}
+
+SurfaceLight::SurfaceLight(const Scene& delta, const ExtinctionVolume& volume, const std::vector<DenseGrid>& depths,
+                           const SurfaceTexels& texels, const Rgb& sky, double delta_m_fraction)
+    : delta_(delta),
+      volume_(volume),
+      depths_(depths),
+      texels_(texels),
+      sky_(sky),
+      sigma_t_(delta_m_sigma_t(volume.sigma_t_scale, volume.albedo, delta_m_fraction)) {
+  const Vec3 h = volume.density.cell_size();
+  offset_ = std::max(1e-4 * std::min({h.x, h.y, h.z}), 1e-6);  // past nearest_surface's 1e-7
+}
+
+Rgb SurfaceLight::reflected(const Surface& surface, const Vec3& p, const Vec3& n, const Vec3& wo) const {
+  Rgb sum(0.0);
+  LightArrival a;
+  for (size_t l = 0; l < delta_.lights.size(); ++l) {
+    if (!arrival(delta_.lights[l], p, a)) continue;
+    const double cos_i = glm::dot(n, a.to_light);
+    if (cos_i <= 0.0 || occluded(delta_.surfaces, p, a.to_light, a.distance)) continue;
+    const double reach = std::isfinite(a.distance) ? a.distance : 1e30;  // directional: past any grid
+    const double depth = volume_.density.bounds().contains(p) ? static_cast<double>(sample_trilinear(depths_[l], p))
+                                                              : density_integral_dda(volume_.density, p, p + a.to_light * reach);
+    sum += surface.brdf(a.to_light, wo, n) * a.irradiance * cos_i * glm::exp(-sigma_t_ * depth);
+  }
+  Rgb e_s = kPi * sky_;
+  const auto index = static_cast<size_t>(&surface - delta_.surfaces.data());
+  if (const SurfaceTexels::Rectangle& rectangle = texels_.planes[index]; !rectangle.values.empty()) rectangle.lookup(p, e_s);
+  return sum + surface.kd / kPi * e_s;
+}
+
+Rgb SurfaceLight::entering(const Vec3& point, const Vec3& w) const {
+  const Ray back{point + offset_ * w, -w};
+  double t = kInfinity;
+  Vec3 n;
+  const Surface* surface = nearest_surface(delta_.surfaces, back, kInfinity, t, n);
+  return surface ? reflected(*surface, back.at(t), n, w) : sky_;
+}
+
+DomBoundary SurfaceLight::boundary() const {
+  bool grey = is_grey(sky_);
+  for (const Surface& s : delta_.surfaces) grey = grey && is_grey(s.kd) && is_grey(s.ks);
+  return DomBoundary{[this](const Vec3& point, const Vec3& w) { return entering(point, w); }, grey};
+}
+
+}  // namespace haze::grids::dom
