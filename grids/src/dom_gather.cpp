@@ -26,11 +26,15 @@ Gather::Gather(const Scene& delta, const ExtinctionVolume& volume, const std::ve
   sigma_t_ = delta_m_sigma_t(volume.sigma_t_scale, volume.albedo, f);
   albedo_ = delta_m_albedo(volume.albedo, f);
   single_albedo_ = volume.albedo / (Rgb(1.0) - volume.albedo * f);
+  // Each of the K directions stands for 4 pi / K steradians: a cone of half-angle alpha with
+  // 2 pi (1 - cos alpha) = 4 pi / K.
+  const double cos_alpha = 1.0 - 2.0 / kSurfaceDirections;
+  cone_ = std::sqrt(1.0 - cos_alpha * cos_alpha) / cos_alpha;
   if (!delta.surfaces.empty())
     for (int j = 0; j < around_.size(); ++j) around_weights_.push_back(inscatter_weights(solution, -around_[j]));
 }
 
-Rgb Gather::along(const Ray& ray, double t_end, const Eigen::VectorXd& c, Rgb& transmittance) const {
+Rgb Gather::along(const Ray& ray, double t_end, const Eigen::VectorXd& c, Rgb& transmittance, double cone) const {
   const DenseGrid& density = volume_.density;
   Rgb radiance(0.0);
   transmittance = Rgb(1.0);
@@ -60,8 +64,10 @@ Rgb Gather::along(const Ray& ray, double t_end, const Eigen::VectorXd& c, Rgb& t
     }
     if (solution_.channels == 1) inscattered = Rgb(inscattered[0]);
     Rgb single(0.0);
+    const double radius = cone * (t0 + (s + 0.5) * dt);
     for (size_t l = 0; l < delta_.lights.size(); ++l) {
       if (!arrival(delta_.lights[l], p, a) || a.irradiance == Rgb(0.0)) continue;
+      if (a.distance < radius) a.irradiance *= (a.distance / radius) * (a.distance / radius);
       const double depth = stencil.apply(depths_[l].values().data());
       const double visible = visibility_.empty() ? 1.0 : stencil.apply(visibility_[l].values().data());
       single += volume_.phase.eval(-a.to_light, -ray.direction) * a.irradiance * visible * glm::exp(-volume_.sigma_t_scale * depth);
@@ -79,7 +85,7 @@ Rgb Gather::arriving(const Vec3& point, int j, const Rgb& sky) const {
   Vec3 n;
   const Surface* hit = nearest_surface(delta_.surfaces, up, kInfinity, t_next, n);
   Rgb t_up;
-  const Rgb radiance = along(up, t_next, around_weights_[static_cast<size_t>(j)], t_up);
+  const Rgb radiance = along(up, t_next, around_weights_[static_cast<size_t>(j)], t_up, cone_);
   if (!hit) return radiance + t_up * sky;
   return surfaces_ ? radiance + t_up * surfaces_->reflected(*hit, up.at(t_next), n, -around_[j]) : radiance;
 }

@@ -24,8 +24,11 @@ class Gather {
   //   L += T' (1 - e^(-sigma_t' rho step)) [albedo' sum_k c_k(w) m_k + albedo / (1 - albedo f) q1(w)],
   //   q1(w) = sum_lights p(w_light . w) E_light V_light e^(-sigma_t depth_light)   (single scattering),
   // c = inscatter_weights(solution, -ray.direction); density, depths, visibility and moments
-  // trilinear at each step's midpoint. Writes the transmittance T' over the stretch.
-  Rgb along(const Ray& ray, double t_end, const Eigen::VectorXd& c, Rgb& transmittance) const;
+  // trilinear at each step's midpoint. Writes the transmittance T' over the stretch. With cone > 0
+  // the ray stands for a cone of directions of that tangent of its half-angle: a light nearer
+  // than the cone's radius at the step, cone t, delivers its irradiance at that radius, no more
+  // (a direction passing by a point light would otherwise count its 1 / d^2 peak for the whole cone).
+  Rgb along(const Ray& ray, double t_end, const Eigen::VectorXd& c, Rgb& transmittance, double cone = 0.0) const;
 
   // The light arriving at a surface point from the hemisphere about `normal`, over the K
   // Fibonacci directions w_j (4 pi / K each), weighted:
@@ -52,7 +55,7 @@ class Gather {
   const DomSolution& solution_;
   const SurfaceLight* surfaces_;
   std::vector<DenseGrid> visibility_;
-  double step_;
+  double step_, cone_ = 0.0;
   Rgb sigma_t_, albedo_, single_albedo_;
   DirectionSet around_;
   std::vector<Eigen::VectorXd> around_weights_;

@@ -21,6 +21,18 @@ bool SurfaceTexels::Rectangle::lookup(const Vec3& p, Rgb& e) const {
   return true;
 }
 
+bool SurfaceTexels::Globe::lookup(const Vec3& p, Rgb& e) const {
+  const Vec3 u = glm::normalize(p - centre);
+  const double ft = std::clamp(std::acos(std::clamp(u.y, -1.0, 1.0)) / kPi * nt - 0.5, 0.0, nt - 1.0);
+  const double fp = (std::atan2(u.z, u.x) + kPi) / (2.0 * kPi) * np - 0.5;
+  const int t = std::min(static_cast<int>(ft), nt - 2);
+  const double a = ft - t, fl = std::floor(fp), b = fp - fl;
+  const int p0 = (static_cast<int>(fl) % np + np) % np, p1 = (p0 + 1) % np;
+  auto at = [&](int ti, int pi) { return values[static_cast<size_t>(ti) * static_cast<size_t>(np) + static_cast<size_t>(pi)]; };
+  e = (1.0 - a) * ((1.0 - b) * at(t, p0) + b * at(t, p1)) + a * ((1.0 - b) * at(t + 1, p0) + b * at(t + 1, p1));
+  return true;
+}
+
 SurfaceTexels surface_texels(const Scene& delta, const ExtinctionVolume& volume, const std::vector<DenseGrid>& depths,
                              const DomSolution& solution, const Rgb& sky, double step_cells, int threads) {
   const Aabb& bounds = volume.density.bounds();
@@ -28,9 +40,24 @@ SurfaceTexels surface_texels(const Scene& delta, const ExtinctionVolume& volume,
   const Gather gather(delta, volume, depths, solution, step_cells, threads);
   SurfaceTexels out;
   out.planes.resize(delta.surfaces.size());
+  out.spheres.resize(delta.surfaces.size());
   for (size_t s = 0; s < delta.surfaces.size(); ++s) {
+    if (const auto* sphere = std::get_if<Sphere>(&delta.surfaces[s].shape)) {
+      SurfaceTexels::Globe& g = out.spheres[s];
+      g.centre = sphere->center, g.radius = sphere->radius, g.nt = 16, g.np = 32;
+      g.values.assign(static_cast<size_t>(g.nt) * static_cast<size_t>(g.np), Rgb(0.0));
+      parallel_for(g.nt, threads, 1, [&](long long t0, long long t1) {
+        for (auto t = static_cast<int>(t0); t < t1; ++t)
+          for (int p = 0; p < g.np; ++p) {
+            const double theta = (t + 0.5) * kPi / g.nt, phi = (p + 0.5) * 2.0 * kPi / g.np - kPi;
+            const Vec3 u(std::sin(theta) * std::cos(phi), std::cos(theta), std::sin(theta) * std::sin(phi));
+            g.values[static_cast<size_t>(t) * static_cast<size_t>(g.np) + static_cast<size_t>(p)] =
+                gather.around(g.centre + (g.radius * (1.0 + 1e-9)) * u, u, sky, [](const Vec3&) { return Rgb(1.0); });
+          }
+      });
+      continue;
+    }
     const auto* plane = std::get_if<Plane>(&delta.surfaces[s].shape);
-    if (!plane) continue;
     SurfaceTexels::Rectangle& t = out.planes[s];
     const Vec3 n = glm::dot(centre - plane->point, plane->normal) >= 0.0 ? plane->normal : -plane->normal;
     t.origin = plane->point;
@@ -87,7 +114,40 @@ Rgb SurfaceLight::reflected(const Surface& surface, const Vec3& p, const Vec3& n
   Rgb e_s = kPi * sky_;
   const auto index = static_cast<size_t>(&surface - delta_.surfaces.data());
   if (const SurfaceTexels::Rectangle& rectangle = texels_.planes[index]; !rectangle.values.empty()) rectangle.lookup(p, e_s);
+  if (const SurfaceTexels::Globe& globe = texels_.spheres[index]; !globe.values.empty()) globe.lookup(p, e_s);
   return sum + surface.kd / kPi * e_s;
+}
+
+double SurfaceLight::depth(const Surface& s, const Vec3& x, Vec3& point, Vec3& normal) const {
+  if (const auto* sphere = std::get_if<Sphere>(&s.shape)) {
+    const Vec3 d = x - sphere->center;
+    const double r = glm::length(d);
+    normal = r > 0.0 ? d / r : Vec3(0.0, 1.0, 0.0);
+    point = sphere->center + sphere->radius * normal;
+    return sphere->radius - r;
+  }
+  const auto& plane = std::get<Plane>(s.shape);
+  normal = glm::dot(delta_.camera.position - plane.point, plane.normal) >= 0.0 ? plane.normal : -plane.normal;
+  const double above = glm::dot(x - plane.point, normal);
+  point = x - above * normal;
+  return -above;
+}
+
+bool SurfaceLight::solid(const Vec3& x) const {
+  Vec3 p, n;
+  for (const Surface& s : delta_.surfaces)
+    if (depth(s, x, p, n) > 0.0) return true;
+  return false;
+}
+
+Rgb SurfaceLight::emitted(const Vec3& x, const Vec3& w) const {
+  const Surface* nearest = nullptr;
+  double least = kInfinity;
+  Vec3 point, normal, p, n;
+  for (const Surface& s : delta_.surfaces)
+    if (const double d = depth(s, x, p, n); d > 0.0 && d < least) least = d, nearest = &s, point = p, normal = n;
+  if (!nearest || glm::dot(normal, w) <= 0.0) return Rgb(0.0);
+  return reflected(*nearest, point, normal, w);
 }
 
 Rgb SurfaceLight::entering(const Vec3& point, const Vec3& w) const {
@@ -101,7 +161,8 @@ Rgb SurfaceLight::entering(const Vec3& point, const Vec3& w) const {
 DomBoundary SurfaceLight::boundary() const {
   bool grey = is_grey(sky_);
   for (const Surface& s : delta_.surfaces) grey = grey && is_grey(s.kd) && is_grey(s.ks);
-  return DomBoundary{[this](const Vec3& point, const Vec3& w) { return entering(point, w); }, grey};
+  return DomBoundary{[this](const Vec3& point, const Vec3& w) { return entering(point, w); },
+                     [this](const Vec3& x) { return solid(x); }, [this](const Vec3& x, const Vec3& w) { return emitted(x, w); }, grey};
 }
 
 }  // namespace haze::grids::dom

@@ -9,8 +9,9 @@
 namespace haze::grids::dom {
 
 // Irradiance E_s from the medium's scattered light and the sky through it (Gather::around) at
-// texel centres over a rectangle of each plane: the grid's bounds widened by their extent on
-// every side, texels at least two cells wide, at most 48 a side.
+// texel centres: over a rectangle of each plane, the grid's bounds widened by their extent on
+// every side, texels at least two cells wide, at most 48 a side; over each sphere in latitude
+// and longitude, 16 x 32.
 struct SurfaceTexels {
   struct Rectangle {
     Vec3 origin, u, v;
@@ -19,7 +20,15 @@ struct SurfaceTexels {
     std::vector<Rgb> values;  // [j * nu + i]
     bool lookup(const Vec3& p, Rgb& e) const;  // bilinear; false outside the rectangle
   };
+  struct Globe {
+    Vec3 centre{0.0};
+    double radius = 1.0;
+    int nt = 0, np = 0;
+    std::vector<Rgb> values;  // [t * np + p], t along the polar angle from +y, p the azimuth from +x
+    bool lookup(const Vec3& p, Rgb& e) const;  // bilinear, wrapping in azimuth
+  };
   std::vector<Rectangle> planes;  // per surface; empty for spheres
+  std::vector<Globe> spheres;     // per surface; empty for planes
 };
 SurfaceTexels surface_texels(const Scene& delta, const ExtinctionVolume& volume, const std::vector<DenseGrid>& depths,
                              const DomSolution& solution, const Rgb& sky, double step_cells, int threads);
@@ -42,7 +51,13 @@ class SurfaceLight {
   // back along -w meets no surface, else what the surface hit reflects toward w.
   Rgb entering(const Vec3& point, const Vec3& w) const;
 
-  // The boundary for solve_dom; valid while this lives.
+  // Cells taken by a surface: inside a sphere, or past a plane from the camera.
+  bool solid(const Vec3& x) const;
+  // What a solid cell sends along w: what the nearest point of the surface it lies in reflects
+  // toward w, where w leaves that surface; nothing else.
+  Rgb emitted(const Vec3& x, const Vec3& w) const;
+
+  // The boundary for solve_dom (faces and solid cells); valid while this lives.
   DomBoundary boundary() const;
 
  private:
@@ -52,6 +67,8 @@ class SurfaceLight {
   const SurfaceTexels& texels_;
   Rgb sky_, sigma_t_;
   double offset_;  // the back ray starts this far inside the face: a plane on the face is hit
+  // How deep x lies in surface s (> 0 inside), and the nearest point of it with its outward normal.
+  double depth(const Surface& s, const Vec3& x, Vec3& point, Vec3& normal) const;
 };
 
 }  // namespace haze::grids::dom
