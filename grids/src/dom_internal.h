@@ -36,12 +36,8 @@ struct FirstCollision {
 // Radiance entering through the grid's faces (DomBoundary) for one channel: per octant and the
 // upwind face across each axis, per face cell and the octant's padded directions (P of them):
 // x faces [(k * ny + j) * P + e], y faces [(k * nx + i) * P + e], z faces [(j * nx + i) * P + e].
-// With solid cells: solid[cell] is -1 or the cell's index s among them, and emitted[s * padded +
-// i] what it sends along the padded direction i.
 struct Faces {
   std::array<std::array<std::vector<float>, 3>, 8> values;
-  std::vector<int> solid;
-  std::vector<float> emitted;
 };
 
 // The directions regrouped by octant (signs of x, y, z), so that each octant's directions share
@@ -61,11 +57,8 @@ class Transport {
   void sweep(const Channel& channel, const FirstCollision* first, const float* m_in, float boundary, float* m_out, int threads,
              const Faces* faces = nullptr) const;
 
-  // The boundary's radiance at the centre of every face cell, and its solid cells, per channel (1 or 3).
+  // The boundary's radiance at the centre of every face cell, per channel (1 or 3).
   std::vector<Faces> faces(const DomBoundary& boundary, const DenseGrid& grid, int channels, int threads) const;
-  // Cells every later sweep treats as solid (Faces::solid; empty: none). A solid cell sends on
-  // the sweep's faces' emitted light, or none.
-  void set_solid(std::vector<int> solid) { solid_ = std::move(solid); }
 
   // The first-collision source from point, spot and directional lights, depths[i] to lights[i],
   // per cell and direction, before the factor sigma_s:
@@ -96,7 +89,6 @@ class Transport {
   mutable double seconds_ = 0.0;
   mutable long long cells_skipped_ = 0, cells_visited_ = 0;
   bool scalar_kernel_;
-  std::vector<int> solid_;
   std::vector<Vec3> directions_;    // regrouped
   std::array<int, 9> start_{};      // octant o holds regrouped directions [start_[o], start_[o + 1])
   std::vector<float> a_;            // [i * 3 + e]: |w_e| / h_e

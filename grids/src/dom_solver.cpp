@@ -238,32 +238,6 @@ void solve_moments(const dom::Transport& t, const dom::Channel& channel, const s
   }
 }
 
-// Solid cells hold no radiance; those next to the medium take the mean of their medium neighbours'
-// moments, so that trilinear lookups near a surface (the camera's gather) read the medium's light
-// rather than a dark cell.
-void fill_solid(const std::vector<int>& solid, const std::array<int, 3>& n, size_t terms, std::vector<std::vector<float>>& moments) {
-  const std::array<long long, 3> stride{1, n[0], static_cast<long long>(n[0]) * n[1]};
-  for (std::vector<float>& m : moments)
-    for (int k = 0; k < n[2]; ++k)
-      for (int j = 0; j < n[1]; ++j)
-        for (int i = 0; i < n[0]; ++i) {
-          const std::array<int, 3> at{i, j, k};
-          const long long c = i + j * stride[1] + k * stride[2];
-          if (solid[static_cast<size_t>(c)] < 0) continue;
-          int count = 0;
-          std::vector<float> sum(terms, 0.0f);
-          for (int axis = 0; axis < 3; ++axis)
-            for (int side : {-1, 1}) {
-              const int e = at[static_cast<size_t>(axis)] + side;
-              const long long nb = c + side * stride[static_cast<size_t>(axis)];
-              if (e < 0 || e >= n[static_cast<size_t>(axis)] || solid[static_cast<size_t>(nb)] >= 0) continue;
-              for (size_t t = 0; t < terms; ++t) sum[t] += m[static_cast<size_t>(nb) * terms + t];
-              ++count;
-            }
-          for (size_t t = 0; t < terms; ++t) m[static_cast<size_t>(c) * terms + t] = count ? sum[t] / static_cast<float>(count) : 0.0f;
-        }
-}
-
 }  // namespace
 
 size_t dom_memory_bytes(const std::array<int, 3>& resolution, int channels, const DomSettings& settings) {
@@ -334,11 +308,10 @@ DomSolution solve_dom(const ExtinctionVolume& volume, const std::vector<Light>& 
   }
   out.matrix = std::make_shared<PhaseMatrix>(out.phase, *out.directions);
   out.separable = std::make_shared<SeparablePhase>(*out.matrix, kept_terms(settings));
-  dom::Transport transport(volume.density, *out.directions, *out.matrix, *out.separable, settings.scalar_kernel);
+  const dom::Transport transport(volume.density, *out.directions, *out.matrix, *out.separable, settings.scalar_kernel);
   const size_t size = volume.density.cell_count() * static_cast<size_t>(out.terms());
   const std::vector<dom::Faces> faces = boundary ? transport.faces(*boundary, volume.density, out.channels, settings.threads)
                                                  : std::vector<dom::Faces>();
-  if (!faces.empty()) transport.set_solid(faces.front().solid);
   const bool warm_fits = warm && warm->channels == out.channels && warm->resolution == out.resolution &&
                          warm->terms() == out.terms() && warm->directions && warm->directions->size() == settings.directions;
 
@@ -379,7 +352,6 @@ DomSolution solve_dom(const ExtinctionVolume& volume, const std::vector<Light>& 
     x = warm_fits ? warm->moments[static_cast<size_t>(c)] : b;
     solve_moments(transport, channel, b, x, settings, progress, out);
   }
-  if (!faces.empty()) fill_solid(faces.front().solid, out.resolution, static_cast<size_t>(out.terms()), out.moments);
   out.converged = !out.changes.empty() && out.changes.back() < settings.tolerance;
   out.sweep_seconds = transport.seconds();
   out.skipped_fraction = transport.skipped_fraction();

@@ -21,7 +21,7 @@ bool SurfaceTexels::Rectangle::lookup(const Vec3& p, Rgb& e) const {
   return true;
 }
 
-bool SurfaceTexels::Globe::lookup(const Vec3& p, Rgb& e) const {
+Rgb SurfaceTexels::Globe::lookup(const Vec3& p) const {
   const Vec3 u = glm::normalize(p - centre);
   const double ft = std::clamp(std::acos(std::clamp(u.y, -1.0, 1.0)) / kPi * nt - 0.5, 0.0, nt - 1.0);
   const double fp = (std::atan2(u.z, u.x) + kPi) / (2.0 * kPi) * np - 0.5;
@@ -29,8 +29,7 @@ bool SurfaceTexels::Globe::lookup(const Vec3& p, Rgb& e) const {
   const double a = ft - t, fl = std::floor(fp), b = fp - fl;
   const int p0 = (static_cast<int>(fl) % np + np) % np, p1 = (p0 + 1) % np;
   auto at = [&](int ti, int pi) { return values[static_cast<size_t>(ti) * static_cast<size_t>(np) + static_cast<size_t>(pi)]; };
-  e = (1.0 - a) * ((1.0 - b) * at(t, p0) + b * at(t, p1)) + a * ((1.0 - b) * at(t + 1, p0) + b * at(t + 1, p1));
-  return true;
+  return (1.0 - a) * ((1.0 - b) * at(t, p0) + b * at(t, p1)) + a * ((1.0 - b) * at(t + 1, p0) + b * at(t + 1, p1));
 }
 
 SurfaceTexels surface_texels(const Scene& delta, const ExtinctionVolume& volume, const std::vector<DenseGrid>& depths,
@@ -114,40 +113,8 @@ Rgb SurfaceLight::reflected(const Surface& surface, const Vec3& p, const Vec3& n
   Rgb e_s = kPi * sky_;
   const auto index = static_cast<size_t>(&surface - delta_.surfaces.data());
   if (const SurfaceTexels::Rectangle& rectangle = texels_.planes[index]; !rectangle.values.empty()) rectangle.lookup(p, e_s);
-  if (const SurfaceTexels::Globe& globe = texels_.spheres[index]; !globe.values.empty()) globe.lookup(p, e_s);
+  if (const SurfaceTexels::Globe& globe = texels_.spheres[index]; !globe.values.empty()) e_s = globe.lookup(p);
   return sum + surface.kd / kPi * e_s;
-}
-
-double SurfaceLight::depth(const Surface& s, const Vec3& x, Vec3& point, Vec3& normal) const {
-  if (const auto* sphere = std::get_if<Sphere>(&s.shape)) {
-    const Vec3 d = x - sphere->center;
-    const double r = glm::length(d);
-    normal = r > 0.0 ? d / r : Vec3(0.0, 1.0, 0.0);
-    point = sphere->center + sphere->radius * normal;
-    return sphere->radius - r;
-  }
-  const auto& plane = std::get<Plane>(s.shape);
-  normal = glm::dot(delta_.camera.position - plane.point, plane.normal) >= 0.0 ? plane.normal : -plane.normal;
-  const double above = glm::dot(x - plane.point, normal);
-  point = x - above * normal;
-  return -above;
-}
-
-bool SurfaceLight::solid(const Vec3& x) const {
-  Vec3 p, n;
-  for (const Surface& s : delta_.surfaces)
-    if (depth(s, x, p, n) > 0.0) return true;
-  return false;
-}
-
-Rgb SurfaceLight::emitted(const Vec3& x, const Vec3& w) const {
-  const Surface* nearest = nullptr;
-  double least = kInfinity;
-  Vec3 point, normal, p, n;
-  for (const Surface& s : delta_.surfaces)
-    if (const double d = depth(s, x, p, n); d > 0.0 && d < least) least = d, nearest = &s, point = p, normal = n;
-  if (!nearest || glm::dot(normal, w) <= 0.0) return Rgb(0.0);
-  return reflected(*nearest, point, normal, w);
 }
 
 Rgb SurfaceLight::entering(const Vec3& point, const Vec3& w) const {
@@ -161,8 +128,7 @@ Rgb SurfaceLight::entering(const Vec3& point, const Vec3& w) const {
 DomBoundary SurfaceLight::boundary() const {
   bool grey = is_grey(sky_);
   for (const Surface& s : delta_.surfaces) grey = grey && is_grey(s.kd) && is_grey(s.ks);
-  return DomBoundary{[this](const Vec3& point, const Vec3& w) { return entering(point, w); },
-                     [this](const Vec3& x) { return solid(x); }, [this](const Vec3& x, const Vec3& w) { return emitted(x, w); }, grey};
+  return DomBoundary{[this](const Vec3& point, const Vec3& w) { return entering(point, w); }, grey};
 }
 
 }  // namespace haze::grids::dom

@@ -25,7 +25,7 @@ struct SurfaceTexels {
     double radius = 1.0;
     int nt = 0, np = 0;
     std::vector<Rgb> values;  // [t * np + p], t along the polar angle from +y, p the azimuth from +x
-    bool lookup(const Vec3& p, Rgb& e) const;  // bilinear, wrapping in azimuth
+    Rgb lookup(const Vec3& p) const;  // bilinear, wrapping in azimuth
   };
   std::vector<Rectangle> planes;  // per surface; empty for spheres
   std::vector<Globe> spheres;     // per surface; empty for planes
@@ -51,13 +51,7 @@ class SurfaceLight {
   // back along -w meets no surface, else what the surface hit reflects toward w.
   Rgb entering(const Vec3& point, const Vec3& w) const;
 
-  // Cells taken by a surface: inside a sphere, or past a plane from the camera.
-  bool solid(const Vec3& x) const;
-  // What a solid cell sends along w: what the nearest point of the surface it lies in reflects
-  // toward w, where w leaves that surface; nothing else.
-  Rgb emitted(const Vec3& x, const Vec3& w) const;
-
-  // The boundary for solve_dom (faces and solid cells); valid while this lives.
+  // The boundary for solve_dom; valid while this lives.
   DomBoundary boundary() const;
 
  private:
@@ -67,8 +61,6 @@ class SurfaceLight {
   const SurfaceTexels& texels_;
   Rgb sky_, sigma_t_;
   double offset_;  // the back ray starts this far inside the face: a plane on the face is hit
-  // How deep x lies in surface s (> 0 inside), and the nearest point of it with its outward normal.
-  double depth(const Surface& s, const Vec3& x, Vec3& point, Vec3& normal) const;
 };
 
 }  // namespace haze::grids::dom

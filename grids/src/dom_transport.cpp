@@ -131,36 +131,19 @@ void Transport::sweep(const Channel& ch, const FirstCollision* first, const floa
             enter(0, static_cast<size_t>(k) * sy + static_cast<size_t>(j), x_run.data());
             const size_t row_start = (static_cast<size_t>(k) * sy + static_cast<size_t>(j)) * sx;
             char* z_dark_row = z_dark.data() + static_cast<size_t>(j) * sx;
-            const int* solid = solid_.empty() ? nullptr : solid_.data() + row_start;
             int skip = 0;
             if (dark(x_run.data()))
               for (; skip < nx; ++skip) {
                 const auto x = static_cast<size_t>(o & 1 ? nx - 1 - skip : skip);
-                if (!(y_dark[x] && z_dark_row[x] && ch.density[row_start + x] == 0.0f && !(solid && solid[x] >= 0))) break;
+                if (!(y_dark[x] && z_dark_row[x] && ch.density[row_start + x] == 0.0f)) break;
               }
             skipped[half] += skip;
             if (skip == nx) continue;
+            row.count = nx - skip;
+            row.x0 = o & 1 ? nx - 1 - skip : skip;
+            row.cell0 = row_start + static_cast<size_t>(row.x0);
             row.z_row = z_plane.data() + static_cast<size_t>(j) * sx * p;
-            // Runs of medium cells through the kernel; a solid cell sends its own light on.
-            for (int m = skip; m < nx;) {
-              const auto x = static_cast<size_t>(o & 1 ? nx - 1 - m : m);
-              if (solid && solid[x] >= 0) {
-                float* to[3] = {x_run.data(), y_row.data() + x * p, row.z_row + x * p};
-                for (float* t : to) {
-                  if (!faces || faces->emitted.empty()) std::fill(t, t + p, 0.0f);
-                  else std::copy_n(faces->emitted.data() + static_cast<size_t>(solid[x]) * padded_ + oc.offset, p, t);
-                }
-                ++m;
-                continue;
-              }
-              int end = m + 1;
-              while (end < nx && !(solid && solid[o & 1 ? nx - 1 - end : end] >= 0)) ++end;
-              row.count = end - m;
-              row.x0 = static_cast<int>(x);
-              row.cell0 = row_start + x;
-              row_kernel(oc.view, row);
-              m = end;
-            }
+            row_kernel(oc.view, row);
             for (int m = skip; m < nx; ++m) {
               const auto x = static_cast<size_t>(o & 1 ? nx - 1 - m : m);
               y_dark[x] = z_dark_row[x] = 0;
@@ -179,29 +162,6 @@ void Transport::sweep(const Channel& ch, const FirstCollision* first, const floa
 std::vector<Faces> Transport::faces(const DomBoundary& boundary, const DenseGrid& grid, int channels, int threads) const {
   std::vector<Faces> out(static_cast<size_t>(channels));
   const Aabb& b = grid.bounds();
-  if (boundary.solid && boundary.emitted) {
-    std::vector<int> solid(cells_, -1);
-    std::vector<size_t> cells;
-    for (int k = 0; k < n_[2]; ++k)
-      for (int j = 0; j < n_[1]; ++j)
-        for (int i = 0; i < n_[0]; ++i)
-          if (boundary.solid(grid.cell_center(i, j, k))) {
-            solid[grid.index(i, j, k)] = static_cast<int>(cells.size());
-            cells.push_back(grid.index(i, j, k));
-          }
-    for (Faces& f : out) f.solid = solid, f.emitted.assign(cells.size() * padded_, 0.0f);
-    const auto sx = static_cast<size_t>(n_[0]), sy = static_cast<size_t>(n_[1]);
-    parallel_for(static_cast<long long>(cells.size()), threads, 16, [&](long long s0, long long s1) {
-      for (auto s = static_cast<size_t>(s0); s < static_cast<size_t>(s1); ++s) {
-        const size_t c = cells[s];
-        const Vec3 x = grid.cell_center(static_cast<int>(c % sx), static_cast<int>(c / sx % sy), static_cast<int>(c / (sx * sy)));
-        for (size_t i = 0; i < directions_.size(); ++i) {
-          const Rgb r = boundary.emitted(x, directions_[i]);
-          for (int ch = 0; ch < channels; ++ch) out[static_cast<size_t>(ch)].emitted[s * padded_ + padded_index_[i]] = static_cast<float>(r[channels == 1 ? 0 : ch]);
-        }
-      }
-    });
-  }
   for (size_t o = 0; o < 8; ++o) {
     const auto p = static_cast<size_t>(octants_[o].view.directions);
     for (int axis = 0; axis < 3; ++axis) {

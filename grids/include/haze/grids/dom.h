@@ -114,10 +114,6 @@ struct DomSolution {
 // enters through every face.
 struct DomBoundary {
   std::function<Rgb(const Vec3& point, const Vec3& w)> radiance;
-  // Cells taken by opaque surfaces (optional): solid(x) at a cell centre; such a cell holds no
-  // medium and sends emitted(x, w) out along w in place of what it received.
-  std::function<bool(const Vec3& centre)> solid;
-  std::function<Rgb(const Vec3& centre, const Vec3& w)> emitted;
   bool grey = true;  // the same in every channel: a grey medium and lights still solve one channel
 };
 
