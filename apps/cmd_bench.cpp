@@ -298,9 +298,10 @@ void write_tradeoffs(const std::filesystem::path& file, const std::vector<std::s
        << "; under 5% the fastest is " << (five ? five->method + " at " + secs(five->seconds) : std::string("nothing the sweep measured")) << ".\n";
   }
   md << "\nThe single-scattering methods (analytic, quadrature, propagation) miss the light scattered more than\n"
-        "once; every method but the reference and dom lights surfaces with unscattered light only, and none\n"
-        "but the reference sends the light surfaces reflect back into the medium. On scenes\n"
-        "where either matters, the path tracer itself is the fastest way under a tight tolerance.\n";
+        "once; every method but the reference and dom lights surfaces with unscattered light only, and only\n"
+        "the reference and dom send the light surfaces reflect back into the medium (dom: from surfaces\n"
+        "outside its grid or on its faces). On scenes where either matters, the path tracer itself is the\n"
+        "fastest way under a tight tolerance.\n";
   md << "\n## Recommended settings per error level\n\nThe fastest measured method and settings under each error level, per scene (- : none of\n"
         "the sweep reached it).\n\n| scene | under 10% | under 5% | under 2% | under 1% |\n|---|---|---|---|---|\n";
   for (const auto& scene : scenes) {

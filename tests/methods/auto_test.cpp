@@ -62,14 +62,17 @@ TEST(AutoMethod, DomResolutionGrowsAsTheToleranceShrinksThenTheReferenceTakesOve
   EXPECT_EQ(tight.method, "reference");
 }
 
-TEST(AutoMethod, SurfacesInAScatteringMediumGetTheReferenceWithMoreSamplesForLessError) {
-  Scene scene = box_scene(0.5, 0.8);
+TEST(AutoMethod, SurfacesInFogGetTheDomThenTheReferenceWithMoreSamplesForLessError) {
+  Scene scene = box_scene(0.5, 0.8);  // optical diameter 2, multiple share 51%: fog_lamps' kind
   scene.surfaces.push_back(Surface{Plane{Vec3(0.0, -1.0, 0.0), Vec3(0.0, 1.0, 0.0)}, Rgb(0.5), Rgb(0.0), 1.0});
-  const AutoChoice loose = choose_method(scene, 0.1), tight = choose_method(scene, 0.02);
-  ASSERT_EQ(loose.method, "reference");
+  const AutoChoice loose = choose_method(scene, 0.1), mid = choose_method(scene, 0.04), tight = choose_method(scene, 0.02);
+  ASSERT_EQ(loose.method, "dom");
+  EXPECT_EQ(loose.settings["resolution"].get<int>(), 24);
+  ASSERT_EQ(mid.method, "dom");
+  EXPECT_EQ(mid.settings["resolution"].get<int>(), 48);
+  // Under the dom's measured 2.7% with surfaces in fog: the path tracer, which adds samples until
+  // its own noise is a fixed share of the tolerance.
   ASSERT_EQ(tight.method, "reference");
-  // The reference adds samples until its own noise is a fixed share of the tolerance.
-  EXPECT_DOUBLE_EQ(loose.settings["target_noise"].get<double>(), 0.75 * 0.1);
   EXPECT_DOUBLE_EQ(tight.settings["target_noise"].get<double>(), 0.75 * 0.02);
   EXPECT_FALSE(tight.why.empty());
 }
