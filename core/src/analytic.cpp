@@ -2,8 +2,9 @@
 // lights (seed 002 ch. 4, seed 004). Per pixel and light: the airlight of the view segment inside the
 // medium from the tabulated tail form (airlight.h), plus the surface's direct radiance attenuated
 // along both legs (eq. 4.2, 4.10 in Haze's energy-normalized BRDFs) and the airlight scattered onto
-// it (eq. 4.11-4.15, tables J1 and J_n). Like the thesis' model it has no shadows and no multiple
-// scattering.
+// it (eq. 4.11-4.15, tables J1 and J_n). Surfaces shadow the view segments (each light's airlight is
+// summed over the stretches it lights, core's lit_stretches) and each other's direct light; the
+// airlight onto a surface is not shadowed. Like the thesis' model it has no multiple scattering.
 #include "builtin_methods.h"
 
 #include <haze/core/airlight.h>
@@ -31,6 +32,7 @@ struct AnalyticLight {
 // What surface shading needs: the medium, the lights and the J tables.
 struct SurfaceShading {
   const Medium& medium;
+  const std::vector<Surface>& surfaces;
   const std::vector<AnalyticLight>& lights;
   Rgb sigma_t, sigma_s;
   bool grey;
@@ -46,7 +48,7 @@ struct SurfaceShading {
     for (const auto& light : lights) {
       arrival(light.light, p, a);
       double cos_i = glm::dot(normal, a.to_light);
-      if (cos_i <= 0.0) continue;
+      if (cos_i <= 0.0 || occluded(surfaces, p, a.to_light, a.distance)) continue;
       radiance += surface.brdf(a.to_light, -view_dir, normal) * a.irradiance * cos_i * medium.transmittance(p, light.position);
     }
     if (!surface_airlight || !medium.bounds().contains(p)) return radiance;
@@ -98,7 +100,7 @@ class AnalyticSolution final : public MethodSolution {
     RenderResult result{Image(camera.width_px, camera.height_px), std::nullopt, {}};
     ProgressTracker progress(options.progress, camera.height_px);
     const AirlightBatchFunction add_airlight = airlight_batch_function();
-    const SurfaceShading shade{*medium_, lights_, sigma_t_, sigma_s_, grey_, surface_airlight_, lambert_, phong_};
+    const SurfaceShading shade{*medium_, scene_.surfaces, lights_, sigma_t_, sigma_s_, grey_, surface_airlight_, lambert_, phong_};
     parallel_for(camera.height_px, options.threads, 1, [&](long long y0, long long y1) {
       // Per row: the view segments inside the medium as float arrays, then each point light's
       // airlight over the whole row in one batch (SIMD when haze::simd::install() has run).
@@ -109,10 +111,18 @@ class AnalyticSolution final : public MethodSolution {
         double t_hit;
         Vec3 normal;
         const Surface* hit;
+        double t_entry;  // where the ray enters the medium
       };
       std::vector<PixelHit> row(static_cast<size_t>(camera.width_px));
       std::array<std::vector<float>, 3> batch_airlight;
       std::vector<float> unit;
+      // A light's lit stretches (with surfaces): start, length, the segment each belongs to and
+      // its offset from the segment's entry.
+      std::vector<float> sx, sy, sz, sl;
+      std::array<std::vector<float>, 3> sd;
+      std::vector<size_t> owner;
+      std::vector<double> offset;
+      std::vector<std::pair<double, double>> stretches;
       for (auto y = static_cast<int>(y0); y < y1 && !progress.cancelled(); ++y) {
         for (auto* v : {&ox, &oy, &oz, &dx, &dy, &dz, &seg}) v->clear();
         for (int x = 0; x < camera.width_px; ++x) {
@@ -125,6 +135,7 @@ class AnalyticSolution final : public MethodSolution {
           slot[static_cast<size_t>(x)] = -1;
           if (!(airlight_ && bounds.clip(ray, t0, t1) && t1 > t0)) continue;
           slot[static_cast<size_t>(x)] = static_cast<int>(ox.size());
+          px.t_entry = t0;
           Vec3 entry = ray.at(t0);
           ox.push_back(static_cast<float>(entry.x)), oy.push_back(static_cast<float>(entry.y)), oz.push_back(static_cast<float>(entry.z));
           dx.push_back(static_cast<float>(ray.direction.x)), dy.push_back(static_cast<float>(ray.direction.y));
@@ -136,26 +147,61 @@ class AnalyticSolution final : public MethodSolution {
         for (const auto& light : lights_) {
           if (light.spot()) continue;
           const Vec3& p = light.position;
-          if (grey_) {
-            // One batch at unit intensity, scaled per channel: airlight is linear in I.
-            unit.assign(ox.size(), 0.0f);
-            add_airlight(table_, {static_cast<float>(p.x), static_cast<float>(p.y), static_cast<float>(p.z),
-                                 static_cast<float>(sigma_t_[0]), static_cast<float>(sigma_s_[0]), 1.0f},
-                         batch, unit.data());
-            for (int c = 0; c < 3; ++c)
-              for (size_t i = 0; i < unit.size(); ++i)
-                batch_airlight[static_cast<size_t>(c)][i] += static_cast<float>(light.intensity[c]) * unit[i];
-            continue;
+          // With surfaces, the light's own batch: the stretches of each segment it lights, each
+          // seen from its start and carried to the segment's entry by e^(-sigma_t offset).
+          const SegmentBatch* lit = &batch;
+          SegmentBatch stretch_batch{};
+          if (!scene_.surfaces.empty()) {
+            for (auto* v : {&sx, &sy, &sz, &sl}) v->clear();
+            owner.clear(), offset.clear();
+            for (int x = 0; x < camera.width_px; ++x) {
+              const int k = slot[static_cast<size_t>(x)];
+              if (k < 0) continue;
+              const auto kk = static_cast<size_t>(k);
+              const PixelHit& px = row[static_cast<size_t>(x)];
+              const Ray entry{px.ray.at(px.t_entry), px.ray.direction};
+              stretches.clear();
+              lit_stretches(scene_.surfaces, entry, 0.0, std::isfinite(seg[kk]) ? static_cast<double>(seg[kk]) : kInfinity, p, stretches);
+              for (const auto& [a, b] : stretches) {
+                const Vec3 start = entry.at(a);
+                sx.push_back(static_cast<float>(start.x)), sy.push_back(static_cast<float>(start.y)), sz.push_back(static_cast<float>(start.z));
+                sl.push_back(std::isfinite(b) ? static_cast<float>(b - a) : INFINITY);
+                owner.push_back(kk), offset.push_back(a);
+              }
+            }
+            sd[0].assign(sx.size(), 0.0f), sd[1].assign(sx.size(), 0.0f), sd[2].assign(sx.size(), 0.0f);
+            for (size_t i = 0; i < owner.size(); ++i) sd[0][i] = dx[owner[i]], sd[1][i] = dy[owner[i]], sd[2][i] = dz[owner[i]];
+            stretch_batch = {sx.data(), sy.data(), sz.data(), sd[0].data(), sd[1].data(), sd[2].data(), sl.data(), sx.size()};
+            lit = &stretch_batch;
           }
-          for (int c = 0; c < 3; ++c) {
-            if (sigma_s_[c] == 0.0 || light.intensity[c] == 0.0) continue;
+          // out[segment] += airlight, from the light's batch (the segments, or their lit stretches).
+          auto add = [&](int c, float intensity, const Rgb& scale) {
+            unit.assign(lit->count, 0.0f);
             add_airlight(table_, {static_cast<float>(p.x), static_cast<float>(p.y), static_cast<float>(p.z), static_cast<float>(sigma_t_[c]),
-                                 static_cast<float>(sigma_s_[c]), static_cast<float>(light.intensity[c])},
-                         batch, batch_airlight[static_cast<size_t>(c)].data());
-          }
+                                 static_cast<float>(sigma_s_[c]), intensity},
+                         *lit, unit.data());
+            for (int e = 0; e < 3; ++e) {
+              if (scale[e] == 0.0) continue;
+              std::vector<float>& to = batch_airlight[static_cast<size_t>(e)];
+              for (size_t i = 0; i < unit.size(); ++i) {
+                const size_t k = lit == &batch ? i : owner[i];
+                const double carried = lit == &batch ? 1.0 : std::exp(-sigma_t_[e] * offset[i]);
+                to[k] += static_cast<float>(scale[e] * carried * static_cast<double>(unit[i]));
+              }
+            }
+          };
+          // Grey: one batch at unit intensity, scaled per channel (airlight is linear in I).
+          if (grey_) add(0, 1.0f, light.intensity);
+          else
+            for (int c = 0; c < 3; ++c) {
+              if (sigma_s_[c] == 0.0 || light.intensity[c] == 0.0) continue;
+              Rgb only(0.0);
+              only[c] = 1.0;
+              add(c, static_cast<float>(light.intensity[c]), only);
+            }
         }
         for (int x = 0; x < camera.width_px; ++x) {
-          const auto& [ray, t_hit, normal, hit] = row[static_cast<size_t>(x)];
+          const auto& [ray, t_hit, normal, hit, t_entry] = row[static_cast<size_t>(x)];
           Rgb radiance(0.0);
           if (int k = slot[static_cast<size_t>(x)]; k >= 0) {
             for (int c = 0; c < 3; ++c) radiance[c] = static_cast<double>(batch_airlight[static_cast<size_t>(c)][static_cast<size_t>(k)]);
@@ -164,12 +210,16 @@ class AnalyticSolution final : public MethodSolution {
             Vec3 entry = ray.at(t0);
             for (const auto& light : lights_) {
               if (!light.spot()) continue;
-              for (int c = 0; c < 3; ++c) {
-                if (sigma_s_[c] == 0.0 || light.intensity[c] == 0.0) continue;
-                radiance[c] += spot_airlight(scene_.medium->phase, {sigma_t_[c], sigma_s_[c], light.intensity[c]}, entry, ray.direction,
-                                             t1 - t0, light.position, light.spot()->direction, light.spot()->exponent,
-                                             light.spot()->cone_deg);
-              }
+              stretches.clear();
+              if (scene_.surfaces.empty()) stretches.emplace_back(0.0, t1 - t0);
+              else lit_stretches(scene_.surfaces, Ray{entry, ray.direction}, 0.0, t1 - t0, light.position, stretches);
+              for (const auto& [a, b] : stretches)
+                for (int c = 0; c < 3; ++c) {
+                  if (sigma_s_[c] == 0.0 || light.intensity[c] == 0.0) continue;
+                  radiance[c] += std::exp(-sigma_t_[c] * a) * spot_airlight(scene_.medium->phase, {sigma_t_[c], sigma_s_[c], light.intensity[c]},
+                                                                            entry + a * ray.direction, ray.direction, b - a, light.position,
+                                                                            light.spot()->direction, light.spot()->exponent, light.spot()->cone_deg);
+                }
             }
           }
           Rgb view_t = medium_->transmittance_along(ray.origin, ray.direction, t_hit);
@@ -325,7 +375,7 @@ MethodInfo analytic_info() {
   info.summary = "closed-form single scattering, homogeneous medium, point and spot lights (seed 002; no shadows)";
   info.create = [] { return std::make_unique<AnalyticMethod>(); };
   info.handles = {"constant density (bounded or not)", "point, spot",
-                  "planes and spheres lit by unscattered light and the airlight, no shadows", false};
+                  "planes and spheres lit by unscattered light and the airlight, with shadows (not of the airlight onto them)", false};
   info.settings = {SettingInfo::integer("table_a", 256, 16, 4096, "airlight table samples along A = T_sv sin(gamma)"),
                    SettingInfo::integer("table_eta", 512, 16, 4096, "airlight table samples along the angle eta"),
                    SettingInfo::integer("surface_airlight", 1, 0, 1, "1: surfaces also receive the airlight (tables J1 and J_n)"),

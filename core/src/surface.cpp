@@ -1,5 +1,8 @@
 #include <haze/core/surface.h>
 
+#include <algorithm>
+#include <cmath>
+
 namespace haze {
 
 bool Surface::intersect(const Ray& ray, double t_min, double t_max, double& t, Vec3& normal) const {
@@ -53,6 +56,63 @@ bool occluded(const std::vector<Surface>& surfaces, const Vec3& x, const Vec3& d
   double t;
   Vec3 n;
   return !surfaces.empty() && nearest_surface(surfaces, {x, dir}, distance * (1.0 - 1e-9), t, n) != nullptr;
+}
+
+namespace {
+
+// The roots of a t^2 + b t + c = 0 (a may be 0), appended.
+void roots(double a, double b, double c, std::vector<double>& out) {
+  if (std::abs(a) < 1e-300) {
+    if (b != 0.0) out.push_back(-c / b);
+    return;
+  }
+  const double d = b * b - 4.0 * a * c;
+  if (d < 0.0) return;
+  const double q = -0.5 * (b + std::copysign(std::sqrt(d), b));  // stable form
+  out.push_back(q / a);
+  if (q != 0.0) out.push_back(c / q);
+}
+
+}  // namespace
+
+void lit_stretches(const std::vector<Surface>& surfaces, const Ray& ray, double t0, double t1, const Vec3& light,
+                   std::vector<std::pair<double, double>>& out) {
+  if (!(t1 > t0)) return;
+  std::vector<double> cuts;
+  const Vec3& o = ray.origin;
+  const Vec3& d = ray.direction;
+  for (const Surface& s : surfaces) {
+    if (const auto* plane = std::get_if<Plane>(&s.shape)) {
+      roots(0.0, glm::dot(d, plane->normal), glm::dot(o - plane->point, plane->normal), cuts);
+      continue;
+    }
+    const auto& sphere = std::get<Sphere>(s.shape);
+    const Vec3 oc = o - sphere.center;
+    const double r2 = sphere.radius * sphere.radius;
+    roots(glm::dot(d, d), 2.0 * glm::dot(oc, d), glm::dot(oc, oc) - r2, cuts);
+    // The tangent cone: points x with (v . (x - L))^2 = cos^2(alpha) |x - L|^2, sin(alpha) = r / |c - L|.
+    const Vec3 lc = sphere.center - light;
+    const double dist2 = glm::dot(lc, lc);
+    if (dist2 <= r2) continue;  // the light inside: the sphere's surface is the only edge
+    const Vec3 v = lc / std::sqrt(dist2), w = o - light;
+    const double cos2 = 1.0 - r2 / dist2, dv = glm::dot(d, v), wv = glm::dot(w, v);
+    roots(dv * dv - cos2 * glm::dot(d, d), 2.0 * (wv * dv - cos2 * glm::dot(w, d)), wv * wv - cos2 * glm::dot(w, w), cuts);
+  }
+  cuts.push_back(t0), cuts.push_back(t1);
+  std::sort(cuts.begin(), cuts.end());
+  double start = t0;
+  bool open = false;
+  for (size_t i = 0; i + 1 < cuts.size(); ++i) {
+    const double a = std::max(cuts[i], t0), b = std::min(cuts[i + 1], t1);
+    if (!(b > a)) continue;
+    const double mid = std::isfinite(b) ? 0.5 * (a + b) : a + 1.0 + std::abs(a);
+    const Vec3 x = ray.at(mid), to = light - x;
+    const double length = glm::length(to);
+    const bool lit = length > 0.0 && !occluded(surfaces, x, to / length, length);
+    if (lit && !open) start = a, open = true;
+    if (!lit && open) out.emplace_back(start, a), open = false;
+  }
+  if (open) out.emplace_back(start, t1);
 }
 
 }  // namespace haze

@@ -85,6 +85,33 @@ TEST(Surface, BrdfsAreEnergyNormalized) {
   }
 }
 
+// A light at (0, 3, 0) over a sphere of radius 0.3 at (0, 1.8, 0): the tangent cone's half-angle
+// has sin = 0.3 / 1.2, so the line y = 0 along x is in shadow for |x| < 3 tan(asin(0.25)); a plane
+// at y = 1 hides the light from everything below it.
+TEST(Surface, LitStretchesEndAtTheShadowsEdges) {
+  const Vec3 light(0.0, 3.0, 0.0);
+  const std::vector<Surface> sphere{Surface{Sphere{Vec3(0.0, 1.8, 0.0), 0.3}}};
+  std::vector<std::pair<double, double>> lit;
+  lit_stretches(sphere, Ray{Vec3(-5.0, 0.0, 0.0), Vec3(1.0, 0.0, 0.0)}, 0.0, 10.0, light, lit);
+  const double edge = 3.0 * std::tan(std::asin(0.25));
+  ASSERT_EQ(lit.size(), 2u);
+  EXPECT_NEAR(lit[0].first, 0.0, 1e-12);
+  EXPECT_NEAR(lit[0].second, 5.0 - edge, 1e-9);
+  EXPECT_NEAR(lit[1].first, 5.0 + edge, 1e-9);
+  EXPECT_NEAR(lit[1].second, 10.0, 1e-12);
+  // A ray that misses the shadow is lit all along, to infinity.
+  lit.clear();
+  lit_stretches(sphere, Ray{Vec3(-5.0, 0.0, 2.0), Vec3(1.0, 0.0, 0.0)}, 0.0, kInfinity, light, lit);
+  ASSERT_EQ(lit.size(), 1u);
+  EXPECT_EQ(lit[0].second, kInfinity);
+  // Down through the plane: lit to the plane, dark past it.
+  lit.clear();
+  const std::vector<Surface> plane{Surface{Plane{Vec3(0.0, 1.0, 0.0), Vec3(0.0, 1.0, 0.0)}}};
+  lit_stretches(plane, Ray{Vec3(0.5, 2.0, 0.0), Vec3(0.0, -1.0, 0.0)}, 0.0, 4.0, light, lit);
+  ASSERT_EQ(lit.size(), 1u);
+  EXPECT_NEAR(lit[0].second, 1.0, 1e-12);
+}
+
 TEST(Light, ArrivalFollowsInverseSquareAndSpotCone) {
   LightArrival a;
   ASSERT_TRUE(arrival(PointLight{Vec3(0, 0, 2), Rgb(8.0)}, Vec3(0), a));

@@ -5,6 +5,7 @@
 
 #include <haze/core/math.h>
 
+#include <utility>
 #include <variant>
 #include <vector>
 
@@ -40,6 +41,13 @@ const Surface* nearest_surface(const std::vector<Surface>& surfaces, const Ray& 
 // Whether a surface blocks the segment from x along the unit dir over distance (infinite for the
 // sun and the sky), short of its end by 1e-9 of it: a light on a surface is not hidden by it.
 bool occluded(const std::vector<Surface>& surfaces, const Vec3& x, const Vec3& dir, double distance);
+
+// The stretches [a, b] of ray.at(t), t in [t0, t1] (t1 may be infinite), from which a light at
+// `light` is not hidden by a surface, in order; appended to `out`. Exact for planes and spheres:
+// the line crosses a shadow's edge only where it crosses a plane, a sphere or the cone from the
+// light tangent to a sphere, so between those crossings occluded() at one point decides.
+void lit_stretches(const std::vector<Surface>& surfaces, const Ray& ray, double t0, double t1, const Vec3& light,
+                   std::vector<std::pair<double, double>>& out);
 
 }  // namespace haze
 
