@@ -91,7 +91,8 @@ void direct_light(NetworkSolution& s, const ParticleField& field, const std::vec
           // per axis), not E at its centre, which misses the light its fringe gets near lit edges.
           for (const Vec3& node : gaussian_nodes(x, field.h(p))) {
             LightArrival at;
-            if (map.arrival(node, material.sigma_t, nearest, at)) e += 0.125 * at.irradiance;
+            if (map.arrival(node, material.sigma_t, nearest, at) && !occluded(s.surfaces, node, at.to_light, at.distance))
+              e += 0.125 * at.irradiance;
           }
         } else {  // the light at the centre: no direction; a point light's irradiance at `nearest`
           const auto* point = std::get_if<PointLight>(delta[l]);
@@ -199,7 +200,7 @@ VisibilityNetwork build_visibility(const ParticleField& field, const std::vector
 }
 
 NetworkSolution solve_network(const ParticleField& field, const std::vector<Light>& lights, const NetworkSettings& settings,
-                              const NetworkSolution* warm) {
+                              const NetworkSolution* warm, const std::vector<Surface>& surfaces) {
   if (settings.directions < 8 || settings.directions > 4096)
     throw Error("directions", to_text(settings.directions), "a direction count in [8, 4096]");
   if (settings.max_iterations < 0) throw Error("iterations", to_text(settings.max_iterations), "at least 0 (0: single scattering only)");
@@ -219,6 +220,7 @@ NetworkSolution solve_network(const ParticleField& field, const std::vector<Ligh
   const std::vector<const Light*> delta = delta_lights(lights, out.sky);
   for (const Light* l : delta) out.light_maps.emplace_back(field, *l, settings.threads);
   out.channels = grey_scene(material, out.sky, delta) ? 1 : 3;
+  out.surfaces = surfaces;
   for (size_t c = 0; c < static_cast<size_t>(out.channels); ++c) out.source[c].assign(n * d, 0.0f);
   std::vector<int> all(n);
   std::iota(all.begin(), all.end(), 0);

@@ -58,9 +58,11 @@ struct Along {
 // half of the narrowest active width: each step's optical depth per particle is exact (erf
 // differences), and the step's source is the particles' scattered radiance weighted by their
 // share of that depth (the SPH interpolation of the source), plus `direct(t)`, the single-scattered
-// direct light at the step's middle. Returns the radiance; leaves the transmittance through all of it.
+// direct light at the step's middle, up to t_end (a surface). Returns the radiance; leaves the
+// transmittance through all of it.
 template <class Direct>
-Rgb march(std::vector<Along>& along, const Rgb& sigma_t, const std::vector<Rgb>& scattered, const Direct& direct, Rgb& transmittance) {
+Rgb march(std::vector<Along>& along, const Rgb& sigma_t, const std::vector<Rgb>& scattered, const Direct& direct, Rgb& transmittance,
+          double t_end) {
   Rgb radiance(0.0);
   if (along.empty()) return radiance;
   std::sort(along.begin(), along.end(), [](const Along& a, const Along& b) { return a.enter() < b.enter(); });
@@ -69,8 +71,9 @@ Rgb march(std::vector<Along>& along, const Rgb& sigma_t, const std::vector<Rgb>&
   std::vector<size_t> active;
   double t = std::max(0.0, along[0].enter());
   size_t next = 0;
-  while (next < along.size() || !active.empty()) {
+  while ((next < along.size() || !active.empty()) && t < t_end) {
     if (active.empty()) t = std::max(t, along[next].enter());
+    if (!(t < t_end)) break;
     while (next < along.size() && along[next].enter() <= t) {
       erf_at[next] = erf((t - along[next].centre) / along[next].h);
       active.push_back(next++);
@@ -79,6 +82,7 @@ Rgb march(std::vector<Along>& along, const Rgb& sigma_t, const std::vector<Rgb>&
     for (size_t a : active) step = std::min(step, 0.5 * along[a].h);
     double t1 = t + step;
     if (next < along.size()) t1 = std::min(t1, std::max(t + 1e-9, along[next].enter()));
+    t1 = std::min(t1, t_end);
     double tau = 0.0;
     Rgb source(0.0);
     for (size_t a : active) {
@@ -138,9 +142,21 @@ Image render_network(const Scene& scene, const ParticleField& field, const Netwo
     Rgb s(0.0);
     for (const LightDepthMap& map : solution.light_maps) {
       LightArrival a;
-      if (map.arrival(x, material.sigma_t, nearest, a)) s += material.phase.eval(glm::dot(-a.to_light, w)) * a.irradiance;
+      if (map.arrival(x, material.sigma_t, nearest, a) && !occluded(scene.surfaces, x, a.to_light, a.distance))
+        s += material.phase.eval(glm::dot(-a.to_light, w)) * a.irradiance;
     }
     return material.albedo * s;
+  };
+  // A surface point's direct light through the BRDF, shadowed by surfaces and through the particles.
+  const auto surface_light = [&](const Surface& surface, const Vec3& p, const Vec3& normal, const Vec3& wo) {
+    Rgb s(0.0);
+    for (const LightDepthMap& map : solution.light_maps) {
+      LightArrival a;
+      if (!map.arrival(p, material.sigma_t, 0.0, a)) continue;
+      const double cos_i = glm::dot(normal, a.to_light);
+      if (cos_i > 0.0 && !occluded(scene.surfaces, p, a.to_light, a.distance)) s += surface.brdf(a.to_light, wo, normal) * a.irradiance * cos_i;
+    }
+    return s;
   };
 
   // Particles binned to 16 x 16 tiles by their footprints (march() orders each ray's).
@@ -166,18 +182,22 @@ Image render_network(const Scene& scene, const ParticleField& field, const Netwo
       for (int y = ty * kTile; y < std::min(cam.height_px, (ty + 1) * kTile); ++y)
         for (int x = tx * kTile; x < std::min(cam.width_px, (tx + 1) * kTile); ++x) {
           const Ray ray = cam.pixel_ray(x, y);
+          double t_hit = kInfinity;
+          Vec3 normal;
+          const Surface* surface = nearest_surface(scene.surfaces, ray, kInfinity, t_hit, normal);
           along.clear();
           for (const int index : list) {
             const auto p = static_cast<size_t>(index);
             const Vec3 o = field.position(p) - ray.origin;
             const double h = field.h(p), tc = glm::dot(o, ray.direction), perp2 = glm::dot(o, o) - tc * tc;
-            if (perp2 >= kCut * kCut * h * h || tc < -kCut * h) continue;
+            if (perp2 >= kCut * kCut * h * h || tc < -kCut * h || tc - kCut * h >= t_hit) continue;
             along.push_back({tc, h, field.weight(p) * std::exp(-perp2 / (h * h)) * std::sqrt(kPi) * h, index});
           }
           Rgb transmittance(1.0);
           const Rgb radiance = march(
-              along, material.sigma_t, scattered, [&](double t) { return direct(ray.origin + t * ray.direction, -ray.direction); }, transmittance);
-          image.set(x, y, radiance + transmittance * background);
+              along, material.sigma_t, scattered, [&](double t) { return direct(ray.origin + t * ray.direction, -ray.direction); }, transmittance,
+              t_hit);
+          image.set(x, y, radiance + transmittance * (surface ? surface_light(*surface, ray.at(t_hit), normal, -ray.direction) : background));
         }
       progress.advance();
     }
@@ -195,7 +215,7 @@ class NetworkMethodSolution final : public MethodSolution {
       : scene_(scene), neighbours_(neighbours), settings_(settings) {
     set_ = std::make_unique<ParticleSet>(std::move(set));
     field_ = std::make_unique<ParticleField>(set_->view(), neighbours_);
-    solution_ = solve_network(*field_, scene_.lights, settings_);
+    solution_ = solve_network(*field_, scene_.lights, settings_, nullptr, scene_.surfaces);
     settings_.progress = nullptr;
     describe();
   }
@@ -210,9 +230,9 @@ class NetworkMethodSolution final : public MethodSolution {
 
   // Moved particles (a new particle medium of the same count) and new lights: update_network,
   // which redoes only what the moved particles and lights reach, then iterates from the previous
-  // I. Surfaces are not drawn; anything else prepares again.
+  // I. Anything else (new surfaces included) prepares again.
   std::optional<UpdateReport> update(const Scene& scene, const SceneChange& change, const RenderOptions& options) override {
-    if (change.region) return std::nullopt;
+    if (change.region || change.surfaces) return std::nullopt;
     std::unique_ptr<ParticleSet> set;
     std::unique_ptr<ParticleField> field;
     if (change.medium) {
@@ -294,7 +314,7 @@ MethodInfo network_info() {
   info.name = "network";
   info.summary = "multiple scattering in particle media: visibility and illumination networks (seed 001)";
   info.create = [] { return std::make_unique<NetworkMethod>(); };
-  info.handles = {"particles (a Gaussian each)", "point, spot, directional, sky", "none: surfaces are not drawn", true};
+  info.handles = {"particles (a Gaussian each)", "point, spot, directional, sky", "planes and spheres lit by unscattered light through the particles, with shadows (also in the particles' direct light)", true};
   const NetworkSettings n;
   info.settings = {SettingInfo::integer("directions", n.directions, 8, 4096, "D, the network's directions"),
                    SettingInfo::integer("window", 0, 0, 65536, "projection window in texels (0: from the particles' sizes)"),

@@ -15,7 +15,7 @@ NetworkSolution update_network(NetworkSolution s, const ParticleField& field, co
   const MaterialDesc& material = field.particles().material;
   const size_t n = field.size();
   const auto rebuild = [&](const char* reason) {
-    NetworkSolution out = solve_network(field, lights, settings, &s);
+    NetworkSolution out = solve_network(field, lights, settings, &s, s.surfaces);
     out.update.rebuilt = true, out.update.reason = reason;
     return out;
   };

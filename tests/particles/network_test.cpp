@@ -74,6 +74,68 @@ TEST(NetworkRender, SingleScatteringMatchesTheReference) {
   EXPECT_LT(e.rms_noise_removed, 0.04);
 }
 
+// Surfaces: a floor under the ball receives the sun's unscattered light through the particles (its
+// depth map) and the shadow of a sphere beside it, as the reference without scattering does (summed
+// over the floor pixels whose view ray misses the ball, within 1% plus three of the reference's
+// standard errors); a sphere between the sun and the ball shadows the particles' direct light:
+// single scattering over the pixels that see no surface, as in the test above. Without the
+// shadows the floor is 2.9% bright and the single scattering 21%.
+TEST(NetworkRender, SurfacesAreLitThroughTheParticlesAndShadowThem) {
+  register_methods();
+  Scene scene = ball(2000, 0.9, 32, 24);
+  scene.lights.pop_back();  // the sun alone: its shadows on the floor are dark in both
+  scene.surfaces.push_back(Surface{Plane{Vec3(0.0, -1.8, 0.0), Vec3(0.0, 1.0, 0.0)}, Rgb(0.5), Rgb(0.0), 1.0});
+  scene.surfaces.push_back(Surface{Sphere{Vec3(-2.0, -1.25, -1.6), 0.5}, Rgb(0.5), Rgb(0.0), 1.0});
+  RenderOptions unscattered;
+  unscattered.settings = {{"spp", 256}, {"seed", 5}, {"max_scattering", 0}};
+  const RenderResult reference = render(scene, "reference", unscattered);
+  const Image network = render(scene, "network", RenderOptions{0, {{"iterations", 0}}, {}, {}}).radiance;
+  // The floor seen past the ball's support (radius 1 and the Gaussians' reach) and the sphere.
+  Image got(network.width(), network.height()), want = got, se = got;
+  for (int y = 0; y < network.height(); ++y)
+    for (int x = 0; x < network.width(); ++x) {
+      const Ray ray = scene.camera.pixel_ray(x, y);
+      double t;
+      Vec3 n;
+      const Surface* hit = nearest_surface(scene.surfaces, ray, kInfinity, t, n);
+      const double tc = -glm::dot(ray.origin, ray.direction), miss2 = glm::dot(ray.origin, ray.origin) - tc * tc;
+      if (hit != &scene.surfaces[0] || miss2 < 1.6 * 1.6) continue;
+      got.set(x, y, network.at(x, y)), want.set(x, y, reference.radiance.at(x, y)), se.set(x, y, reference.std_error->at(x, y));
+    }
+  // Summed over the floor: a pixel on the shadow's hard edge is its centre here, its area there.
+  double sum_got = 0.0, sum_want = 0.0, variance = 0.0;
+  int pixels = 0;
+  for (int y = 0; y < got.height(); ++y)
+    for (int x = 0; x < got.width(); ++x)
+      if (want.at(x, y).g > 0.0) sum_got += got.at(x, y).g, sum_want += want.at(x, y).g, variance += std::pow(se.at(x, y).g, 2), ++pixels;
+  const double noise = std::sqrt(variance) / sum_want;
+  std::printf("floor over %d pixels: %+.2f%% (reference noise %.2f%%)\n", pixels, 100.0 * (sum_got / sum_want - 1.0), 100.0 * noise);
+  EXPECT_GT(pixels, 50);
+  EXPECT_NEAR(sum_got / sum_want, 1.0, 0.01 + 3.0 * noise);
+
+  Scene shaded = ball(2000, 0.9, 32, 24);
+  shaded.surfaces.push_back(Surface{Sphere{Vec3(0.9, 1.6, 0.9), 0.5}, Rgb(0.5), Rgb(0.0), 1.0});
+  RenderOptions single;
+  single.settings = {{"spp", 256}, {"seed", 5}, {"max_scattering", 1}};
+  const RenderResult shaded_reference = render(shaded, "reference", single);
+  const Image shaded_network = render(shaded, "network", RenderOptions{0, {{"iterations", 0}}, {}, {}}).radiance;
+  Image medium_got(network.width(), network.height()), medium_want = medium_got, medium_se = medium_got;
+  for (int y = 0; y < network.height(); ++y)
+    for (int x = 0; x < network.width(); ++x) {
+      double t;
+      Vec3 n;
+      if (nearest_surface(shaded.surfaces, shaded.camera.pixel_ray(x, y), kInfinity, t, n)) continue;
+      medium_got.set(x, y, shaded_network.at(x, y)), medium_want.set(x, y, shaded_reference.radiance.at(x, y));
+      medium_se.set(x, y, shaded_reference.std_error->at(x, y));
+    }
+  const LitPixelError e = lit_pixel_error(medium_got, medium_want, &medium_se);
+  std::printf("single scattering in the sphere's shadow, %d pixels: signed %+.4f +- %.4f, rms (noise removed) %.4f\n", e.pixels, e.signed_mean,
+              e.signed_mean_error, e.rms_noise_removed);
+  EXPECT_GT(e.pixels, 250);
+  EXPECT_LT(std::abs(e.signed_mean), 0.02 + 3.0 * e.signed_mean_error);
+  EXPECT_LT(e.rms_noise_removed, 0.04);
+}
+
 // The continuous density: a uniform ball of particles stands for density 1 inside (within 15%:
 // the sizes come from the 8 nearest neighbours, a noisy estimate), and a line integral equals the
 // sum of the density along it.

@@ -80,6 +80,7 @@ struct NetworkSolution {
   int channels = 3;
   std::array<std::vector<float>, 3> incoming;  // I per channel, [i * particles + p] (all three filled)
   std::vector<LightDepthMap> light_maps;  // per delta light l, in the scene's order (sky lights skipped)
+  std::vector<Surface> surfaces;          // what shadows the particles' direct light (solve_network's)
   // The iteration's state (iterate_network): S, the direct light scattered into each direction per
   // unit albedo, and each gap's transmittance in sweep order ([i * particles + k] for the k-th
   // particle of visibility.order, -1 where no particle is upstream), per solved channel; the product
@@ -110,9 +111,10 @@ struct NetworkSolution {
   } update;
 };
 
-// Emission is not modelled. `warm` (same particles and directions) starts from its I.
+// Emission is not modelled. `warm` (same particles and directions) starts from its I. `surfaces`
+// shadow the direct light at the particles (at each point of their Gaussians' quadrature).
 NetworkSolution solve_network(const ParticleField& field, const std::vector<Light>& lights, const NetworkSettings& settings,
-                              const NetworkSolution* warm = nullptr);
+                              const NetworkSolution* warm = nullptr, const std::vector<Surface>& surfaces = {});
 // One iteration of the network (every direction swept once, threaded over directions; the
 // in-scattering product threaded over particles): updates solution.incoming for the solved
 // channels and returns the relative L2 change of I. solve_network calls it until converged.
