@@ -20,7 +20,7 @@ using internal::Api;
 namespace {
 
 // Texture units, one per sampler: samplers of different types may not share a unit.
-enum Unit : int { kDensityUnit = 0, kDepthUnit = 1, kPhaseUnit = 5, kMomentsUnit = 6, kWeightsUnit = 7, kVisibilityUnit = 8 };
+enum Unit : int { kDensityUnit = 0, kDepthUnit = 1, kPhaseUnit = 5, kMomentsUnit = 6, kWeightsUnit = 7, kVisibilityUnit = 8, kAtlasUnit = 12 };
 
 GLuint compile(const Api& gl, GLenum type, const char* source) {
   const GLuint shader = gl.CreateShader(type);
@@ -69,7 +69,8 @@ struct VolumeDisplay::Impl {
   Aabb bounds;
   Rgb sigma_t{1.0}, albedo{0.8};
   PhaseFunction phase;
-  std::optional<Texture> density, phase_table, moments, weights;
+  std::optional<Texture> density, phase_table, moments, weights, surface_atlas;
+  Rgb sky{0.0};  // the sky's radiance, for the surfaces' texels (E_s = pi sky where they have none)
   // Bound to the units of samplers the scene does not use: a unit without a complete texture of
   // its sampler's type is undefined on some drivers.
   std::optional<Texture> unused_plane, unused_volume;
@@ -146,6 +147,8 @@ struct VolumeDisplay::Impl {
     gl.Uniform1i(at("phase_table"), kPhaseUnit);
     gl.Uniform1i(at("moments"), kMomentsUnit);
     gl.Uniform1i(at("weights"), kWeightsUnit);
+    gl.Uniform1i(at("surface_atlas"), kAtlasUnit);
+    gl.Uniform1i(at("surface_texels_on"), 0);
     set_phase();
     set_lights();
     set_surfaces();
@@ -239,6 +242,47 @@ struct VolumeDisplay::Impl {
     gl.Uniform1fv(at("surface_shininess"), kMaxSurfaces, shininess);
   }
 
+  // The DOM's surface texels as rows of one RGBA float atlas, with each surface's frame.
+  void upload_surface_texels(const grids::SurfaceTexels* texels) {
+    gl.UseProgram(program);
+    gl.Uniform1i(at("surface_texels_on"), texels ? 1 : 0);
+    if (!texels) return;
+    float map[4 * kMaxSurfaces] = {}, origin[4 * kMaxSurfaces] = {}, u[4 * kMaxSurfaces] = {}, v[4 * kMaxSurfaces] = {};
+    int width = 1, rows = 0;
+    for (size_t i = 0; i < scene.surfaces.size() && i < texels->planes.size(); ++i) {
+      width = std::max({width, texels->planes[i].nu, texels->spheres[i].np});
+      rows += texels->planes[i].values.empty() ? texels->spheres[i].nt : texels->planes[i].nv;
+    }
+    std::vector<float> atlas(4 * static_cast<size_t>(width) * static_cast<size_t>(std::max(1, rows)), 0.0f);
+    int row = 0;
+    for (size_t i = 0; i < scene.surfaces.size() && i < texels->planes.size(); ++i) {
+      const auto& r = texels->planes[i];
+      const auto& g = texels->spheres[i];
+      const bool plane = !r.values.empty();
+      if (!plane && g.values.empty()) continue;
+      const int columns = plane ? r.nu : g.np, count = plane ? r.nv : g.nt;
+      const std::vector<Rgb>& values = plane ? r.values : g.values;
+      for (int y = 0; y < count; ++y)
+        for (int x = 0; x < columns; ++x)
+          for (int c = 0; c < 3; ++c)
+            atlas[4 * (static_cast<size_t>(row + y) * static_cast<size_t>(width) + static_cast<size_t>(x)) + static_cast<size_t>(c)] =
+                f(values[static_cast<size_t>(y) * static_cast<size_t>(columns) + static_cast<size_t>(x)][c]);
+      const size_t k = 4 * i;
+      map[k] = plane ? 1.0f : 2.0f, map[k + 1] = static_cast<float>(row), map[k + 2] = static_cast<float>(columns), map[k + 3] = static_cast<float>(count);
+      const Vec3 o = plane ? r.origin : g.centre;
+      for (int e = 0; e < 3; ++e) origin[k + static_cast<size_t>(e)] = f(o[e]), u[k + static_cast<size_t>(e)] = f(r.u[e]), v[k + static_cast<size_t>(e)] = f(r.v[e]);
+      origin[k + 3] = f(r.size), u[k + 3] = f(r.u0), v[k + 3] = f(r.v0);
+      row += count;
+    }
+    surface_atlas.emplace(Texture::plane(width, std::max(1, rows), 4, TexelFormat::float32));
+    surface_atlas->upload(atlas);
+    gl.Uniform4fv(at("surface_map"), kMaxSurfaces, map);
+    gl.Uniform4fv(at("surface_map_o"), kMaxSurfaces, origin);
+    gl.Uniform4fv(at("surface_map_u"), kMaxSurfaces, u);
+    gl.Uniform4fv(at("surface_map_v"), kMaxSurfaces, v);
+    gl.Uniform3f(at("sky"), f(sky.r), f(sky.g), f(sky.b));
+  }
+
   void set_camera(const Camera& c) {
     const Vec3 forward = glm::normalize(c.look_at - c.position);
     const Vec3 right = glm::normalize(glm::cross(forward, c.up));
@@ -318,6 +362,7 @@ struct VolumeDisplay::Impl {
     bind(kPhaseUnit, GL_TEXTURE_2D, (phase_table ? *phase_table : *unused_plane).id());
     bind(kMomentsUnit, GL_TEXTURE_3D, (moments ? *moments : *unused_volume).id());
     bind(kWeightsUnit, GL_TEXTURE_2D, (weights ? *weights : *unused_plane).id());
+    bind(kAtlasUnit, GL_TEXTURE_2D, (surface_atlas ? *surface_atlas : *unused_plane).id());
     gl.ActiveTexture(GL_TEXTURE0);
     gl.BindVertexArray(vao);
     gl.DrawArrays(GL_TRIANGLES, 0, 3);
@@ -335,7 +380,7 @@ VolumeDisplay::VolumeDisplay(const Scene& scene, const grids::ExtinctionVolume& 
   d.scene = scene;
   d.scene.lights.clear();
   for (const Light& l : scene.lights) {
-    if (const auto* sky = std::get_if<SkyLight>(&l)) d.scene.background += sky->radiance;
+    if (const auto* sky = std::get_if<SkyLight>(&l)) d.scene.background += sky->radiance, d.sky += sky->radiance;
     else d.scene.lights.push_back(l);
   }
   if (d.scene.lights.size() > static_cast<size_t>(kMaxLights))
@@ -404,6 +449,7 @@ void VolumeDisplay::show_dom(const grids::DomSolution& solution) {
   d.set_coefficients(d.sigma_t * scale, d.sigma_t, d.albedo / scale, d.albedo * (1.0 - fm) / scale);
   d.gl.Uniform1i(d.at("ms_groups"), groups);
   d.gl.Uniform1i(d.at("ms_channels"), channels);
+  d.upload_surface_texels(solution.surfaces.get());
   internal::check(d.gl, "dom upload");
 }
 
@@ -440,7 +486,7 @@ const Texture& VolumeDisplay::density() const { return *impl_->density; }
 std::vector<const Texture*> VolumeDisplay::textures() const {
   std::vector<const Texture*> all{&*impl_->density};
   for (const Texture& t : impl_->depths) all.push_back(&t);
-  for (const auto* t : {&impl_->phase_table, &impl_->moments, &impl_->weights})
+  for (const auto* t : {&impl_->phase_table, &impl_->moments, &impl_->weights, &impl_->surface_atlas})
     if (*t) all.push_back(&**t);
   return all;
 }

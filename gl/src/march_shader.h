@@ -49,6 +49,15 @@ uniform vec4 surface_shape[16];  // plane: unit normal, dot(normal, point); sphe
 uniform vec3 surface_kd[16], surface_ks[16];
 uniform float surface_shininess[16];
 
+// The DOM's surface texels (grids::SurfaceTexels), rows of one RGBA atlas: per surface (kind 0
+// none, 1 plane, 2 sphere; its first row; columns; rows) and its frame (plane: origin and texel
+// size, u and u0, v and v0; sphere: centre). Where a surface has none, or past a plane's
+// rectangle: pi sky. Off (0) unless a DOM solution with surfaces is shown.
+uniform int surface_texels_on;
+uniform vec4 surface_map[16], surface_map_o[16], surface_map_u[16], surface_map_v[16];
+uniform sampler2D surface_atlas;
+uniform vec3 sky;
+
 // Multiple scattering (DOM moments): slab (channel * ms_groups + group) of cells.z texels along z
 // holds terms 4 group .. 4 group + 3; the weights c_k toward this pixel's eye direction at texel
 // (x, group * film.y + y) of `weights`.
@@ -187,6 +196,35 @@ vec3 brdf(int i, vec3 wi, vec3 wo, vec3 n) {
   return f;
 }
 
+// SurfaceTexels::Rectangle::lookup and Globe::lookup (grids/src/dom_surfaces.cpp).
+vec3 atlas_at(int row0, int col, int row) { return texelFetch(surface_atlas, ivec2(col, row0 + row), 0).rgb; }
+vec3 surface_irradiance(int i, vec3 p) {
+  vec4 m = surface_map[i];
+  int kind = int(m.x), row0 = int(m.y), nu = int(m.z), nv = int(m.w);
+  if (kind == 1) {
+    vec4 o = surface_map_o[i], u = surface_map_u[i], v = surface_map_v[i];
+    float fu = (dot(p - o.xyz, u.xyz) - u.w) / o.w - 0.5, fv = (dot(p - o.xyz, v.xyz) - v.w) / o.w - 0.5;
+    if (!(fu >= -0.5 && fu <= float(nu) - 0.5 && fv >= -0.5 && fv <= float(nv) - 0.5)) return PI * sky;
+    float cu = clamp(fu, 0.0, float(nu - 1)), cv = clamp(fv, 0.0, float(nv - 1));
+    int a = min(int(cu), nu - 2), b = min(int(cv), nv - 2);
+    float s = cu - float(a), t = cv - float(b);
+    return (1.0 - t) * ((1.0 - s) * atlas_at(row0, a, b) + s * atlas_at(row0, a + 1, b)) +
+           t * ((1.0 - s) * atlas_at(row0, a, b + 1) + s * atlas_at(row0, a + 1, b + 1));
+  }
+  if (kind == 2) {
+    int np = nu, nt = nv;
+    vec3 u = normalize(p - surface_map_o[i].xyz);
+    float ft = clamp(acos(clamp(u.y, -1.0, 1.0)) / PI * float(nt) - 0.5, 0.0, float(nt - 1));
+    float fp = (atan(u.z, u.x) + PI) / (2.0 * PI) * float(np) - 0.5;
+    int t = min(int(ft), nt - 2);
+    float a = ft - float(t), fl = floor(fp), b = fp - fl;
+    int p0 = ((int(fl) % np) + np) % np, p1 = (p0 + 1) % np;
+    return (1.0 - a) * ((1.0 - b) * atlas_at(row0, p0, t) + b * atlas_at(row0, p1, t)) +
+           a * ((1.0 - b) * atlas_at(row0, p0, t + 1) + b * atlas_at(row0, p1, t + 1));
+  }
+  return PI * sky;
+}
+
 void main() {
   vec2 pix = vec2(gl_FragCoord.x, film.y - gl_FragCoord.y);
   float sx = (2.0 * pix.x / film.x - 1.0) * aspect, sy = 1.0 - 2.0 * pix.y / film.y;
@@ -277,6 +315,7 @@ void main() {
       }
       end += brdf(surface, to_light, -d, normal) * E * cos_i * exp(-sigma_t_view * depth);
     }
+    if (surface_texels_on == 1) end += (surface_kd[surface] + surface_ks[surface]) / PI * surface_irradiance(surface, p);
   }
   out_color = vec4(L + T * end, 1.0);
 }

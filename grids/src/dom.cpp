@@ -64,10 +64,18 @@ SurfaceSolve solve_with_surfaces(const Scene& scene, const ExtinctionVolume& vol
   out.iterations = out.solution.iterations;
   Rgb sky;
   const Scene delta = without_sky(scene, sky);
+  // Each set of texels also gathers what other surfaces reflect, from the set before it.
+  std::shared_ptr<const SurfaceTexels> texels;
+  auto next_texels = [&] {
+    std::optional<dom::SurfaceLight> previous;
+    if (texels) previous.emplace(delta, volume, depths, *texels, sky, out.solution.delta_m_fraction);
+    texels = std::make_shared<SurfaceTexels>(
+        dom::surface_texels(delta, volume, depths, out.solution, sky, step_cells, settings.threads, previous ? &*previous : nullptr));
+  };
   for (; out.passes < passes; ++out.passes) {
     Stopwatch watch;
-    const dom::SurfaceTexels texels = dom::surface_texels(delta, volume, depths, out.solution, sky, step_cells, settings.threads);
-    const dom::SurfaceLight light(delta, volume, depths, texels, sky, out.solution.delta_m_fraction);
+    next_texels();
+    const dom::SurfaceLight light(delta, volume, depths, *texels, sky, out.solution.delta_m_fraction);
     const DomBoundary boundary = light.boundary();
     out.surface_seconds += watch.seconds();
     share(out.passes + 1);
@@ -76,8 +84,8 @@ SurfaceSolve solve_with_surfaces(const Scene& scene, const ExtinctionVolume& vol
   }
   if (!scene.surfaces.empty()) {
     Stopwatch watch;
-    out.solution.surfaces =
-        std::make_shared<dom::SurfaceTexels>(dom::surface_texels(delta, volume, depths, out.solution, sky, step_cells, settings.threads));
+    next_texels();
+    out.solution.surfaces = texels;
     out.surface_seconds += watch.seconds();
   }
   return out;
@@ -88,7 +96,7 @@ SurfaceSolve solve_with_surfaces(const Scene& scene, const ExtinctionVolume& vol
 // gather). Then, where the ray meets a surface, the light the medium scatters onto it and the sky
 // through the medium, reflected toward the eye and seen through T' (Gather::around through the
 // BRDF: the first bounce, medium to surface), with what other surfaces reflect onto it when the
-// solution carries its surfaces' texels (one bounce between surfaces).
+// solution carries its surfaces' texels (which hold the bounces between surfaces so far).
 Image gather_scattered(const Scene& delta, const ExtinctionVolume& volume, const std::vector<DenseGrid>& depths,
                        const DomSolution& solution, double step_cells, const Rgb& sky, const RenderOptions& options) {
   std::optional<dom::SurfaceLight> light;
@@ -110,8 +118,10 @@ Image gather_scattered(const Scene& delta, const ExtinctionVolume& volume, const
           radiance = gather.along(ray, t_hit, inscatter_weights(solution, -ray.direction), transmittance);
         if (surface) {
           const Vec3 wo = -ray.direction;
-          radiance += transmittance * gather.around(ray.at(t_hit), normal, sky,
-                                                    [&](const Vec3& wi) { return surface->brdf(wi, wo, normal); });
+          if (solution.texel_surfaces && light)
+            radiance += transmittance * (surface->kd + surface->ks) / kPi * light->irradiance(*surface, ray.at(t_hit));
+          else
+            radiance += transmittance * gather.around(ray.at(t_hit), normal, sky, [&](const Vec3& wi) { return surface->brdf(wi, wo, normal); });
         }
         image.set(x, y, radiance);
       }
@@ -201,6 +211,7 @@ class DomMethodSolution final : public GridSolution {
       report.stats["final_change"] = next.solution.changes.empty() ? 0.0 : next.solution.changes.back();
       report.stats["converged"] = next.solution.converged;
       report.stats["sweep_seconds"] = next.solution.sweep_seconds;
+      next.solution.texel_surfaces = solution_.texel_surfaces;
       solution_ = std::move(next.solution);
     }
     report.stats["solve_seconds"] = watch.lap();
@@ -247,6 +258,7 @@ DomFields dom_fields(const Scene& scene, const RenderOptions& options) {
   const double step_cells = settings.number("step");
   const int warm_iterations = static_cast<int>(settings.integer("warm_iterations"));
   const int surface_passes = static_cast<int>(settings.integer("surface_passes"));
+  const bool texel_surfaces = settings.choice("surface_view") == "texels";
   settings.reject_unknown();
 
   Stopwatch watch;
@@ -262,6 +274,7 @@ DomFields dom_fields(const Scene& scene, const RenderOptions& options) {
   SurfaceSolve solved_surfaces = solve_with_surfaces(scene, volume, delta_depths, dom, nullptr, surface_passes, step_cells);
   const double solve_seconds = watch.lap();
   dom.progress = nullptr;
+  solved_surfaces.solution.texel_surfaces = texel_surfaces;
   DomFields fields{std::move(volume), std::move(delta_depths), std::move(solved_surfaces.solution), step_cells, {}, resolution, dom, depth,
                    warm_iterations, surface_passes};
   const ExtinctionVolume& v = fields.volume;
@@ -326,7 +339,7 @@ MethodInfo dom_info() {
   info.summary = "multiple scattering on grids: discrete ordinates with a separable phase function (seed 000)";
   info.create = [] { return std::make_unique<DomMethod>(); };
   info.handles = {"RBF, grid and bounded constant densities, the particles' density", "point, spot, directional, sky",
-                  "planes and spheres: shadows, the medium's light onto them and theirs into it (outside the grid or on its faces), one bounce between them", true};
+                  "planes and spheres: shadows, the medium's light onto them and theirs into it (outside the grid or on its faces), and between them", true};
   const DomSettings d;
   info.settings = {
       SettingInfo::integer("resolution", 64, 2, 1024, "cells along the longest side of the medium's bounds (RBF and constant)"),
@@ -341,7 +354,9 @@ MethodInfo dom_info() {
       SettingInfo::choice("optical_depth", "exact", {"exact", "paper", "sweep"}, "how the depth to each light is computed"),
       SettingInfo::number("step", 0.5, 0.01, 4.0, "camera gather's ray-march step in cells"),
       SettingInfo::integer("warm_iterations", 0, 0, 100000, "sweeps per update, each with the first-collision source in it (0: GMRES to the tolerance)"),
-      SettingInfo::integer("surface_passes", 2, 0, 100, "solves with the light surfaces reflect into the medium, one more bounce each (scheme sweep)")};
+      SettingInfo::integer("surface_passes", 2, 0, 100, "solves with the light surfaces reflect into the medium, one more bounce each (scheme sweep)"),
+      SettingInfo::choice("surface_view", "rays", {"rays", "texels"},
+                          "visible surfaces' scattered light: 64 rays per pixel, or the surfaces' texels (what the GL display shows)")};
   for (auto [resolution, directions, terms] : {std::tuple{16, 32, 9}, {24, 48, 16}, {32, 80, 25}, {48, 128, 25}, {64, 128, 25}, {96, 128, 25}})
     info.trade_sweep.push_back({{"resolution", resolution}, {"directions", directions}, {"terms", terms}});
   // Trade suite, dense_cloud (albedo 0.99), against its 262144-spp reference: error 25.6% at 16^3,

@@ -4,11 +4,7 @@
 
 #include <cmath>
 
-namespace haze::grids::dom {
-
-namespace {
-constexpr int kMostTexels = 48;
-}
+namespace haze::grids {
 
 bool SurfaceTexels::Rectangle::lookup(const Vec3& p, Rgb& e) const {
   const double fu = (glm::dot(p - origin, u) - u0) / size - 0.5, fv = (glm::dot(p - origin, v) - v0) / size - 0.5;
@@ -32,11 +28,20 @@ Rgb SurfaceTexels::Globe::lookup(const Vec3& p) const {
   return (1.0 - a) * ((1.0 - b) * at(t, p0) + b * at(t, p1)) + a * ((1.0 - b) * at(t + 1, p0) + b * at(t + 1, p1));
 }
 
+}  // namespace haze::grids
+
+namespace haze::grids::dom {
+
+namespace {
+constexpr int kMostTexels = 48;
+}
+
 SurfaceTexels surface_texels(const Scene& delta, const ExtinctionVolume& volume, const std::vector<DenseGrid>& depths,
-                             const DomSolution& solution, const Rgb& sky, double step_cells, int threads) {
+                             const DomSolution& solution, const Rgb& sky, double step_cells, int threads,
+                             const SurfaceLight* surfaces) {
   const Aabb& bounds = volume.density.bounds();
   const Vec3 h = volume.density.cell_size(), extent = bounds.extent(), centre = 0.5 * (bounds.lo + bounds.hi);
-  const Gather gather(delta, volume, depths, solution, step_cells, threads);
+  const Gather gather(delta, volume, depths, solution, step_cells, threads, surfaces);
   SurfaceTexels out;
   out.planes.resize(delta.surfaces.size());
   out.spheres.resize(delta.surfaces.size());
@@ -110,11 +115,15 @@ Rgb SurfaceLight::reflected(const Surface& surface, const Vec3& p, const Vec3& n
                                                               : density_integral_dda(volume_.density, p, p + a.to_light * reach);
     sum += surface.brdf(a.to_light, wo, n) * a.irradiance * cos_i * glm::exp(-sigma_t_ * depth);
   }
+  return sum + surface.kd / kPi * irradiance(surface, p);
+}
+
+Rgb SurfaceLight::irradiance(const Surface& surface, const Vec3& p) const {
   Rgb e_s = kPi * sky_;
   const auto index = static_cast<size_t>(&surface - delta_.surfaces.data());
   if (const SurfaceTexels::Rectangle& rectangle = texels_.planes[index]; !rectangle.values.empty()) rectangle.lookup(p, e_s);
   if (const SurfaceTexels::Globe& globe = texels_.spheres[index]; !globe.values.empty()) e_s = globe.lookup(p);
-  return sum + surface.kd / kPi * e_s;
+  return e_s;
 }
 
 Rgb SurfaceLight::entering(const Vec3& point, const Vec3& w) const {

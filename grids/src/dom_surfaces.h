@@ -8,30 +8,11 @@
 
 namespace haze::grids::dom {
 
-// Irradiance E_s from the medium's scattered light and the sky through it (Gather::around) at
-// texel centres: over a rectangle of each plane, the grid's bounds widened by their extent on
-// every side, texels at least two cells wide, at most 48 a side; over each sphere in latitude
-// and longitude, 16 x 32.
-struct SurfaceTexels {
-  struct Rectangle {
-    Vec3 origin, u, v;
-    double u0 = 0.0, v0 = 0.0, size = 1.0;
-    int nu = 0, nv = 0;
-    std::vector<Rgb> values;  // [j * nu + i]
-    bool lookup(const Vec3& p, Rgb& e) const;  // bilinear; false outside the rectangle
-  };
-  struct Globe {
-    Vec3 centre{0.0};
-    double radius = 1.0;
-    int nt = 0, np = 0;
-    std::vector<Rgb> values;  // [t * np + p], t along the polar angle from +y, p the azimuth from +x
-    Rgb lookup(const Vec3& p) const;  // bilinear, wrapping in azimuth
-  };
-  std::vector<Rectangle> planes;  // per surface; empty for spheres
-  std::vector<Globe> spheres;     // per surface; empty for planes
-};
+class SurfaceLight;
+// With `surfaces`, E_s also holds what other surfaces reflect onto each texel (Gather::around).
 SurfaceTexels surface_texels(const Scene& delta, const ExtinctionVolume& volume, const std::vector<DenseGrid>& depths,
-                             const DomSolution& solution, const Rgb& sky, double step_cells, int threads);
+                             const DomSolution& solution, const Rgb& sky, double step_cells, int threads,
+                             const SurfaceLight* surfaces = nullptr);
 
 class SurfaceLight {
  public:
@@ -46,6 +27,8 @@ class SurfaceLight {
   // the whole BRDF and E_s through its Lambert part: from the texels on planes, pi sky past them
   // and on spheres.
   Rgb reflected(const Surface& surface, const Vec3& p, const Vec3& n, const Vec3& wo) const;
+  // E_s at a surface point: from the texels, pi sky past them.
+  Rgb irradiance(const Surface& surface, const Vec3& p) const;
 
   // What enters the grid at a face point along w (pointing into the grid): the sky where the ray
   // back along -w meets no surface, else what the surface hit reflects toward w.

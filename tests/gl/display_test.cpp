@@ -11,6 +11,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdio>
+
 #include "../grids/cloud_scene.h"
 
 namespace haze::gl {
@@ -144,6 +146,31 @@ TEST(VolumeDisplay, ShowsAnyGridSolution) {
   EXPECT_GT(e.pixels, 64 * 48 / 3);
   EXPECT_LT(e.mean_abs, 0.01);
   EXPECT_EQ(dynamic_cast<const grids::GridSolution*>(&prepare(scene, "reference").method_solution()), nullptr);
+}
+
+// With surfaces, the DOM's scattered light on them from its surface texels (method setting
+// surface_view "texels", what the display shows): within 1% of the CPU render, and without that
+// light (surface_passes 0 and no texels shown) the floor and sphere are far darker.
+TEST(VolumeDisplay, ShowsTheDomSurfaceLightWithinOnePercent) {
+  grids::register_methods();
+  HeadlessContext context;
+  const Scene scene = full_scene(64, 48);
+  RenderOptions options;
+  options.settings = {{"resolution", 24}, {"directions", 48}, {"terms", 16}, {"surface_view", "texels"}};
+  const Solution solution = prepare(scene, "dom", options);
+  const auto& grid = dynamic_cast<const grids::GridSolution&>(solution.method_solution());
+  ASSERT_NE(grid.dom()->surfaces, nullptr);
+  VolumeDisplay display(grid);
+  const Image shown = display.render(scene.camera), cpu_image = solution.render().radiance;
+  const LitPixelError e = lit_pixel_error(shown, cpu_image);
+  std::printf("dom with surface texels, %d lit pixels: GL against CPU %.3f%% mean |relative|\n", e.pixels, 100.0 * e.mean_abs);
+  EXPECT_GT(e.pixels, 64 * 48 / 3);
+  EXPECT_LT(e.mean_abs, 0.01);
+  grids::DomSolution without = *grid.dom();
+  without.surfaces.reset();
+  VolumeDisplay bare(scene, grid.volume(), grid.depths(), DisplaySettings{grid.step_cells()});
+  bare.show_dom(without);
+  EXPECT_GT(lit_pixel_error(bare.render(scene.camera), cpu_image).mean_abs, 0.03);
 }
 
 TEST(VolumeDisplay, RefusesMismatchedFields) {

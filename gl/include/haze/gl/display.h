@@ -5,7 +5,9 @@
 //   L += T albedo_1 (1 - e^(-sigma_t' rho dt)) sum_l p(wi . wo) E_l e^(-sigma_t depth_l)
 //      + T albedo' (1 - e^(-sigma_t' rho dt)) sum_k c_k(wo) m_k        (when a DOM solution is shown)
 // then surfaces (lit through the depth volumes inside the grid, a DDA walk through the density
-// outside it) and the background through T. Without a DOM solution sigma_t' = sigma_t and
+// outside it, shadowed by each other; with a DOM solution that carries surface texels, plus
+// (kd + ks) / pi times their irradiance, as render_dom with surface_view "texels") and the
+// background through T. Without a DOM solution sigma_t' = sigma_t and
 // albedo_1 = albedo; with one, the delta-M scaled values of render_dom (grids/dom.h).
 #pragma once
 
@@ -48,7 +50,8 @@ class VolumeDisplay {
   VolumeDisplay& operator=(const VolumeDisplay&) = delete;
 
   // Adds the multiple-scattering term of a DOM solution of the same volume (its moments as 3D
-  // textures) and switches to its delta-M scaled coefficients.
+  // textures) and switches to its delta-M scaled coefficients; its surface texels (DomSolution::
+  // surfaces), when it has them, light the surfaces with the medium's and each other's light.
   void show_dom(const grids::DomSolution& solution);
 
   // New values computed on the CPU: the whole field, or only the bricks that changed.

@@ -75,10 +75,29 @@ struct DomSettings {
   ProgressCallback progress;  // once per iteration, with the fraction of max_iterations done
 };
 
-namespace dom {
-struct SurfaceTexels;  // internal: what the medium's light gives the surfaces (dom_surfaces.h)
-}
-
+// The irradiance E_s the DOM solution's scattered light, the sky through the medium and (after the
+// first surface pass) other surfaces' reflected light give the surfaces (dom_fields, the surface
+// passes; gathered along 64 directions like a camera pixel's), at texel centres: over a rectangle of each plane, the grid's bounds widened by their extent on
+// every side, texels at least two cells wide, at most 48 a side; over each sphere in latitude
+// and longitude, 16 x 32.
+struct SurfaceTexels {
+  struct Rectangle {
+    Vec3 origin, u, v;
+    double u0 = 0.0, v0 = 0.0, size = 1.0;
+    int nu = 0, nv = 0;
+    std::vector<Rgb> values;  // [j * nu + i]
+    bool lookup(const Vec3& p, Rgb& e) const;  // bilinear; false outside the rectangle
+  };
+  struct Globe {
+    Vec3 centre{0.0};
+    double radius = 1.0;
+    int nt = 0, np = 0;
+    std::vector<Rgb> values;  // [t * np + p], t along the polar angle from +y, p the azimuth from +x
+    Rgb lookup(const Vec3& p) const;  // bilinear, wrapping in azimuth
+  };
+  std::vector<Rectangle> planes;  // per surface; empty for spheres
+  std::vector<Globe> spheres;     // per surface; empty for planes
+};
 // The converged diffuse radiance in moment form: per solved channel (1 when medium and lights are
 // grey, else 3) and cell, the N moments m_k = sum_d Q[d][k] L_d (seed 000 eq. 10). The in-scattered
 // radiance toward any direction w follows from them (inscatter_weights).
@@ -103,7 +122,10 @@ struct DomSolution {
   double seconds = 0.0;            // wall time of the whole solve (phase matrix, first collision, sweeps)
   // With surfaces (dom_fields): the irradiance the medium's light gives them, which render_dom's
   // surfaces reflect toward each other; without, surfaces light each other not at all.
-  std::shared_ptr<const dom::SurfaceTexels> surfaces;
+  std::shared_ptr<const SurfaceTexels> surfaces;
+  // render_dom shades visible surfaces with the texels' irradiance through (kd + ks) / pi (what
+  // the GL display shows) instead of gathering along 64 directions per pixel through the BRDF.
+  bool texel_surfaces = false;
 
   int terms() const { return separable ? separable->terms() : 0; }
 };
