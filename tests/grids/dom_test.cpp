@@ -204,6 +204,38 @@ TEST(DomSolver, EmptyCellsSkippedExactly) {
   }
 }
 
+// A boundary (DomBoundary, what surfaces send in through the faces) that returns the sky's radiance
+// everywhere is the sky: the same moments to the last bit. One that lets light in through the
+// bottom face only (a floor's light going up) brightens the cells near that face more than the top.
+TEST(DomSolver, BoundaryRadianceEntersThroughTheFaces) {
+  Small s;
+  DomSettings settings;
+  settings.directions = 48;
+  std::vector<Light> with_sky = s.lights;
+  with_sky.push_back(SkyLight{Rgb(0.2)});
+  const DomSolution sky = solve_dom(s.volume, with_sky, s.depths, settings);
+  const DomBoundary uniform{[](const Vec3&, const Vec3&) { return Rgb(0.2); }, true};
+  const DomSolution faces = solve_dom(s.volume, s.lights, s.depths, settings, nullptr, &uniform);
+  EXPECT_EQ(faces.moments, sky.moments);
+  const DenseGrid& d = s.volume.density;
+  const double bottom = d.bounds().lo.y;
+  const DomBoundary floor{[bottom](const Vec3& x, const Vec3& w) { return w.y > 0.0 && x.y == bottom ? Rgb(1.0) : Rgb(0.0); }, true};
+  const DomSolution lit = solve_dom(s.volume, s.lights, s.depths, settings, nullptr, &floor);
+  const DomSolution dark = solve_dom(s.volume, s.lights, s.depths, settings);
+  // The added light in the lowest and highest layers: moment 0, along the constant eigenvector
+  // (the mean radiance times a constant of either sign).
+  const int ny = d.resolution()[1];
+  double low = 0.0, high = 0.0;
+  for (int k = 0; k < d.resolution()[2]; ++k)
+    for (int i = 0; i < d.resolution()[0]; ++i) {
+      const size_t n = static_cast<size_t>(lit.terms());
+      low += static_cast<double>(lit.moments[0][d.index(i, 0, k) * n] - dark.moments[0][d.index(i, 0, k) * n]);
+      high += static_cast<double>(lit.moments[0][d.index(i, ny - 1, k) * n] - dark.moments[0][d.index(i, ny - 1, k) * n]);
+    }
+  EXPECT_GT(std::abs(high), 0.0);
+  EXPECT_GT(std::abs(low), 2.0 * std::abs(high));
+}
+
 // float16 storage (first-collision source and GMRES basis) changes the converged moments by about
 // float16's rounding (2^-11 = 4.9e-4 relative), not more, needs no more than a few extra sweeps,
 // and takes less memory.
