@@ -13,6 +13,7 @@ namespace haze::particles {
 namespace {
 
 constexpr int kTile = 16;
+constexpr int kSurfaceDirections = 64;  // over the sphere: a surface point's hemisphere gets about half
 
 // Camera::generate_ray inverted: the pixel position and footprint radius (pixels) of a sphere.
 struct Projection {
@@ -147,8 +148,56 @@ Image render_network(const Scene& scene, const ParticleField& field, const Netwo
     }
     return material.albedo * s;
   };
-  // A surface point's direct light through the BRDF, shadowed by surfaces and through the particles.
-  const auto surface_light = [&](const Surface& surface, const Vec3& p, const Vec3& normal, const Vec3& wo) {
+  // The light the particles scatter onto surfaces (the first bounce, medium to surface): along K
+  // Fibonacci directions w_j from a surface point, the same march as a camera ray's toward -w_j
+  // (each particle's in-scattering toward -w_j, direct light per step), up to the next surface,
+  // plus the sky through the particles where no surface is hit. Every particle is tested against
+  // each such ray (rays that miss the particles' bounding sphere skip them).
+  const DirectionSet around = DirectionSet::fibonacci(kSurfaceDirections);
+  std::vector<std::vector<Rgb>> around_scattered;  // [j][particle]
+  Vec3 support_centre(0.0);
+  double support_radius = 0.0;
+  if (!scene.surfaces.empty() && n > 0) {
+    around_scattered.assign(static_cast<size_t>(around.size()), std::vector<Rgb>(n));
+    parallel_for(around.size(), options.threads, 1, [&](long long j0, long long j1) {
+      for (auto j = j0; j < j1; ++j) {
+        const Eigen::VectorXd row = solution.matrix->row(-around[static_cast<int>(j)]);
+        for (size_t p = 0; p < n; ++p) {
+          Rgb sum(0.0);
+          for (int c = 0; c < 3; ++c)
+            for (size_t i = 0; i < d; ++i) sum[c] += row(static_cast<long>(i)) * static_cast<double>(solution.incoming[static_cast<size_t>(c)][i * n + p]);
+          around_scattered[static_cast<size_t>(j)][p] = material.albedo * sum;
+        }
+      }
+    });
+    for (size_t p = 0; p < n; ++p) support_centre += field.position(p) / static_cast<double>(n);
+    for (size_t p = 0; p < n; ++p) support_radius = std::max(support_radius, glm::length(field.position(p) - support_centre) + kCut * field.h(p));
+  }
+  const auto arriving = [&](const Vec3& x, int j, std::vector<Along>& along) {
+    const Ray ray{x, around[j]};
+    double t_next = kInfinity;
+    Vec3 unused;
+    const bool blocked = nearest_surface(scene.surfaces, ray, kInfinity, t_next, unused) != nullptr;
+    Rgb transmittance(1.0), radiance(0.0);
+    const Vec3 o = support_centre - x;
+    const double tc = glm::dot(o, ray.direction);
+    if (n > 0 && glm::dot(o, o) - tc * tc < support_radius * support_radius && tc > -support_radius) {
+      along.clear();
+      for (size_t p = 0; p < n; ++p) {
+        const Vec3 op = field.position(p) - x;
+        const double h = field.h(p), tp = glm::dot(op, ray.direction), perp2 = glm::dot(op, op) - tp * tp;
+        if (field.weight(p) <= 0.0 || perp2 >= kCut * kCut * h * h || tp < -kCut * h || tp - kCut * h >= t_next) continue;
+        along.push_back({tp, h, field.weight(p) * std::exp(-perp2 / (h * h)) * std::sqrt(kPi) * h, static_cast<int>(p)});
+      }
+      radiance = march(
+          along, material.sigma_t, around_scattered[static_cast<size_t>(j)], [&](double t) { return direct(ray.at(t), -ray.direction); },
+          transmittance, t_next);
+    }
+    return blocked ? radiance : radiance + transmittance * solution.sky;
+  };
+  // A surface point's light through the BRDF: the direct light, shadowed by surfaces and through
+  // the particles, and what the particles scatter onto it.
+  const auto surface_light = [&](const Surface& surface, const Vec3& p, const Vec3& normal, const Vec3& wo, std::vector<Along>& along) {
     Rgb s(0.0);
     for (const LightDepthMap& map : solution.light_maps) {
       LightArrival a;
@@ -156,6 +205,9 @@ Image render_network(const Scene& scene, const ParticleField& field, const Netwo
       const double cos_i = glm::dot(normal, a.to_light);
       if (cos_i > 0.0 && !occluded(scene.surfaces, p, a.to_light, a.distance)) s += surface.brdf(a.to_light, wo, normal) * a.irradiance * cos_i;
     }
+    for (int j = 0; j < around.size(); ++j)
+      if (const double cos_i = glm::dot(normal, around[j]); cos_i > 0.0)
+        s += around.weight(j) * cos_i * surface.brdf(around[j], wo, normal) * arriving(p, j, along);
     return s;
   };
 
@@ -178,7 +230,7 @@ Image render_network(const Scene& scene, const ParticleField& field, const Netwo
     for (auto t = t0; t < t1 && !progress.cancelled(); ++t) {
       const std::vector<int>& list = tiles[static_cast<size_t>(t)];
       const int tx = static_cast<int>(t % tiles_x), ty = static_cast<int>(t / tiles_x);
-      std::vector<Along> along;
+      std::vector<Along> along, gathered;
       for (int y = ty * kTile; y < std::min(cam.height_px, (ty + 1) * kTile); ++y)
         for (int x = tx * kTile; x < std::min(cam.width_px, (tx + 1) * kTile); ++x) {
           const Ray ray = cam.pixel_ray(x, y);
@@ -197,7 +249,7 @@ Image render_network(const Scene& scene, const ParticleField& field, const Netwo
           const Rgb radiance = march(
               along, material.sigma_t, scattered, [&](double t) { return direct(ray.origin + t * ray.direction, -ray.direction); }, transmittance,
               t_hit);
-          image.set(x, y, radiance + transmittance * (surface ? surface_light(*surface, ray.at(t_hit), normal, -ray.direction) : background));
+          image.set(x, y, radiance + transmittance * (surface ? surface_light(*surface, ray.at(t_hit), normal, -ray.direction, gathered) : background));
         }
       progress.advance();
     }
@@ -314,7 +366,7 @@ MethodInfo network_info() {
   info.name = "network";
   info.summary = "multiple scattering in particle media: visibility and illumination networks (seed 001)";
   info.create = [] { return std::make_unique<NetworkMethod>(); };
-  info.handles = {"particles (a Gaussian each)", "point, spot, directional, sky", "planes and spheres lit by unscattered light through the particles, with shadows (also in the particles' direct light)", true};
+  info.handles = {"particles (a Gaussian each)", "point, spot, directional, sky", "planes and spheres lit through the particles and by their scattered light, with shadows (also in the particles' direct light)", true};
   const NetworkSettings n;
   info.settings = {SettingInfo::integer("directions", n.directions, 8, 4096, "D, the network's directions"),
                    SettingInfo::integer("window", 0, 0, 65536, "projection window in texels (0: from the particles' sizes)"),
