@@ -2,6 +2,7 @@
 // one pixel at a time, and the SIMD kernel (haze/simd/march_rays.h) over each image row. Surfaces
 // shadow the medium (surface_visibility, trilinear) and each other (a ray to each light).
 #include <haze/core/error.h>
+#include <haze/core/directions.h>
 #include <haze/core/grid_walk.h>
 #include <haze/grids/optical_depth.h>
 #include <haze/grids/propagation.h>
@@ -13,6 +14,8 @@
 namespace haze::grids {
 
 namespace {
+
+constexpr int kSurfaceDirections = 64;  // MarchSettings::surface_gather
 
 struct Hit {
   const Surface* surface = nullptr;
@@ -37,9 +40,17 @@ struct Marcher {
   // The same for the surfaces' shadows (surface_visibility); empty without surfaces.
   std::vector<float> packed_visibility;
 
+  // MarchSettings::surface_gather: the directions, and the tangent of the cone each stands for.
+  bool gather = false;
+  DirectionSet around = DirectionSet::fibonacci(kSurfaceDirections);
+  double cone = 0.0;
+
   Marcher(const Scene& s, const ExtinctionVolume& v, const std::vector<DenseGrid>& d, double step_length, int threads,
-          const std::vector<DenseGrid>* visibility)
+          const std::vector<DenseGrid>* visibility, bool surface_gather = false)
       : scene(s), volume(v), depths(d), sigma_t(v.sigma_t_scale), step(step_length), packed(interleave(d)) {
+    gather = surface_gather && !scene.surfaces.empty() && volume.albedo != Rgb(0.0);
+    const double cos_alpha = 1.0 - 2.0 / kSurfaceDirections;  // 2 pi (1 - cos alpha) = 4 pi / K
+    cone = std::sqrt(1.0 - cos_alpha * cos_alpha) / cos_alpha;
     if (volume.albedo == Rgb(0.0) || scene.surfaces.empty()) return;  // no light in the medium to shadow
     packed_visibility = interleave(visibility ? *visibility : surface_visibility(volume.density, scene.lights, scene.surfaces, threads));
   }
@@ -77,8 +88,9 @@ struct Marcher {
     return density_integral_dda(volume.density, x, x + a.to_light * reach);
   }
 
-  // The medium along the ray's steps (the float64 reference of the SIMD kernel).
-  void march(const Ray& ray, const Steps& s, Rgb& radiance, Rgb& transmittance) const {
+  // The medium along the ray's steps (the float64 reference of the SIMD kernel). With cone > 0 a
+  // point light nearer than cone t at a step delivers its irradiance at that distance, no more.
+  void march(const Ray& ray, const Steps& s, Rgb& radiance, Rgb& transmittance, double cone_tangent = 0.0) const {
     radiance = Rgb(0.0), transmittance = Rgb(1.0);
     const size_t lights = scene.lights.size();
     std::vector<double> depth(lights), visible(lights, 1.0);
@@ -103,6 +115,8 @@ struct Marcher {
       Rgb in(0.0);
       for (size_t l = 0; l < lights; ++l) {
         if (!arrival(scene.lights[l], x, a) || a.irradiance == Rgb(0.0)) continue;
+        if (const double radius = cone_tangent * (s.t0 + (i + 0.5) * s.dt); a.distance < radius)
+          a.irradiance *= (a.distance / radius) * (a.distance / radius);
         in += volume.phase.eval(-a.to_light, -ray.direction) * a.irradiance * visible[l] * glm::exp(-sigma_t * depth[l]);
       }
       const Rgb step_transmittance = glm::exp(-sigma_t * rho * s.dt);
@@ -123,6 +137,14 @@ struct Marcher {
       const double cos_i = glm::dot(h.normal, a.to_light);
       if (cos_i <= 0.0 || occluded(scene.surfaces, p, a.to_light, a.distance)) continue;
       surface += h.surface->brdf(a.to_light, -ray.direction, h.normal) * a.irradiance * cos_i * glm::exp(-sigma_t * depth_to_light(l, p, a));
+    }
+    for (int j = 0; gather && j < around.size(); ++j) {
+      const double cos_i = glm::dot(h.normal, around[j]);
+      if (cos_i <= 0.0) continue;
+      const Ray up{p, around[j]};
+      Rgb arriving, unused;
+      march(up, steps(up, hit(up).t), arriving, unused, cone);
+      surface += around.weight(j) * cos_i * h.surface->brdf(around[j], -ray.direction, h.normal) * arriving;
     }
     return radiance + transmittance * surface;
   }
@@ -218,7 +240,8 @@ Image march_image(const Scene& scene, const ExtinctionVolume& volume, const std:
   const Vec3 h = volume.density.cell_size();
   if (visibility && !scene.surfaces.empty() && visibility->size() != depths.size())
     throw Error("visibility", to_text(visibility->size()) + " volumes", "one per light (" + to_text(depths.size()) + ")");
-  const Marcher marcher(scene, volume, depths, settings.step_cells * std::min({h.x, h.y, h.z}), options.threads, visibility);
+  const Marcher marcher(scene, volume, depths, settings.step_cells * std::min({h.x, h.y, h.z}), options.threads, visibility,
+                        settings.surface_gather);
   std::vector<simd::MarchLight> lights;
   simd::MarchVolume simd_view;
   const bool use_simd = !settings.scalar && simd_volume(marcher, lights, simd_view);

@@ -86,12 +86,13 @@ PropagationFields propagation_fields(const Scene& scene, const RenderOptions& op
   depth.threads = options.threads;
   const double step_cells = settings.number("step");
   const double cutoff = settings.number("cutoff");
+  const bool surface_light = settings.integer("surface_light") != 0;
   settings.reject_unknown();
 
   check_lights(scene.lights);
   Stopwatch watch;
   VolumeReport report;
-  PropagationFields fields{make_extinction_volume(scene, resolution, cutoff, options.threads, &report), {}, MarchSettings{step_cells}, {}};
+  PropagationFields fields{make_extinction_volume(scene, resolution, cutoff, options.threads, &report), {}, MarchSettings{step_cells, false, surface_light}, {}};
   const double inject_seconds = watch.lap();
   DepthStats depth_stats;
   fields.depths = optical_depths(fields.volume.density, scene.lights, depth, &depth_stats);
@@ -117,7 +118,8 @@ MethodInfo propagation_info() {
                    SettingInfo::choice("optical_depth", "sweep", {"exact", "paper", "sweep"}, "how the depth to each light is computed"),
                    SettingInfo::integer("sweep_layers", 4, 1, 64, "sweep: cell layers each short characteristic walks exactly"),
                    SettingInfo::number("step", 0.5, 0.01, 4.0, "ray-march step in cells"),
-                   SettingInfo::number("cutoff", 0.0, 0.0, 1e30, "RBF injection cutoff (0: 1e-4 of the largest weight)")};
+                   SettingInfo::number("cutoff", 0.0, 0.0, 1e30, "RBF injection cutoff (0: 1e-4 of the largest weight)"),
+                   SettingInfo::integer("surface_light", 0, 0, 1, "1: surfaces also receive the single-scattered light (64 directions, about 4x the render; not in the GL display)")};
   for (int resolution : {16, 32, 64, 96})
     for (double step : {1.0, 0.5}) info.trade_sweep.push_back({{"resolution", resolution}, {"step", step}});
   info.offer = [](const SceneFeatures& f, double tolerance) {

@@ -47,6 +47,11 @@ struct MarchSettings {
   // The float64 reference, one pixel at a time, instead of the float32 SIMD kernel over each row
   // (which a tabulated phase function also falls back to).
   bool scalar = false;
+  // Surfaces also receive the single-scattered light of the medium (the first bounce, medium to
+  // surface): the march toward each visible surface point along 64 Fibonacci directions (32 over
+  // its hemisphere), through the BRDF, a point light's irradiance capped at the cone each direction
+  // stands for. Method "propagation"'s setting surface_light; the GL display has it not.
+  bool surface_gather = false;
 };
 
 // Seed 003 eq. 8-10 in Haze's conventions: along each camera ray inside the volume, in steps,
