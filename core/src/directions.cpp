@@ -2,6 +2,8 @@
 #include <haze/core/error.h>
 #include <haze/core/rng.h>
 
+#include <cmath>
+
 namespace haze {
 
 DirectionSet::DirectionSet(std::vector<Vec3> directions, std::vector<double> weights)
@@ -46,6 +48,11 @@ int DirectionSet::nearest(const Vec3& w) const {
     if (d > best_dot) best_dot = d, best = i;
   }
   return best;
+}
+
+double cone_tangent(int count) {
+  const double cos_alpha = 1.0 - 2.0 / count;
+  return std::sqrt(1.0 - cos_alpha * cos_alpha) / cos_alpha;
 }
 
 }  // namespace haze

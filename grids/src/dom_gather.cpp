@@ -26,10 +26,7 @@ Gather::Gather(const Scene& delta, const ExtinctionVolume& volume, const std::ve
   sigma_t_ = delta_m_sigma_t(volume.sigma_t_scale, volume.albedo, f);
   albedo_ = delta_m_albedo(volume.albedo, f);
   single_albedo_ = volume.albedo / (Rgb(1.0) - volume.albedo * f);
-  // Each of the K directions stands for 4 pi / K steradians: a cone of half-angle alpha with
-  // 2 pi (1 - cos alpha) = 4 pi / K.
-  const double cos_alpha = 1.0 - 2.0 / kSurfaceDirections;
-  cone_ = std::sqrt(1.0 - cos_alpha * cos_alpha) / cos_alpha;
+  cone_ = cone_tangent(kSurfaceDirections);
   if (!delta.surfaces.empty())
     for (int j = 0; j < around_.size(); ++j) around_weights_.push_back(inscatter_weights(solution, -around_[j]));
 }

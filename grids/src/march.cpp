@@ -49,8 +49,7 @@ struct Marcher {
           const std::vector<DenseGrid>* visibility, bool surface_gather = false)
       : scene(s), volume(v), depths(d), sigma_t(v.sigma_t_scale), step(step_length), packed(interleave(d)) {
     gather = surface_gather && !scene.surfaces.empty() && volume.albedo != Rgb(0.0);
-    const double cos_alpha = 1.0 - 2.0 / kSurfaceDirections;  // 2 pi (1 - cos alpha) = 4 pi / K
-    cone = std::sqrt(1.0 - cos_alpha * cos_alpha) / cos_alpha;
+    cone = cone_tangent(kSurfaceDirections);
     if (volume.albedo == Rgb(0.0) || scene.surfaces.empty()) return;  // no light in the medium to shadow
     packed_visibility = interleave(visibility ? *visibility : surface_visibility(volume.density, scene.lights, scene.surfaces, threads));
   }

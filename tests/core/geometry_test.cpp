@@ -1,5 +1,6 @@
 // Cameras, boxes, surfaces and BRDF normalization, lights, media, the random number generator.
 #include <haze/core/camera.h>
+#include <haze/core/directions.h>
 #include <haze/core/error.h>
 #include <haze/core/light.h>
 #include <haze/core/medium.h>
@@ -110,6 +111,14 @@ TEST(Surface, LitStretchesEndAtTheShadowsEdges) {
   lit_stretches(plane, Ray{Vec3(0.5, 2.0, 0.0), Vec3(0.0, -1.0, 0.0)}, 0.0, 4.0, light, lit);
   ASSERT_EQ(lit.size(), 1u);
   EXPECT_NEAR(lit[0].second, 1.0, 1e-12);
+}
+
+// One direction's cone of a set of 64 covers 4 pi / 64 steradians: 2 pi (1 - cos(atan t)).
+TEST(Directions, ConeTangentCoversOneDirectionsShare) {
+  for (int count : {3, 8, 64, 4096}) {
+    const double alpha = std::atan(cone_tangent(count));
+    EXPECT_NEAR(2.0 * kPi * (1.0 - std::cos(alpha)), 4.0 * kPi / count, 1e-12) << count;
+  }
 }
 
 TEST(Light, ArrivalFollowsInverseSquareAndSpotCone) {

@@ -31,6 +31,11 @@ class DirectionSet {
   std::vector<double> weights_;
 };
 
+// The tangent of the half-angle of a cone of 4 pi / count steradians, one direction's share of a
+// set of `count` (at least 3): 2 pi (1 - cos alpha) = 4 pi / count. A gather that stands each direction for its
+// cone caps a point light's irradiance where the light is nearer the ray than the cone's radius.
+double cone_tangent(int count);
+
 }  // namespace haze
 
 #pragma GCC visibility pop
