@@ -104,18 +104,8 @@ SurfaceLight::SurfaceLight(const Scene& delta, const ExtinctionVolume& volume, c
 }
 
 Rgb SurfaceLight::reflected(const Surface& surface, const Vec3& p, const Vec3& n, const Vec3& wo) const {
-  Rgb sum(0.0);
-  LightArrival a;
-  for (size_t l = 0; l < delta_.lights.size(); ++l) {
-    if (!arrival(delta_.lights[l], p, a)) continue;
-    const double cos_i = glm::dot(n, a.to_light);
-    if (cos_i <= 0.0 || occluded(delta_.surfaces, p, a.to_light, a.distance)) continue;
-    const double reach = std::isfinite(a.distance) ? a.distance : 1e30;  // directional: past any grid
-    const double depth = volume_.density.bounds().contains(p) ? static_cast<double>(sample_trilinear(depths_[l], p))
-                                                              : density_integral_dda(volume_.density, p, p + a.to_light * reach);
-    sum += surface.brdf(a.to_light, wo, n) * a.irradiance * cos_i * glm::exp(-sigma_t_ * depth);
-  }
-  return sum + surface.kd / kPi * irradiance(surface, p);
+  return surface_direct(delta_.lights, delta_.surfaces, volume_.density, depths_, sigma_t_, surface, p, n, wo) +
+         surface.kd / kPi * irradiance(surface, p);
 }
 
 Rgb SurfaceLight::irradiance(const Surface& surface, const Vec3& p) const {

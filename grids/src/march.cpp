@@ -64,7 +64,6 @@ struct Marcher {
     return out;
   }
 
-
   Hit hit(const Ray& ray) const {
     Hit h;
     h.surface = nearest_surface(scene.surfaces, ray, kInfinity, h.t, h.normal);
@@ -78,13 +77,6 @@ struct Marcher {
     s.count = static_cast<int>(std::ceil((t1 - s.t0) / step));
     s.dt = (t1 - s.t0) / s.count;
     return s;
-  }
-
-  // Density integral from x to the light: the volume's value inside it, a DDA walk outside.
-  double depth_to_light(size_t l, const Vec3& x, const LightArrival& a) const {
-    if (volume.density.bounds().contains(x)) return static_cast<double>(sample_trilinear(depths[l], x));
-    const double reach = std::isfinite(a.distance) ? a.distance : 1e30;  // directional: past any grid
-    return density_integral_dda(volume.density, x, x + a.to_light * reach);
   }
 
   // The medium along the ray's steps (the float64 reference of the SIMD kernel). With cone > 0 a
@@ -129,14 +121,7 @@ struct Marcher {
   Rgb finish(const Ray& ray, const Hit& h, const Rgb& radiance, const Rgb& transmittance) const {
     if (!h.surface) return radiance + transmittance * scene.background;
     const Vec3 p = ray.at(h.t);
-    Rgb surface(0.0);
-    LightArrival a;
-    for (size_t l = 0; l < scene.lights.size(); ++l) {
-      if (!arrival(scene.lights[l], p, a)) continue;
-      const double cos_i = glm::dot(h.normal, a.to_light);
-      if (cos_i <= 0.0 || occluded(scene.surfaces, p, a.to_light, a.distance)) continue;
-      surface += h.surface->brdf(a.to_light, -ray.direction, h.normal) * a.irradiance * cos_i * glm::exp(-sigma_t * depth_to_light(l, p, a));
-    }
+    Rgb surface = surface_direct(scene.lights, scene.surfaces, volume.density, depths, sigma_t, *h.surface, p, h.normal, -ray.direction);
     for (int j = 0; gather && j < around.size(); ++j) {
       const double cos_i = glm::dot(h.normal, around[j]);
       if (cos_i <= 0.0) continue;

@@ -363,4 +363,21 @@ std::vector<DenseGrid> shadowed_depths(std::vector<DenseGrid> depths, const std:
   return depths;
 }
 
+Rgb surface_direct(const std::vector<Light>& lights, const std::vector<Surface>& surfaces, const DenseGrid& density,
+                   const std::vector<DenseGrid>& depths, const Rgb& sigma_t, const Surface& surface, const Vec3& p, const Vec3& n,
+                   const Vec3& wo) {
+  Rgb sum(0.0);
+  LightArrival a;
+  for (size_t l = 0; l < lights.size(); ++l) {
+    if (!arrival(lights[l], p, a)) continue;
+    const double cos_i = glm::dot(n, a.to_light);
+    if (cos_i <= 0.0 || occluded(surfaces, p, a.to_light, a.distance)) continue;
+    const double reach = std::isfinite(a.distance) ? a.distance : 1e30;
+    const double depth = density.bounds().contains(p) ? static_cast<double>(sample_trilinear(depths[l], p))
+                                                      : density_integral_dda(density, p, p + a.to_light * reach);
+    sum += surface.brdf(a.to_light, wo, n) * a.irradiance * cos_i * glm::exp(-sigma_t * depth);
+  }
+  return sum;
+}
+
 }  // namespace haze::grids

@@ -74,6 +74,35 @@ TEST(NetworkRender, SingleScatteringMatchesTheReference) {
   EXPECT_LT(e.rms_noise_removed, 0.04);
 }
 
+// Sums over the pixels keep(x, y, ray, hit, point) selects (hit: the nearest surface, or null):
+// the network's, the reference's, and the reference's standard error relative to its sum.
+struct PixelSums {
+  double got = 0.0, want = 0.0, noise = 0.0;
+  int pixels = 0;
+};
+template <class Keep>
+PixelSums sum_pixels(const Scene& scene, const Image& network, const RenderResult& reference, const Keep& keep) {
+  PixelSums s;
+  double variance = 0.0;
+  for (int y = 0; y < network.height(); ++y)
+    for (int x = 0; x < network.width(); ++x) {
+      const Ray ray = scene.camera.pixel_ray(x, y);
+      double t = kInfinity;
+      Vec3 n;
+      const Surface* hit = nearest_surface(scene.surfaces, ray, kInfinity, t, n);
+      if (!keep(x, y, ray, hit, hit ? ray.at(t) : Vec3(0.0))) continue;
+      s.got += network.at(x, y).g, s.want += reference.radiance.at(x, y).g, variance += std::pow(reference.std_error->at(x, y).g, 2);
+      ++s.pixels;
+    }
+  s.noise = std::sqrt(variance) / s.want;
+  return s;
+}
+// Whether a camera ray passes the ball's support (radius 1 and the Gaussians' reach) by.
+bool misses_ball(const Ray& ray) {
+  const double tc = -glm::dot(ray.origin, ray.direction);
+  return glm::dot(ray.origin, ray.origin) - tc * tc >= 1.6 * 1.6;
+}
+
 // Surfaces: a floor under the ball receives the sun's unscattered light through the particles (its
 // depth map) and the shadow of a sphere beside it, as the reference without scattering does (summed
 // over the floor pixels whose view ray misses the ball, within 1% plus three of the reference's
@@ -91,28 +120,15 @@ TEST(NetworkRender, SurfacesAreLitThroughTheParticlesAndShadowThem) {
   unscattered.settings = {{"spp", 256}, {"seed", 5}, {"max_scattering", 0}};
   const RenderResult reference = render(scene, "reference", unscattered);
   const Image network = render(scene, "network", RenderOptions{0, {{"iterations", 0}}, {}, {}}).radiance;
-  // The floor seen past the ball's support (radius 1 and the Gaussians' reach) and the sphere.
-  Image got(network.width(), network.height()), want = got, se = got;
-  for (int y = 0; y < network.height(); ++y)
-    for (int x = 0; x < network.width(); ++x) {
-      const Ray ray = scene.camera.pixel_ray(x, y);
-      double t;
-      Vec3 n;
-      const Surface* hit = nearest_surface(scene.surfaces, ray, kInfinity, t, n);
-      const double tc = -glm::dot(ray.origin, ray.direction), miss2 = glm::dot(ray.origin, ray.origin) - tc * tc;
-      if (hit != &scene.surfaces[0] || miss2 < 1.6 * 1.6) continue;
-      got.set(x, y, network.at(x, y)), want.set(x, y, reference.radiance.at(x, y)), se.set(x, y, reference.std_error->at(x, y));
-    }
-  // Summed over the floor: a pixel on the shadow's hard edge is its centre here, its area there.
-  double sum_got = 0.0, sum_want = 0.0, variance = 0.0;
-  int pixels = 0;
-  for (int y = 0; y < got.height(); ++y)
-    for (int x = 0; x < got.width(); ++x)
-      if (want.at(x, y).g > 0.0) sum_got += got.at(x, y).g, sum_want += want.at(x, y).g, variance += std::pow(se.at(x, y).g, 2), ++pixels;
-  const double noise = std::sqrt(variance) / sum_want;
-  std::printf("floor over %d pixels: %+.2f%% (reference noise %.2f%%)\n", pixels, 100.0 * (sum_got / sum_want - 1.0), 100.0 * noise);
-  EXPECT_GT(pixels, 50);
-  EXPECT_NEAR(sum_got / sum_want, 1.0, 0.01 + 3.0 * noise);
+  // Summed over the lit floor seen past the ball, not the sphere: a pixel on the shadow's hard edge
+  // is its centre here, its area there.
+  const PixelSums floor = sum_pixels(scene, network, reference, [&](int x, int y, const Ray& ray, const Surface* hit, const Vec3&) {
+    return hit == &scene.surfaces[0] && misses_ball(ray) && reference.radiance.at(x, y).g > 0.0;
+  });
+  std::printf("floor over %d pixels: %+.2f%% (reference noise %.2f%%)\n", floor.pixels, 100.0 * (floor.got / floor.want - 1.0),
+              100.0 * floor.noise);
+  EXPECT_GT(floor.pixels, 50);
+  EXPECT_NEAR(floor.got / floor.want, 1.0, 0.01 + 3.0 * floor.noise);
 
   Scene shaded = ball(2000, 0.9, 32, 24);
   shaded.surfaces.push_back(Surface{Sphere{Vec3(0.9, 1.6, 0.9), 0.5}, Rgb(0.5), Rgb(0.0), 1.0});
@@ -155,26 +171,14 @@ TEST(NetworkRender, FloorUnderTheBallReceivesItsScatteredLight) {
   reference_options.settings = {{"spp", 1024}, {"seed", 6}, {"max_bounces", 1}};
   const RenderResult reference = render(scene, "reference", reference_options);
   const Image network = render(scene, "network", {}).radiance;
-  double got = 0.0, want = 0.0, variance = 0.0;
-  int pixels = 0;
-  for (int y = 0; y < network.height(); ++y)
-    for (int x = 0; x < network.width(); ++x) {
-      const Ray ray = scene.camera.pixel_ray(x, y);
-      double t;
-      Vec3 n;
-      if (!nearest_surface(scene.surfaces, ray, kInfinity, t, n)) continue;
-      const Vec3 p = ray.at(t);
-      const double tc = -glm::dot(ray.origin, ray.direction), miss2 = glm::dot(ray.origin, ray.origin) - tc * tc;
-      if (p.x * p.x + p.z * p.z > 0.6 * 0.6 || miss2 < 1.6 * 1.6) continue;
-      got += network.at(x, y).g, want += reference.radiance.at(x, y).g, variance += std::pow(reference.std_error->at(x, y).g, 2);
-      ++pixels;
-    }
-  const double noise = std::sqrt(variance) / want;
-  std::printf("floor in the ball's shadow, %d pixels: network %.5f, reference %.5f (noise %.2f%%): %+.2f%%\n", pixels, got / pixels,
-              want / pixels, 100.0 * noise, 100.0 * (got / want - 1.0));
-  ASSERT_GT(pixels, 15);
-  EXPECT_LT(noise, 0.05);
-  EXPECT_NEAR(got / want, 1.0, 0.25);
+  const PixelSums floor = sum_pixels(scene, network, reference, [](int, int, const Ray& ray, const Surface* hit, const Vec3& p) {
+    return hit && p.x * p.x + p.z * p.z <= 0.6 * 0.6 && misses_ball(ray);
+  });
+  std::printf("floor in the ball's shadow, %d pixels: network %.5f, reference %.5f (noise %.2f%%): %+.2f%%\n", floor.pixels,
+              floor.got / floor.pixels, floor.want / floor.pixels, 100.0 * floor.noise, 100.0 * (floor.got / floor.want - 1.0));
+  ASSERT_GT(floor.pixels, 15);
+  EXPECT_LT(floor.noise, 0.05);
+  EXPECT_NEAR(floor.got / floor.want, 1.0, 0.25);
 }
 
 // The continuous density: a uniform ball of particles stands for density 1 inside (within 15%:

@@ -66,6 +66,14 @@ double density_integral_dda(const DenseGrid& density, const Vec3& a, const Vec3&
 // Trilinear sample of cell-centred values (clamped to the edge cells), and 0 outside the bounds.
 float sample_trilinear(const DenseGrid& grid, const Vec3& p);
 
+// The lights' unscattered light a surface point p (unit normal n) reflects toward wo:
+//   sum_l brdf(w_l, wo) E_l (n . w_l) e^(-sigma_t depth_l)   where no surface is in the way,
+// depth_l the density integral to light l: depths[l] trilinear inside the density's bounds, a DDA
+// walk through the density outside them (past any grid for a directional light).
+Rgb surface_direct(const std::vector<Light>& lights, const std::vector<Surface>& surfaces, const DenseGrid& density,
+                   const std::vector<DenseGrid>& depths, const Rgb& sigma_t, const Surface& surface, const Vec3& p, const Vec3& n,
+                   const Vec3& wo);
+
 }  // namespace haze::grids
 
 #pragma GCC visibility pop
