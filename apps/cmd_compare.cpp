@@ -13,6 +13,7 @@ namespace {
 struct CompareArgs {
   std::string image, reference;
   bool json = false;
+  int worst = 0;
 };
 
 int run(const CompareArgs& a) {
@@ -35,6 +36,9 @@ int run(const CompareArgs& a) {
   out["lit_mean_abs_relative"] = lit.mean_abs;
   out["lit_signed_mean_relative"] = lit.signed_mean;
   if (ref_error) out["lit_rms_relative_noise_removed"] = lit.rms_noise_removed, out["lit_reference_noise_rms"] = lit.noise_rms;
+  const std::vector<PixelError> worst = worst_pixels(image, reference, ref_error ? &*ref_error : nullptr, a.worst);
+  for (const PixelError& w : worst)
+    out["worst"].push_back({{"x", w.x}, {"y", w.y}, {"relative_error", w.relative}, {"reference_noise", w.noise}, {"share", w.share}});
   if (a.json) {
     std::cout << out.dump(2) << "\n";
   } else {
@@ -45,6 +49,9 @@ int run(const CompareArgs& a) {
       std::cout << ", RMS relative error with the reference's noise removed " << lit.rms_noise_removed << " (reference noise "
                 << lit.noise_rms << ")";
     std::cout << "\n";
+    for (const PixelError& w : worst)
+      std::cout << "pixel (" << w.x << ", " << w.y << "): relative error " << w.relative << " (reference noise " << w.noise << "), "
+                << 100.0 * w.share << "% of the squared error\n";
   }
   return 0;
 }
@@ -57,6 +64,8 @@ Command add_compare(CLI::App& app) {
   sub->add_option("image", a->image, "Image to measure")->required()->check(CLI::ExistingFile);
   sub->add_option("reference", a->reference, "Reference image")->required()->check(CLI::ExistingFile);
   sub->add_flag("--json", a->json, "Print JSON");
+  sub->add_option("--worst", a->worst, "List the N lit pixels that carry the most squared error (less the reference's noise)")
+      ->check(CLI::NonNegativeNumber);
   return {sub, [a] { return run(*a); }};
 }
 

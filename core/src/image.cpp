@@ -9,6 +9,7 @@
 #include <ImfStringAttribute.h>
 #include <png.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <memory>
 
@@ -227,6 +228,32 @@ LitPixelError lit_pixel_error(const Image& image, const Image& reference, const 
     e.rms_noise_removed = std::sqrt(std::max(0.0, (squared - noise) / n));
   }
   return e;
+}
+
+std::vector<PixelError> worst_pixels(const Image& image, const Image& reference, const Image* reference_std_error, int count,
+                                     double threshold) {
+  const LitPixelError checked = lit_pixel_error(image, reference, reference_std_error, nullptr, threshold);  // sizes
+  double peak = 0.0;
+  for (int y = 0; y < reference.height(); ++y)
+    for (int x = 0; x < reference.width(); ++x) peak = std::max(peak, luminance(reference.at(x, y)));
+  std::vector<PixelError> all;
+  all.reserve(static_cast<size_t>(checked.pixels));
+  double total = 0.0;
+  for (int y = 0; y < reference.height(); ++y)
+    for (int x = 0; x < reference.width(); ++x) {
+      const double ref = luminance(reference.at(x, y));
+      if (ref < threshold * peak) continue;
+      PixelError e{x, y, (luminance(image.at(x, y)) - ref) / ref, reference_std_error ? luminance(reference_std_error->at(x, y)) / ref : 0.0};
+      e.share = e.relative * e.relative - e.noise * e.noise;
+      total += e.share;
+      all.push_back(e);
+    }
+  const auto n = std::min(all.size(), static_cast<size_t>(std::max(count, 0)));
+  std::partial_sort(all.begin(), all.begin() + static_cast<std::ptrdiff_t>(n), all.end(),
+                    [](const PixelError& a, const PixelError& b) { return a.share > b.share; });
+  all.resize(n);
+  for (PixelError& e : all) e.share = total > 0.0 ? e.share / total : 0.0;
+  return all;
 }
 
 }  // namespace haze

@@ -42,6 +42,24 @@ bool arrival(const Light& light, const Vec3& x, LightArrival& out) {
   return false;
 }
 
+int equiangular_nodes(const Ray& ray, const Vec3& centre, double t0, double t1, double max_angle, std::span<double> t,
+                      std::span<double> weight) {
+  if (!(t1 > t0) || t.empty()) return 0;
+  const double t_c = glm::dot(centre - ray.origin, ray.direction);
+  // A ray through the light: b from the stretch's scale keeps the weights finite.
+  const double b = std::max(glm::length(centre - ray.at(t_c)), 1e-9 * (std::abs(t0) + std::abs(t1) + 1.0));
+  const double theta0 = std::atan((t0 - t_c) / b), theta1 = std::atan((t1 - t_c) / b);
+  const auto most = static_cast<int>(std::min(t.size(), weight.size()));
+  const int count = std::clamp(static_cast<int>(std::ceil((theta1 - theta0) / max_angle)), 1, most);
+  const double d_theta = (theta1 - theta0) / count;
+  for (int n = 0; n < count; ++n) {
+    const double theta = theta0 + (n + 0.5) * d_theta, c = std::cos(theta);
+    t[static_cast<size_t>(n)] = t_c + b * std::tan(theta);
+    weight[static_cast<size_t>(n)] = b / (c * c) * d_theta;  // d^2 / b dtheta, d = b / cos(theta)
+  }
+  return count;
+}
+
 std::vector<double> cone_crossings(const SpotLight& spot, const Ray& ray, double t_max) {
   // Inside: (m + t d) . a >= cos(c) |m + t d|, m = origin - apex; squared, a quadratic in t.
   const double cos_c = std::cos(spot.cone_deg * kPi / 180.0), c2 = cos_c * cos_c;

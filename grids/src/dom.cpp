@@ -121,7 +121,8 @@ Image gather_scattered(const Scene& delta, const ExtinctionVolume& volume, const
           if (solution.texel_surfaces && light)
             radiance += transmittance * (surface->kd + surface->ks) / kPi * light->irradiance(*surface, ray.at(t_hit));
           else
-            radiance += transmittance * gather.around(ray.at(t_hit), normal, sky, [&](const Vec3& wi) { return surface->brdf(wi, wo, normal); });
+            radiance += transmittance * (gather.around(ray.at(t_hit), normal, sky, [&](const Vec3&) { return surface->kd / kPi; }) +
+                                         gather.glossy(ray.at(t_hit), normal, wo, *surface, sky));
         }
         image.set(x, y, radiance);
       }

@@ -5,10 +5,31 @@
 
 #include <haze/core/grid_walk.h>
 
+#include <algorithm>
+#include <array>
+#include <cmath>
+
 namespace haze::grids::dom {
 
 namespace {
 constexpr int kSurfaceDirections = 64;  // over the sphere: the hemisphere above a surface point gets about half
+// A step whose midpoint lies within kNearLight half-steps of a point or spot light integrates that
+// light's single scattering over equiangular nodes, each at most kNodeAngle radians as seen from it.
+constexpr double kNearLight = 16.0, kNodeAngle = 0.05;
+constexpr int kMostNodes = 32;
+// A point or spot light's glow about its direction: s(psi) = 1 up to kGlowInner, smoothly 0 at
+// kGlowOuter (radians), taken over kGlowRings x kGlowSpokes polar nodes (Gather::around).
+constexpr double kGlowInner = 0.3, kGlowOuter = 0.9;
+constexpr int kGlowRings = 3, kGlowSpokes = 4;
+// Gather::glossy's nodes over the Phong lobe.
+constexpr int kLobeRings = 4, kLobeSpokes = 6;
+
+double glow_share(double psi) {
+  if (psi <= kGlowInner) return 1.0;
+  if (psi >= kGlowOuter) return 0.0;
+  const double x = (kGlowOuter - psi) / (kGlowOuter - kGlowInner);
+  return x * x * (3.0 - 2.0 * x);
+}
 }
 
 Gather::Gather(const Scene& delta, const ExtinctionVolume& volume, const std::vector<DenseGrid>& depths, const DomSolution& solution,
@@ -29,9 +50,21 @@ Gather::Gather(const Scene& delta, const ExtinctionVolume& volume, const std::ve
   cone_ = cone_tangent(kSurfaceDirections);
   if (!delta.surfaces.empty())
     for (int j = 0; j < around_.size(); ++j) around_weights_.push_back(inscatter_weights(solution, -around_[j]));
+  // Midpoints in psi over [0, kGlowOuter] and in phi; sin psi dpsi dphi is the solid angle.
+  const double d_psi = kGlowOuter / kGlowRings, d_phi = 2.0 * kPi / kGlowSpokes;
+  for (int r = 0; r < kGlowRings; ++r)
+    for (int k = 0; k < kGlowSpokes; ++k) {
+      const double psi = (r + 0.5) * d_psi, phi = (k + 0.5) * d_phi;
+      glow_.push_back({std::cos(psi), std::sin(psi), std::cos(phi), std::sin(phi), std::sin(psi) * d_psi * d_phi * glow_share(psi)});
+    }
 }
 
 Rgb Gather::along(const Ray& ray, double t_end, const Eigen::VectorXd& c, Rgb& transmittance, double cone) const {
+  return along(ray, t_end, &c, nullptr, kAll, transmittance, cone);
+}
+
+Rgb Gather::along(const Ray& ray, double t_end, const Eigen::VectorXd* c, const double* share, size_t only, Rgb& transmittance,
+                  double cone) const {
   const DenseGrid& density = volume_.density;
   Rgb radiance(0.0);
   transmittance = Rgb(1.0);
@@ -48,7 +81,7 @@ Rgb Gather::along(const Ray& ray, double t_end, const Eigen::VectorXd& c, Rgb& t
     const double rho = stencil.apply(density.values().data());
     if (rho <= 0.0) continue;
     Rgb inscattered(0.0);
-    for (int ch = 0; ch < solution_.channels; ++ch) {
+    for (int ch = 0; c && ch < solution_.channels; ++ch) {
       std::fill(m.begin(), m.end(), 0.0);
       const float* moments = solution_.moments[static_cast<size_t>(ch)].data();
       for (int e = 0; e < 8; ++e) {
@@ -56,18 +89,33 @@ Rgb Gather::along(const Ray& ray, double t_end, const Eigen::VectorXd& c, Rgb& t
         for (size_t k = 0; k < n; ++k) m[k] += stencil.weight[e] * static_cast<double>(cell[k]);
       }
       double j = 0.0;
-      for (size_t k = 0; k < n; ++k) j += c(static_cast<int>(k)) * m[k];
+      for (size_t k = 0; k < n; ++k) j += (*c)(static_cast<int>(k)) * m[k];
       inscattered[ch] = j;
     }
     if (solution_.channels == 1) inscattered = Rgb(inscattered[0]);
     Rgb single(0.0);
     const double radius = cone * (t0 + (s + 0.5) * dt);
     for (size_t l = 0; l < delta_.lights.size(); ++l) {
-      if (!arrival(delta_.lights[l], p, a) || a.irradiance == Rgb(0.0)) continue;
-      if (a.distance < radius) a.irradiance *= (a.distance / radius) * (a.distance / radius);
+      if ((only != kAll && l != only) || (share && share[l] == 0.0) || !arrival(delta_.lights[l], p, a)) continue;
+      // A camera ray near a point or spot light: the step's 1 / d^2 peak integrated over
+      // equiangular nodes (the midpoint alone misses it), depth and visibility at the midpoint.
+      Rgb q = volume_.phase.eval(-a.to_light, -ray.direction) * a.irradiance;
+      if (cone == 0.0 && std::isfinite(a.distance) && 2.0 * a.distance < kNearLight * dt) {
+        std::array<double, kMostNodes> t, w;
+        const int count = equiangular_nodes(ray, p + a.distance * a.to_light, t0 + s * dt, t0 + (s + 1) * dt, kNodeAngle, t, w);
+        if (count > 1) {
+          q = Rgb(0.0);
+          for (int i = 0; i < count; ++i) {
+            LightArrival b;
+            if (arrival(delta_.lights[l], ray.at(t[i]), b)) q += w[i] / dt * volume_.phase.eval(-b.to_light, -ray.direction) * b.irradiance;
+          }
+        }
+      }
+      if (q == Rgb(0.0)) continue;
+      if (a.distance < radius) q *= (a.distance / radius) * (a.distance / radius);
       const double depth = stencil.apply(depths_[l].values().data());
       const double visible = visibility_.empty() ? 1.0 : stencil.apply(visibility_[l].values().data());
-      single += volume_.phase.eval(-a.to_light, -ray.direction) * a.irradiance * visible * glm::exp(-volume_.sigma_t_scale * depth);
+      single += (share ? share[l] : 1.0) * q * visible * glm::exp(-volume_.sigma_t_scale * depth);
     }
     const Rgb step_transmittance = glm::exp(-sigma_t_ * rho * dt);
     radiance += transmittance * (Rgb(1.0) - step_transmittance) * (albedo_ * inscattered + single_albedo_ * single);
@@ -76,15 +124,63 @@ Rgb Gather::along(const Ray& ray, double t_end, const Eigen::VectorXd& c, Rgb& t
   return radiance;
 }
 
-Rgb Gather::arriving(const Vec3& point, int j, const Rgb& sky) const {
-  const Ray up{point, around_[j]};
+void Gather::glow_directions(const Vec3& point, std::vector<Vec3>& out) const {
+  out.assign(delta_.lights.size(), Vec3(0.0));
+  LightArrival a;
+  for (size_t l = 0; l < delta_.lights.size(); ++l)
+    if (arrival(delta_.lights[l], point, a) && std::isfinite(a.distance) && a.distance > 0.0) out[l] = a.to_light;
+}
+
+Vec3 Gather::orthogonal(const Vec3& u) {
+  return glm::normalize(glm::cross(u, std::abs(u.x) < 0.9 ? Vec3(1.0, 0.0, 0.0) : Vec3(0.0, 1.0, 0.0)));
+}
+
+Rgb Gather::arriving(const Vec3& point, int j, const Rgb& sky, const std::vector<Vec3>& to_light) const {
+  std::array<double, 64> share;
+  const bool shared = to_light.size() <= share.size();
+  for (size_t l = 0; shared && l < to_light.size(); ++l)
+    share[l] = to_light[l] == Vec3(0.0) ? 1.0 : 1.0 - glow_share(std::acos(std::clamp(glm::dot(to_light[l], around_[j]), -1.0, 1.0)));
+  return arriving(point, around_[j], around_weights_[static_cast<size_t>(j)], sky, shared ? share.data() : nullptr, cone_);
+}
+
+Rgb Gather::arriving(const Vec3& point, const Vec3& w, const Eigen::VectorXd& c, const Rgb& sky, const double* share, double cone) const {
+  const Ray up{point, w};
   double t_next = kInfinity;
   Vec3 n;
   const Surface* hit = nearest_surface(delta_.surfaces, up, kInfinity, t_next, n);
   Rgb t_up;
-  const Rgb radiance = along(up, t_next, around_weights_[static_cast<size_t>(j)], t_up, cone_);
+  const Rgb radiance = along(up, t_next, &c, share, kAll, t_up, cone);
   if (!hit) return radiance + t_up * sky;
-  return surfaces_ ? radiance + t_up * surfaces_->reflected(*hit, up.at(t_next), n, -around_[j]) : radiance;
+  return surfaces_ ? radiance + t_up * surfaces_->reflected(*hit, up.at(t_next), n, -w, false) : radiance;
+}
+
+Rgb Gather::glossy(const Vec3& point, const Vec3& normal, const Vec3& wo, const Surface& surface, const Rgb& sky) const {
+  if (surface.ks == Rgb(0.0)) return Rgb(0.0);
+  const Vec3 r = 2.0 * glm::dot(wo, normal) * normal - wo, a = orthogonal(r), b = glm::cross(r, a);
+  const double n = surface.shininess, weight = (n + 2.0) / (n + 1.0) / (kLobeRings * kLobeSpokes);
+  // Each node stands for an equal share of the lobe's solid angle, about 2 pi / (n + 1).
+  const double cone = cone_tangent(2 * static_cast<int>(std::ceil(n + 1.0)) * kLobeRings * kLobeSpokes);
+  Rgb sum(0.0);
+  for (int i = 0; i < kLobeRings; ++i) {
+    const double cos_alpha = std::pow((i + 0.5) / kLobeRings, 1.0 / (n + 1.0)), sin_alpha = std::sqrt(std::max(0.0, 1.0 - cos_alpha * cos_alpha));
+    for (int k = 0; k < kLobeSpokes; ++k) {
+      const double phi = (k + 0.5) * 2.0 * kPi / kLobeSpokes;
+      const Vec3 w = cos_alpha * r + sin_alpha * (std::cos(phi) * a + std::sin(phi) * b);
+      const double cos_i = glm::dot(normal, w);
+      if (cos_i <= 0.0) continue;
+      sum += weight * cos_i * arriving(point, w, inscatter_weights(solution_, -w), sky, nullptr, cone);
+    }
+  }
+  return surface.ks * sum;
+}
+
+Rgb Gather::single(const Vec3& point, const Vec3& w, size_t l) const {
+  const Ray up{point, w};
+  double t_next = kInfinity;
+  Vec3 n;
+  nearest_surface(delta_.surfaces, up, kInfinity, t_next, n);
+  Rgb unused;
+  return along(up, t_next, nullptr, nullptr, l, unused, 0.0);
 }
 
 }  // namespace haze::grids::dom

@@ -30,24 +30,67 @@ class Gather {
   // (a direction passing by a point light would otherwise count its 1 / d^2 peak for the whole cone).
   Rgb along(const Ray& ray, double t_end, const Eigen::VectorXd& c, Rgb& transmittance, double cone = 0.0) const;
 
-  // The light arriving at a surface point from the hemisphere about `normal`, over the K
-  // Fibonacci directions w_j (4 pi / K each), weighted:
-  //   sum_j (4 pi / K) max(0, n . w_j) weight(w_j) [L_j + T_j L_e],
-  // L_j, T_j from along() toward w_j up to the next surface; L_e the sky where no surface is hit,
-  // else, given `surfaces`, what the surface hit reflects (SurfaceLight::reflected), or nothing.
+  // The light arriving at a surface point from the hemisphere about `normal`, weighted:
+  //   sum_j (4 pi / K) max(0, n . w_j) weight(w_j) [L_j + T_j L_e]
+  //     + sum_lights sum_i w_i max(0, n . w_i) weight(w_i) L1_i,
+  // over the K Fibonacci directions w_j; L_j, T_j from along() toward w_j up to the next surface;
+  // L_e the sky where no surface is hit, else, given `surfaces`, what the surface hit reflects
+  // (SurfaceLight::reflected), or nothing. A point or spot light's single scattering glows about
+  // its direction u (like 1 / psi at an angle psi from it), which K directions alias: its share
+  // s(psi) (1 below kGlowInner, smoothly 0 at kGlowOuter) is taken instead over a polar grid
+  // about u (nodes w_i, psi uniform: the 1 / psi cancels sin psi), L1_i that light's single
+  // scattering toward w_i, and the K directions carry the rest, 1 - s(psi).
   template <class Weight>
   Rgb around(const Vec3& point, const Vec3& normal, const Rgb& sky, const Weight& weight) const {
     Rgb sum(0.0);
+    std::vector<Vec3> to_light;
+    glow_directions(point, to_light);
     for (int j = 0; j < around_.size(); ++j) {
       const double cos_i = glm::dot(normal, around_[j]);
       if (cos_i <= 0.0) continue;
-      sum += around_.weight(j) * cos_i * weight(around_[j]) * arriving(point, j, sky);
+      sum += around_.weight(j) * cos_i * weight(around_[j]) * arriving(point, j, sky, to_light);
+    }
+    for (size_t l = 0; l < to_light.size(); ++l) {
+      if (to_light[l] == Vec3(0.0)) continue;
+      const Vec3 a = orthogonal(to_light[l]), b = glm::cross(to_light[l], a);
+      for (const PolarNode& node : glow_) {
+        const Vec3 w = node.cos_psi * to_light[l] + node.sin_psi * (node.cos_phi * a + node.sin_phi * b);
+        const double cos_i = glm::dot(normal, w);
+        if (cos_i <= 0.0) continue;
+        sum += node.weight * cos_i * weight(w) * single(point, w, l);
+      }
     }
     return sum;
   }
 
+  // The light a glossy surface's Phong lobe (ks, shininess) reflects toward wo from the medium,
+  // the sky and other surfaces, taken over the lobe: about the mirror direction r of wo, nodes at
+  // the midpoints of kLobeRings parts in u = cos^(n+1)(alpha) and kLobeSpokes in phi, each of
+  // weight ks (n + 2) / (n + 1) / nodes (normalized Phong, Surface::brdf, equal lobe shares), times
+  // max(0, n . w) and the radiance arriving from w (as around()'s). 64 directions alias a lobe
+  // narrower than their spacing (shininess 24: about 12 degrees, against 25).
+  Rgb glossy(const Vec3& point, const Vec3& normal, const Vec3& wo, const Surface& surface, const Rgb& sky) const;
+
  private:
-  Rgb arriving(const Vec3& point, int j, const Rgb& sky) const;
+  struct PolarNode {
+    double cos_psi, sin_psi, cos_phi, sin_phi, weight;  // weight: sin psi dpsi dphi s(psi)
+  };
+  // Per delta light, the unit direction from `point` to it, or 0 for a directional light.
+  void glow_directions(const Vec3& point, std::vector<Vec3>& out) const;
+  static Vec3 orthogonal(const Vec3& u);
+  // K direction j's radiance: along() with each light's single scattering times 1 - s(psi).
+  Rgb arriving(const Vec3& point, int j, const Rgb& sky, const std::vector<Vec3>& to_light) const;
+  // The same toward any direction w, in-scattering weights c, each light's single scattering times
+  // share[l] (whole without `share`), the ray standing for a cone of that tangent (along()); what a
+  // surface hit reflects through its Lambert part only (SurfaceLight::reflected).
+  Rgb arriving(const Vec3& point, const Vec3& w, const Eigen::VectorXd& c, const Rgb& sky, const double* share, double cone) const;
+  // Light l's single scattering arriving at `point` from direction w, up to the next surface.
+  Rgb single(const Vec3& point, const Vec3& w, size_t l) const;
+  // along() with the moments' in-scattering only given c, and each light's single scattering
+  // times share[l] (all of it without `share`), or only light `only`'s.
+  static constexpr size_t kAll = static_cast<size_t>(-1);
+  Rgb along(const Ray& ray, double t_end, const Eigen::VectorXd* c, const double* share, size_t only, Rgb& transmittance,
+            double cone) const;
 
   const Scene& delta_;
   const ExtinctionVolume& volume_;
@@ -59,6 +102,7 @@ class Gather {
   Rgb sigma_t_, albedo_, single_albedo_;
   DirectionSet around_;
   std::vector<Eigen::VectorXd> around_weights_;
+  std::vector<PolarNode> glow_;
 };
 
 }  // namespace haze::grids::dom

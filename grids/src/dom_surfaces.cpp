@@ -103,8 +103,10 @@ SurfaceLight::SurfaceLight(const Scene& delta, const ExtinctionVolume& volume, c
   offset_ = std::max(1e-4 * std::min({h.x, h.y, h.z}), 1e-6);  // past nearest_surface's 1e-7
 }
 
-Rgb SurfaceLight::reflected(const Surface& surface, const Vec3& p, const Vec3& n, const Vec3& wo) const {
-  return surface_direct(delta_.lights, delta_.surfaces, volume_.density, depths_, sigma_t_, surface, p, n, wo) +
+Rgb SurfaceLight::reflected(const Surface& surface, const Vec3& p, const Vec3& n, const Vec3& wo, bool glossy) const {
+  Surface lambert = surface;
+  if (!glossy) lambert.ks = Rgb(0.0);
+  return surface_direct(delta_.lights, delta_.surfaces, volume_.density, depths_, sigma_t_, lambert, p, n, wo) +
          surface.kd / kPi * irradiance(surface, p);
 }
 

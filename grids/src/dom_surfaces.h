@@ -25,8 +25,9 @@ class SurfaceLight {
   //   sum_lights brdf(w_l, wo) E_l (n . w_l) V_l e^(-sigma_t' depth_l)  +  kd / pi E_s,
   // the direct light (shadowed by surfaces, through the medium with the solve's extinction) through
   // the whole BRDF and E_s through its Lambert part: from the texels on planes, pi sky past them
-  // and on spheres.
-  Rgb reflected(const Surface& surface, const Vec3& p, const Vec3& n, const Vec3& wo) const;
+  // and on spheres. With `glossy` false the direct light too goes through the Lambert part only:
+  // a gather's few directions would alias a glossy surface's highlight into spikes (a caustic).
+  Rgb reflected(const Surface& surface, const Vec3& p, const Vec3& n, const Vec3& wo, bool glossy = true) const;
   // E_s at a surface point: from the texels, pi sky past them.
   Rgb irradiance(const Surface& surface, const Vec3& p) const;
 

@@ -2,12 +2,16 @@
 #include <haze/core/camera.h>
 #include <haze/core/directions.h>
 #include <haze/core/error.h>
+#include <haze/core/integrate.h>
 #include <haze/core/light.h>
 #include <haze/core/medium.h>
 #include <haze/core/phase.h>
 #include <haze/core/surface.h>
 
 #include <gtest/gtest.h>
+
+#include <array>
+#include <cmath>
 
 namespace haze {
 namespace {
@@ -138,6 +142,41 @@ TEST(Light, ArrivalFollowsInverseSquareAndSpotCone) {
   EXPECT_EQ(a.to_light, Vec3(0, 1, 0));
   EXPECT_TRUE(std::isinf(a.distance));
   EXPECT_FALSE(arrival(SkyLight{}, Vec3(0), a));
+}
+
+TEST(Light, EquiangularNodesIntegrateTheInverseSquarePeak) {
+  // A ray passing 0.01 from a point: integral of 1 / d^2 over t in [-0.3, 0.5] is
+  // (atan(50) + atan(30)) / 0.01 in closed form, exact for any node count.
+  const Ray ray{Vec3(0.0, 0.01, -2.0), Vec3(0.0, 0.0, 1.0)};
+  const Vec3 centre(0.0);
+  std::array<double, 16> t{}, w{};
+  const double exact = (std::atan(50.0) + std::atan(30.0)) / 0.01;
+  for (double angle : {10.0, 0.5, 0.05}) {
+    const int count = equiangular_nodes(ray, centre, 1.7, 2.5, angle, t, w);
+    ASSERT_GE(count, 1);
+    double sum = 0.0;
+    for (int n = 0; n < count; ++n) {
+      EXPECT_GE(t[n], 1.7);
+      EXPECT_LE(t[n], 2.5);
+      const Vec3 d = ray.at(t[n]) - centre;
+      sum += w[n] / glm::dot(d, d);
+    }
+    EXPECT_NEAR(sum, exact, 1e-9 * exact) << angle;
+  }
+  EXPECT_EQ(equiangular_nodes(ray, centre, 1.7, 2.5, 0.05, t, w), 16);  // at most the room given
+  // A smooth factor times the peak, e^(-t) / d^2, against adaptive quadrature: 16 nodes to 1e-3;
+  // the midpoint rule (one node at t = 2.1, weight 0.8) is over half off.
+  const int count = equiangular_nodes(ray, centre, 1.7, 2.5, 0.2, t, w);
+  double sum = 0.0;
+  for (int n = 0; n < count; ++n) sum += w[n] * std::exp(-t[n]) / glm::dot(ray.at(t[n]), ray.at(t[n]));
+  const double adaptive = integrate_adaptive([&](double s) { return std::exp(-s) / glm::dot(ray.at(s), ray.at(s)); }, 1.7, 2.5, 1e-12).value;
+  EXPECT_NEAR(sum, adaptive, 1e-3 * adaptive);
+  EXPECT_GT(std::abs(0.8 * std::exp(-2.1) / glm::dot(ray.at(2.1), ray.at(2.1)) - adaptive), 0.5 * adaptive);
+  // A ray through the point and an empty stretch stay finite.
+  const Ray through{Vec3(0.0, 0.0, -2.0), Vec3(0.0, 0.0, 1.0)};
+  ASSERT_EQ(equiangular_nodes(through, centre, 1.0, 3.0, 0.05, t, w), 16);
+  for (int n = 0; n < 16; ++n) EXPECT_TRUE(std::isfinite(w[n]) && std::isfinite(t[n]));
+  EXPECT_EQ(equiangular_nodes(ray, centre, 2.0, 2.0, 0.05, t, w), 0);
 }
 
 TEST(Medium, DensityIntegralsAreExactOrConverged) {

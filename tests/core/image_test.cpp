@@ -83,6 +83,19 @@ TEST(Image, LitPixelError) {
   EXPECT_NEAR(e.rms_noise_removed, std::sqrt((0.01 + 0.04 - 3 * 0.0025) / 3.0), 1e-7);
   EXPECT_EQ(lit_pixel_error(image, reference, nullptr, &image).pixels, 4);  // lit by another image
   EXPECT_THROW(lit_pixel_error(Image(3, 1), reference), Error);
+
+  // The same pixels by their share of the squared error less the noise: 0.04 - 0.0025 first,
+  // 0.01 - 0.0025 next, of a sum 0.0425 (the exact pixel's -0.0025 included).
+  const std::vector<PixelError> worst = worst_pixels(image, reference, &se, 2);
+  ASSERT_EQ(worst.size(), 2u);
+  EXPECT_EQ(worst[0].x, 1);
+  EXPECT_NEAR(worst[0].relative, -0.2, 1e-7);
+  EXPECT_NEAR(worst[0].noise, 0.05, 1e-7);
+  EXPECT_NEAR(worst[0].share, 0.0375 / 0.0425, 1e-6);
+  EXPECT_EQ(worst[1].x, 0);
+  EXPECT_NEAR(worst[1].share, 0.0075 / 0.0425, 1e-6);
+  EXPECT_EQ(worst_pixels(image, reference, &se, 10).size(), 3u);  // the lit ones, at most
+  EXPECT_THROW(worst_pixels(Image(3, 1), reference, nullptr, 1), Error);
 }
 
 }  // namespace

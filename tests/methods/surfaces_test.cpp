@@ -3,6 +3,7 @@
 // radiance profile across the shadow's edge as the reference does (the single-scattering methods
 // against its single scattering, the DOM against all of it); a floor under a cloud receives the
 // light the cloud scatters onto it in the DOM as in the reference.
+#include <haze/core/image.h>
 #include <haze/core/method.h>
 #include <haze/grids/methods.h>
 
@@ -180,6 +181,50 @@ TEST(SurfaceLight, PropagationGathersTheSingleScatteredLightOntoTheFloor) {
     } else {
       EXPECT_LT(got / want, 0.8);
     }
+  }
+}
+
+// A point light 0.5 above a Lambert floor in haze (optical depth 0.2 across), beside a glossy
+// sphere (ks 0.6, shininess 24): the light's single scattering glows about its direction, the
+// sphere's Phong lobe is about 12 degrees wide, and its highlight is a small bright spot seen from
+// the floor, all narrower than the spacing of the DOM gather's 64 directions (25 degrees), which
+// alias them into blotches and spikes. With the glow's share over a polar grid about the light,
+// the lobe over its own nodes and the gathers seeing other surfaces' Lambert part only, the floor's
+// pixels are 3.3% RMS from the full reference (noise removed; its own noise 1.5%) and the sphere's
+// 5.5% (2.0%); the 64 directions alone were 8.4% and 7.3% off. What the sphere still misses is the
+// floor's bright spot under the light, as small as the glow seen from it (docs/DOM.md).
+TEST(SurfaceLight, DomGathersALightsGlowAndAGlossyLobeWithoutAliasing) {
+  grids::register_methods();
+  Scene scene;
+  scene.camera.position = Vec3(0.0, 1.4, 3.2), scene.camera.look_at = Vec3(0.0, 0.2, 0.0);
+  scene.camera.width_px = 48, scene.camera.height_px = 36;
+  MediumDesc haze;
+  haze.bounds = {Vec3(-2.0, 0.0, -2.0), Vec3(2.0, 1.5, 2.0)};
+  haze.sigma_t = Rgb(0.05), haze.albedo = Rgb(0.9), haze.phase = PhaseFunction::henyey_greenstein(0.7);
+  scene.medium = haze;
+  scene.lights.push_back(PointLight{Vec3(-0.3, 0.5, 0.0), Rgb(4.0)});
+  scene.surfaces.push_back(Surface{Plane{Vec3(0.0), Vec3(0.0, 1.0, 0.0)}, Rgb(0.5), Rgb(0.0), 1.0});
+  scene.surfaces.push_back(Surface{Sphere{Vec3(0.6, 0.4, 0.2), 0.4}, Rgb(0.2), Rgb(0.6), 24.0});
+  RenderOptions reference_options;
+  reference_options.settings = {{"spp", 16384}, {"seed", 5}};
+  const RenderResult reference = render(scene, "reference", reference_options);
+  RenderOptions dom_options;
+  dom_options.settings = {{"resolution", 24}, {"directions", 48}, {"terms", 16}};
+  const Image dom = render(scene, "dom", dom_options).radiance;
+  for (size_t which = 0; which < 2; ++which) {
+    Image mask(scene.camera.width_px, scene.camera.height_px);  // the reference where `which` is seen
+    for (int y = 0; y < mask.height(); ++y)
+      for (int x = 0; x < mask.width(); ++x) {
+        double t;
+        Vec3 normal;
+        const Surface* hit = nearest_surface(scene.surfaces, scene.camera.pixel_ray(x, y), kInfinity, t, normal);
+        if (hit == &scene.surfaces[which]) mask.set(x, y, reference.radiance.at(x, y));
+      }
+    const LitPixelError e = lit_pixel_error(dom, reference.radiance, &*reference.std_error, &mask);
+    std::printf("%s: %d pixels, RMS %.2f%% (noise removed; reference noise %.2f%%), signed mean %+.2f%%\n", which == 0 ? "floor" : "sphere",
+                e.pixels, 100.0 * e.rms_noise_removed, 100.0 * e.noise_rms, 100.0 * e.signed_mean);
+    EXPECT_GT(e.pixels, which == 0 ? 400 : 40);
+    EXPECT_LT(e.rms_noise_removed, which == 0 ? 0.045 : 0.065);
   }
 }
 

@@ -76,6 +76,17 @@ struct LitPixelError {
 LitPixelError lit_pixel_error(const Image& image, const Image& reference, const Image* reference_std_error = nullptr,
                               const Image* lit = nullptr, double threshold = 0.01);
 
+// Where lit_pixel_error's error comes from: the `count` lit pixels with the largest d^2 - se^2,
+// largest first, each with its share of that sum over all lit pixels.
+struct PixelError {
+  int x = 0, y = 0;
+  double relative = 0.0;  // d
+  double noise = 0.0;     // se (0 without reference_std_error)
+  double share = 0.0;
+};
+std::vector<PixelError> worst_pixels(const Image& image, const Image& reference, const Image* reference_std_error, int count,
+                                     double threshold = 0.01);
+
 }  // namespace haze
 
 #pragma GCC visibility pop

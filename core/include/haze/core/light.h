@@ -5,6 +5,7 @@
 
 #include <haze/core/math.h>
 
+#include <span>
 #include <variant>
 #include <vector>
 
@@ -56,6 +57,16 @@ bool arrival(const Light& light, const Vec3& x, LightArrival& out);
 // Distances t in (0, t_max) where the ray crosses the spot light's cone (its lateral surface or the
 // plane of its apex), sorted: between consecutive ones the ray is wholly inside or outside.
 std::vector<double> cone_crossings(const SpotLight& spot, const Ray& ray, double t_max);
+
+// Equiangular nodes (Kulla and Fajardo 2012) for an integral over t in [t0, t1] along the ray of a
+// function that peaks like 1 / d^2, d the distance from ray.at(t) to `centre`: with t_c the ray's
+// closest approach, at distance b, t = t_c + b tan(theta) for theta at the midpoints of `count`
+// equal parts of the stretch's angle, each weighted d^2 / b dtheta, so that
+//   integral f dt ~ sum_n weight_n f(t_n)
+// is exact for f = 1 / d^2. count = ceil(angle / max_angle), at most t.size(); writes the nodes
+// and returns count (0 for an empty stretch).
+int equiangular_nodes(const Ray& ray, const Vec3& centre, double t0, double t1, double max_angle, std::span<double> t,
+                      std::span<double> weight);
 
 }  // namespace haze
 
