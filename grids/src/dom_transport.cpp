@@ -15,6 +15,11 @@ namespace {
 
 int octant(const Vec3& w) { return (w.x < 0.0 ? 1 : 0) | (w.y < 0.0 ? 2 : 0) | (w.z < 0.0 ? 4 : 0); }
 
+// Cells whose centre lies within kNearCells cells of a point or spot light average its irradiance
+// (Transport::first_collision).
+constexpr double kNearCells = 2.5;
+constexpr int kAverage = 8, kAverageOwn = 24;
+
 }  // namespace
 
 Channel make_channel(const ExtinctionVolume& volume, const std::vector<Light>& lights, int channel, double delta_m_fraction) {
@@ -197,9 +202,22 @@ FirstCollision Transport::first_collision(const ExtinctionVolume& volume, const 
   const DenseGrid& grid = volume.density;
   const auto d = static_cast<size_t>(d_);
   const Vec3 h = grid.cell_size();
-  // A point light inside a cell delivers the irradiance at half a cell's distance, no more: the
-  // cell's source stays finite (and isotropic when the light sits at its centre).
-  const double nearest = 0.5 * std::min({h.x, h.y, h.z});
+  // A cell near a point or spot light takes the light's irradiance averaged over the cell (the
+  // 1 / d^2 peak, which its centre alone undercounts: by half in the light's own cell), over
+  // midpoints of a kAverage^3 (kAverageOwn^3 in the light's own cell) subgrid; the light's own
+  // cell scatters it isotropically.
+  const double near = kNearCells * std::max({h.x, h.y, h.z});
+  auto cell_irradiance = [&](const Light& light, const Vec3& x, int n) {
+    double sum = 0.0;
+    LightArrival b;
+    for (int c = 0; c < n * n * n; ++c) {
+      const Vec3 f((c % n + 0.5) / n - 0.5, ((c / n) % n + 0.5) / n - 0.5, (c / (n * n) + 0.5) / n - 0.5);
+      // A midpoint within a thousandth of a cell of the light (whose 1 / d^2 integrates to next
+      // to nothing over that ball) counts nothing.
+      if (arrival(light, x + f * h, b) && b.distance > 1e-3 * std::min({h.x, h.y, h.z})) sum += b.irradiance[channel];
+    }
+    return sum / (n * n * n);
+  };
   const double sigma_t = volume.sigma_t_scale[channel], weight = 4.0 * kPi / d_;
   FirstCollision first;
   if (half) first.half.resize(cells_ * padded_), first.scale.resize(cells_);
@@ -222,11 +240,11 @@ FirstCollision Transport::first_collision(const ExtinctionVolume& volume, const 
             LightArrival a;
             if (!arrival(lights[l], x, a)) continue;
             double e = a.irradiance[channel];
-            if (std::isfinite(a.distance) && a.distance < nearest) e *= (a.distance / nearest) * (a.distance / nearest);
-            if (!(a.distance > 0.0)) {
-              const auto* p = std::get_if<PointLight>(&lights[l]);
-              e = p ? p->intensity[channel] / (nearest * nearest) : 0.0;
-              a.to_light = Vec3(0.0);  // every cosine 0: an isotropic source
+            if (std::isfinite(a.distance) && a.distance < near) {
+              const Vec3 offset = glm::abs(a.to_light * a.distance);
+              const bool own = !(a.distance > 0.0) || (offset.x <= 0.5 * h.x && offset.y <= 0.5 * h.y && offset.z <= 0.5 * h.z);
+              e = cell_irradiance(lights[l], x, own ? kAverageOwn : kAverage);
+              if (own) a.to_light = Vec3(0.0);  // every cosine 0: an isotropic source
             }
             e *= std::exp(-sigma_t * static_cast<double>(depths[l].values()[c]));
             if (!(e > 0.0)) continue;

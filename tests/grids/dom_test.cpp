@@ -1,6 +1,7 @@
 // The discrete-ordinate solver (method "dom") against published slab values, the reference path
 // tracer, its own schemes, and bad input.
 #include <haze/core/error.h>
+#include <haze/core/image.h>
 #include <haze/core/method.h>
 #include <haze/grids/dom.h>
 #include <haze/grids/methods.h>
@@ -290,6 +291,34 @@ TEST(DomRender, WhiteFurnace) {
   for (int y = 0; y < 9; ++y)
     for (int x = 0; x < 12; ++x)
       for (int c = 0; c < 3; ++c) EXPECT_NEAR(image.at(x, y)[c], 1.0, 2e-3) << x << "," << y;
+}
+
+// A point light inside fog (optical radius 1.5, albedo 0.9) at a cell's centre: its first-collision
+// source is the 1 / d^2 peak averaged over each cell near it, which the cell centres undercount (by
+// half in the light's own cell). The image's signed mean over the lit pixels is within 8% of the
+// reference (whose own standard error there is 0.6%): measured -4.6% at 16^3, -9.6% with the
+// centres' values (against a 4096-spp reference: -5.7% and -10.7% at 16^3, -3.8% and -6.6% at 32^3).
+TEST(DomRender, PointLightInsideTheFog) {
+  register_methods();
+  Scene scene;
+  scene.camera.position = Vec3(0.0, 0.0, 4.0);
+  scene.camera.fov_y_deg = 40.0;
+  scene.camera.width_px = scene.camera.height_px = 32;
+  MediumDesc fog;
+  fog.bounds = {Vec3(-1.0), Vec3(1.0)};
+  fog.sigma_t = Rgb(1.5), fog.albedo = Rgb(0.9);
+  scene.medium = fog;
+  scene.lights.push_back(PointLight{Vec3(0.0625), Rgb(1.0)});  // a cell centre at 16^3
+  RenderOptions reference_options;
+  reference_options.settings = {{"spp", 1024}, {"seed", 3}};
+  const RenderResult reference = render(scene, "reference", reference_options);
+  RenderOptions options;
+  options.settings = {{"resolution", 16}, {"directions", 48}, {"terms", 16}};
+  const LitPixelError e = lit_pixel_error(render(scene, "dom", options).radiance, reference.radiance, &*reference.std_error);
+  std::printf("point light in fog, 16^3: signed mean %+.2f%% (its standard error %.2f%%)\n", 100.0 * e.signed_mean,
+              100.0 * e.signed_mean_error);
+  EXPECT_LT(e.signed_mean_error, 0.01);
+  EXPECT_NEAR(e.signed_mean, 0.0, 0.08);
 }
 
 TEST(DomSolver, RejectsBadInput) {
