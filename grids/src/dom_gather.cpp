@@ -13,14 +13,18 @@ namespace haze::grids::dom {
 
 namespace {
 constexpr int kSurfaceDirections = 64;  // over the sphere: the hemisphere above a surface point gets about half
-// A step whose midpoint lies within kNearLight half-steps of a point or spot light integrates that
-// light's single scattering over equiangular nodes, each at most kNodeAngle radians as seen from it.
-constexpr double kNearLight = 16.0, kNodeAngle = 0.05;
+// A step whose midpoint lies within kNearLight steps of a point or spot light (so that it spans
+// more than about 1 / kNearLight radians as seen from it) integrates that light's single scattering
+// over equiangular nodes, each at most kNodeAngle radians.
+constexpr double kNearLight = 4.0, kNodeAngle = 0.1;
 constexpr int kMostNodes = 32;
 // A point or spot light's glow about its direction: s(psi) = 1 up to kGlowInner, smoothly 0 at
 // kGlowOuter (radians), taken over kGlowRings x kGlowSpokes polar nodes (Gather::around).
 constexpr double kGlowInner = 0.3, kGlowOuter = 0.9;
-constexpr int kGlowRings = 3, kGlowSpokes = 4;
+constexpr int kGlowRings = 2, kGlowSpokes = 4;
+// Their rays carry one light's single scattering, smooth but near it (where the equiangular nodes
+// take over): steps kGlowStep times the gather's.
+constexpr double kGlowStep = 4.0;
 // Gather::glossy's nodes over the Phong lobe.
 constexpr int kLobeRings = 4, kLobeSpokes = 6;
 
@@ -72,7 +76,8 @@ Rgb Gather::along(const Ray& ray, double t_end, const Eigen::VectorXd* c, const 
   if (!density.bounds().clip(ray, t0, t1) || !(t1 > t0)) return radiance;
   const auto n = static_cast<size_t>(solution_.terms());
   std::vector<double> m(n);
-  const int steps = static_cast<int>(std::ceil((t1 - t0) / step_));
+  const double step = only == kAll ? step_ : kGlowStep * step_;
+  const int steps = static_cast<int>(std::ceil((t1 - t0) / step));
   const double dt = (t1 - t0) / steps;
   LightArrival a;
   for (int s = 0; s < steps; ++s) {
@@ -100,7 +105,7 @@ Rgb Gather::along(const Ray& ray, double t_end, const Eigen::VectorXd* c, const 
       // A camera ray near a point or spot light: the step's 1 / d^2 peak integrated over
       // equiangular nodes (the midpoint alone misses it), depth and visibility at the midpoint.
       Rgb q = volume_.phase.eval(-a.to_light, -ray.direction) * a.irradiance;
-      if (cone == 0.0 && std::isfinite(a.distance) && 2.0 * a.distance < kNearLight * dt) {
+      if (cone == 0.0 && std::isfinite(a.distance) && a.distance < kNearLight * dt) {
         std::array<double, kMostNodes> t, w;
         const int count = equiangular_nodes(ray, p + a.distance * a.to_light, t0 + s * dt, t0 + (s + 1) * dt, kNodeAngle, t, w);
         if (count > 1) {

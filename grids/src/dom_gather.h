@@ -87,7 +87,7 @@ class Gather {
   // Light l's single scattering arriving at `point` from direction w, up to the next surface.
   Rgb single(const Vec3& point, const Vec3& w, size_t l) const;
   // along() with the moments' in-scattering only given c, and each light's single scattering
-  // times share[l] (all of it without `share`), or only light `only`'s.
+  // times share[l] (all of it without `share`), or only light `only`'s (in longer steps).
   static constexpr size_t kAll = static_cast<size_t>(-1);
   Rgb along(const Ray& ray, double t_end, const Eigen::VectorXd* c, const double* share, size_t only, Rgb& transmittance,
             double cone) const;
