@@ -25,6 +25,9 @@ constexpr int kGlowRings = 2, kGlowSpokes = 4;
 // Their rays carry one light's single scattering, smooth but near it (where the equiangular nodes
 // take over): steps kGlowStep times the gather's.
 constexpr double kGlowStep = 4.0;
+// A sphere that covers at least this solid angle seen from a step replaces the medium's scattered
+// light arriving through it with what it reflects (Gather::sphere_correction).
+constexpr double kSphereSolidAngle = 0.02;
 // Gather::glossy's nodes over the Phong lobe.
 constexpr int kLobeRings = 4, kLobeSpokes = 6;
 
@@ -54,6 +57,12 @@ Gather::Gather(const Scene& delta, const ExtinctionVolume& volume, const std::ve
   cone_ = cone_tangent(kSurfaceDirections);
   if (!delta.surfaces.empty())
     for (int j = 0; j < around_.size(); ++j) around_weights_.push_back(inscatter_weights(solution, -around_[j]));
+  // The scattered radiance's mean over directions from the moments: sum_d (1 / D) L_d.
+  const DirectionSet& set = *solution.directions;
+  Eigen::VectorXd uniform = Eigen::VectorXd::Constant(set.size(), 1.0 / set.size());
+  mean_radiance_ = solution.separable->basis().transpose() * uniform;
+  for (const Surface& s : delta.surfaces)
+    if (std::holds_alternative<Sphere>(s.shape)) spheres_.push_back(&s);
   // Midpoints in psi over [0, kGlowOuter] and in phi; sin psi dpsi dphi is the solid angle.
   const double d_psi = kGlowOuter / kGlowRings, d_phi = 2.0 * kPi / kGlowSpokes;
   for (int r = 0; r < kGlowRings; ++r)
@@ -85,7 +94,7 @@ Rgb Gather::along(const Ray& ray, double t_end, const Eigen::VectorXd* c, const 
     const TrilinearStencil stencil(density.bounds(), density.resolution(), p);
     const double rho = stencil.apply(density.values().data());
     if (rho <= 0.0) continue;
-    Rgb inscattered(0.0);
+    Rgb inscattered(0.0), mean_scattered(0.0);
     for (int ch = 0; c && ch < solution_.channels; ++ch) {
       std::fill(m.begin(), m.end(), 0.0);
       const float* moments = solution_.moments[static_cast<size_t>(ch)].data();
@@ -93,11 +102,13 @@ Rgb Gather::along(const Ray& ray, double t_end, const Eigen::VectorXd* c, const 
         const float* cell = moments + stencil.offset[e] * n;
         for (size_t k = 0; k < n; ++k) m[k] += stencil.weight[e] * static_cast<double>(cell[k]);
       }
-      double j = 0.0;
-      for (size_t k = 0; k < n; ++k) j += (*c)(static_cast<int>(k)) * m[k];
+      double j = 0.0, mean = 0.0;
+      for (size_t k = 0; k < n; ++k) j += (*c)(static_cast<int>(k)) * m[k], mean += mean_radiance_(static_cast<int>(k)) * m[k];
       inscattered[ch] = j;
+      mean_scattered[ch] = mean;
     }
-    if (solution_.channels == 1) inscattered = Rgb(inscattered[0]);
+    if (solution_.channels == 1) inscattered = Rgb(inscattered[0]), mean_scattered = Rgb(mean_scattered[0]);
+    if (c && surfaces_ && cone == 0.0) inscattered -= sphere_correction(p, ray.direction, mean_scattered);  // camera rays
     Rgb single(0.0);
     const double radius = cone * (t0 + (s + 0.5) * dt);
     for (size_t l = 0; l < delta_.lights.size(); ++l) {
@@ -127,6 +138,25 @@ Rgb Gather::along(const Ray& ray, double t_end, const Eigen::VectorXd* c, const 
     transmittance *= step_transmittance;
   }
   return radiance;
+}
+
+Rgb Gather::sphere_correction(const Vec3& x, const Vec3& direction, const Rgb& mean) const {
+  Rgb out(0.0);
+  for (const Surface* s : spheres_) {
+    const auto& sphere = std::get<Sphere>(s->shape);
+    const Vec3 to_centre = sphere.center - x;
+    const double d = glm::length(to_centre);
+    const double along_ray = glm::dot(to_centre, direction);
+    if (!(d > sphere.radius) || (along_ray > 0.0 && d * d - along_ray * along_ray < sphere.radius * sphere.radius)) continue;
+    const double sin2 = (sphere.radius / d) * (sphere.radius / d), solid_angle = 2.0 * kPi * (1.0 - std::sqrt(1.0 - sin2));
+    if (solid_angle < kSphereSolidAngle) continue;
+    const Vec3 w = to_centre / d, n = -w;
+    const Rgb seen = surfaces_->reflected(*s, sphere.center + sphere.radius * n, n, n, false);
+    // Light arriving from w, scattered toward the eye (-direction), under the delta-M scaled phase.
+    const double phase = volume_.phase.eval(-w, -direction) / (1.0 - solution_.delta_m_fraction);
+    out += solid_angle * phase * (mean - seen);
+  }
+  return out;
 }
 
 void Gather::glow_directions(const Vec3& point, std::vector<Vec3>& out) const {

@@ -84,6 +84,14 @@ class Gather {
   // share[l] (whole without `share`), the ray standing for a cone of that tangent (along()); what a
   // surface hit reflects through its Lambert part only (SurfaceLight::reflected).
   Rgb arriving(const Vec3& point, const Vec3& w, const Eigen::VectorXd& c, const Rgb& sky, const double* share, double cone) const;
+  // The sweeps let the medium's light through spheres inside the grid. At x, for a step along
+  // `direction`, a sphere seen in a cone of solid angle Omega about w sends what its nearest point
+  // reflects toward x, L_s, in place of the medium's light there, taken as its mean over
+  // directions `mean`: the in-scattering changes by Omega p'(w -> eye) (mean - L_s), returned
+  // (p' the delta-M scaled phase function). Camera rays passing a sphere only: in front of a
+  // sphere a ray ends on, or from a surface's own gather, the mean is too crude where it matters
+  // (the sphere fills half of what the steps next to it see).
+  Rgb sphere_correction(const Vec3& x, const Vec3& direction, const Rgb& mean) const;
   // Light l's single scattering arriving at `point` from direction w, up to the next surface.
   Rgb single(const Vec3& point, const Vec3& w, size_t l) const;
   // along() with the moments' in-scattering only given c, and each light's single scattering
@@ -103,6 +111,8 @@ class Gather {
   DirectionSet around_;
   std::vector<Eigen::VectorXd> around_weights_;
   std::vector<PolarNode> glow_;
+  Eigen::VectorXd mean_radiance_;          // the moments' weights for the mean scattered radiance
+  std::vector<const Surface*> spheres_;
 };
 
 }  // namespace haze::grids::dom

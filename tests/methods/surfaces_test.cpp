@@ -228,5 +228,43 @@ TEST(SurfaceLight, DomGathersALightsGlowAndAGlossyLobeWithoutAliasing) {
   }
 }
 
+// A dark sphere (kd 0.1) inside a dense fog box (optical radius 2, albedo 0.95) under the sun: the
+// sweeps let the medium's scattered light through the sphere, so the fog beside it, where the
+// sphere fills much of what a point sees, comes out bright unless the gather takes the sphere's
+// own light there instead (Gather::sphere_correction). Over the fog pixels whose rays pass within
+// two radii of its centre, the DOM's signed mean is within 4% of the reference (measured -1.0%,
+// its standard error 0.2%; without the correction +4.9%).
+TEST(SurfaceLight, DomFogBesideASphereInsideTheGrid) {
+  grids::register_methods();
+  Scene scene;
+  scene.camera.position = Vec3(0.0, 0.0, 4.0);
+  scene.camera.fov_y_deg = 40.0;
+  scene.camera.width_px = scene.camera.height_px = 32;
+  MediumDesc fog;
+  fog.bounds = {Vec3(-1.0), Vec3(1.0)};
+  fog.sigma_t = Rgb(2.0), fog.albedo = Rgb(0.95), fog.phase = PhaseFunction::henyey_greenstein(0.3);
+  scene.medium = fog;
+  scene.lights.push_back(DirectionalLight{glm::normalize(Vec3(0.3, -1.0, -0.2)), Rgb(1.0)});
+  const Sphere ball{Vec3(0.0), 0.35};
+  scene.surfaces.push_back(Surface{ball, Rgb(0.1), Rgb(0.0), 1.0});
+  RenderOptions reference_options;
+  reference_options.settings = {{"spp", 4096}, {"seed", 3}};
+  const RenderResult reference = render(scene, "reference", reference_options);
+  Image beside(32, 32);  // the reference where a ray passes the sphere within two radii
+  for (int y = 0; y < 32; ++y)
+    for (int x = 0; x < 32; ++x) {
+      const Ray ray = scene.camera.pixel_ray(x, y);
+      const double t = glm::dot(ball.center - ray.origin, ray.direction), miss = glm::length(ray.at(t) - ball.center);
+      if (miss > ball.radius && miss < 2.0 * ball.radius) beside.set(x, y, reference.radiance.at(x, y));
+    }
+  RenderOptions options;
+  options.settings = {{"resolution", 24}, {"directions", 48}, {"terms", 16}};
+  const LitPixelError e = lit_pixel_error(render(scene, "dom", options).radiance, reference.radiance, &*reference.std_error, &beside);
+  std::printf("fog beside the sphere, %d pixels: signed mean %+.2f%% (its standard error %.2f%%), RMS %.2f%%\n", e.pixels,
+              100.0 * e.signed_mean, 100.0 * e.signed_mean_error, 100.0 * e.rms_noise_removed);
+  EXPECT_GT(e.pixels, 100);
+  EXPECT_NEAR(e.signed_mean, 0.0, 0.04);
+}
+
 }  // namespace
 }  // namespace haze
