@@ -21,7 +21,7 @@ constexpr int kMostNodes = 32;
 // A point or spot light's glow about its direction: s(psi) = 1 up to kGlowInner, smoothly 0 at
 // kGlowOuter (radians), taken over kGlowRings x kGlowSpokes polar nodes (Gather::around).
 constexpr double kGlowInner = 0.3, kGlowOuter = 0.9;
-constexpr int kGlowRings = 2, kGlowSpokes = 4;
+constexpr int kGlowRings = 3, kGlowSpokes = 4;
 // Their rays carry one light's single scattering, smooth but near it (where the equiangular nodes
 // take over): steps kGlowStep times the gather's.
 constexpr double kGlowStep = 4.0;
@@ -84,7 +84,9 @@ Rgb Gather::along(const Ray& ray, double t_end, const Eigen::VectorXd* c, const 
   double t0 = 0.0, t1 = t_end;
   if (!density.bounds().clip(ray, t0, t1) || !(t1 > t0)) return radiance;
   const auto n = static_cast<size_t>(solution_.terms());
-  std::vector<double> m(n);
+  std::array<double, 64> small;  // the moments at a step: no allocation for up to 64 terms
+  std::vector<double> large(n > small.size() ? n : 0);
+  double* m = n > small.size() ? large.data() : small.data();
   const double step = only == kAll ? step_ : kGlowStep * step_;
   const int steps = static_cast<int>(std::ceil((t1 - t0) / step));
   const double dt = (t1 - t0) / steps;
@@ -96,7 +98,7 @@ Rgb Gather::along(const Ray& ray, double t_end, const Eigen::VectorXd* c, const 
     if (rho <= 0.0) continue;
     Rgb inscattered(0.0), mean_scattered(0.0);
     for (int ch = 0; c && ch < solution_.channels; ++ch) {
-      std::fill(m.begin(), m.end(), 0.0);
+      std::fill(m, m + n, 0.0);
       const float* moments = solution_.moments[static_cast<size_t>(ch)].data();
       for (int e = 0; e < 8; ++e) {
         const float* cell = moments + stencil.offset[e] * n;

@@ -48,7 +48,9 @@ SurfaceTexels surface_texels(const Scene& delta, const ExtinctionVolume& volume,
   for (size_t s = 0; s < delta.surfaces.size(); ++s) {
     if (const auto* sphere = std::get_if<Sphere>(&delta.surfaces[s].shape)) {
       SurfaceTexels::Globe& g = out.spheres[s];
-      g.centre = sphere->center, g.radius = sphere->radius, g.nt = 16, g.np = 32;
+      // Texels about a cell apart along a meridian, 8 to 16 of them (and twice as many around).
+      g.centre = sphere->center, g.radius = sphere->radius;
+      g.nt = std::clamp(static_cast<int>(std::ceil(kPi * sphere->radius / std::min({h.x, h.y, h.z}))), 8, 16), g.np = 2 * g.nt;
       g.values.assign(static_cast<size_t>(g.nt) * static_cast<size_t>(g.np), Rgb(0.0));
       parallel_for(g.nt, threads, 1, [&](long long t0, long long t1) {
         for (auto t = static_cast<int>(t0); t < t1; ++t)

@@ -18,7 +18,7 @@ int octant(const Vec3& w) { return (w.x < 0.0 ? 1 : 0) | (w.y < 0.0 ? 2 : 0) | (
 // Cells whose centre lies within kNearCells cells of a point or spot light average its irradiance
 // (Transport::first_collision).
 constexpr double kNearCells = 2.5;
-constexpr int kAverage = 8, kAverageOwn = 24;
+constexpr int kAverage = 8, kAverageOwn = 16;
 
 }  // namespace
 

@@ -67,14 +67,20 @@ TEST(AutoMethod, SurfacesInFogGetTheDomThenTheReferenceWithMoreSamplesForLessErr
   scene.surfaces.push_back(Surface{Plane{Vec3(0.0, -1.0, 0.0), Vec3(0.0, 1.0, 0.0)}, Rgb(0.5), Rgb(0.0), 1.0});
   const AutoChoice loose = choose_method(scene, 0.1), mid = choose_method(scene, 0.04), tight = choose_method(scene, 0.02);
   ASSERT_EQ(loose.method, "dom");
-  EXPECT_EQ(loose.settings["resolution"].get<int>(), 24);
+  EXPECT_EQ(loose.settings["resolution"].get<int>(), 16);
   ASSERT_EQ(mid.method, "dom");
-  EXPECT_EQ(mid.settings["resolution"].get<int>(), 48);
-  // Under the dom's measured 2.7% with surfaces in fog: the path tracer, which adds samples until
+  EXPECT_EQ(mid.settings["resolution"].get<int>(), 24);
+  // Under the dom's measured 2.25% with surfaces in fog: the path tracer, which adds samples until
   // its own noise is a fixed share of the tolerance.
   ASSERT_EQ(tight.method, "reference");
   EXPECT_DOUBLE_EQ(tight.settings["target_noise"].get<double>(), 0.75 * 0.02);
   EXPECT_FALSE(tight.why.empty());
+  // Thin fog (multiple share under 30%, thin_haze's kind) gets the dom at 2%: 1.7% at 32^3.
+  Scene thin = box_scene(0.05, 0.8);
+  thin.surfaces = scene.surfaces;
+  const AutoChoice thin_tight = choose_method(thin, 0.02);
+  ASSERT_EQ(thin_tight.method, "dom");
+  EXPECT_EQ(thin_tight.settings["resolution"].get<int>(), 32);
 }
 
 TEST(AutoMethod, RendersWithItsChoiceAndRefusesABadTolerance) {

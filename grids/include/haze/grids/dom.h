@@ -79,7 +79,7 @@ struct DomSettings {
 // first surface pass) other surfaces' reflected light give the surfaces (dom_fields, the surface
 // passes; gathered along 64 directions like a camera pixel's), at texel centres: over a rectangle of each plane, the grid's bounds widened by their extent on
 // every side, texels at least two cells wide, at most 48 a side; over each sphere in latitude
-// and longitude, 16 x 32.
+// and longitude, n x 2n, n about a cell apart along a meridian (8 to 16).
 struct SurfaceTexels {
   struct Rectangle {
     Vec3 origin, u, v;
