@@ -312,21 +312,21 @@ AutoOffer dom_offer(int resolution, int directions, int terms, double seconds, s
 //   cloud_sun (an RBF cloud over a floor, albedo 0.92): 4.6% at 16^3, 2.1% at 24^3, 1.3% at 32^3
 //   (1.1 s), 0.63% at 48^3 (3.9 s), 0.45% at 64^3;
 //   fog_lamps and thin_haze (constant fog over a floor with a sphere inside the grid; multiple
-//   shares 58% and 16%; measured 2026-12-02): 4.3% and 3.2% at 16^3 (0.31 s), 3.2% and 2.2% at
-//   24^3 (0.66 s), 2.5% and 1.7% at 32^3 (1.3 s), 2.25% and 1.6% at 48^3 (3.2 s), no better past
-//   it (2.5% and 1.6% at 96^3: the sphere neither blocks nor sends light in the sweeps).
+//   shares 58% and 16%; measured 2026-12-02): 4.2% and 3.1% at 16^3 (0.35 s), 3.1% and 2.2% at
+//   24^3 (0.8 s), 2.4% and 1.7% at 32^3 (1.7 s), 2.2% and 1.6% at 48^3 (4 s), no better past it
+//   (2.4% and 1.6% at 96^3: the sphere neither blocks nor sends light in the sweeps).
 // Clouds of higher albedo than cloud_sun's take the dense cloud's resolutions (the rule below).
 AutoOffer surface_offer(const SceneFeatures& f, double tolerance) {
   if (f.homogeneous) {
-    if (tolerance >= 0.05) return dom_offer(16, 32, 9, 0.31, "surfaces in fog: fog_lamps and thin_haze measured 4.3% and 3.2% at 16^3");
-    if (tolerance >= 0.035) return dom_offer(24, 48, 16, 0.66, "surfaces in fog: fog_lamps and thin_haze measured 3.2% and 2.2% at 24^3");
-    if (tolerance >= 0.03) return dom_offer(32, 80, 25, 1.3, "surfaces in fog: fog_lamps and thin_haze measured 2.5% and 1.7% at 32^3");
+    if (tolerance >= 0.05) return dom_offer(16, 32, 9, 0.35, "surfaces in fog: fog_lamps and thin_haze measured 4.2% and 3.1% at 16^3");
+    if (tolerance >= 0.035) return dom_offer(24, 48, 16, 0.8, "surfaces in fog: fog_lamps and thin_haze measured 3.1% and 2.2% at 24^3");
+    if (tolerance >= 0.03) return dom_offer(32, 80, 25, 1.7, "surfaces in fog: fog_lamps and thin_haze measured 2.4% and 1.7% at 32^3");
     if (f.multiple_share < 0.3 && tolerance >= 0.02)
-      return dom_offer(32, 80, 25, 1.3, "surfaces in thin fog: thin_haze (multiple share 16%) measured 1.7% at 32^3");
-    if (tolerance >= 0.025) return dom_offer(48, 128, 25, 3.2, "surfaces in fog: fog_lamps measured 2.25% at 48^3");
+      return dom_offer(32, 80, 25, 1.7, "surfaces in thin fog: thin_haze (multiple share 16%) measured 1.7% at 32^3");
+    if (tolerance >= 0.025) return dom_offer(48, 128, 25, 4.0, "surfaces in fog: fog_lamps measured 2.2% at 48^3");
     return AutoOffer{false, {}, 0.0,
                      f.multiple_share < 0.3 ? "surfaces in thin fog: 1.6% at best on the suite"
-                                            : "surfaces in fog: 2.25% at best on the suite (a sphere inside the grid is left out of the sweeps)"};
+                                            : "surfaces in fog: 2.2% at best on the suite (a sphere inside the grid is left out of the sweeps)"};
   }
   if (f.albedo > 0.95) return AutoOffer{false, {}, 0.0, "surfaces under a cloud of albedo over 0.95: not measured"};
   if (tolerance >= 0.05) return dom_offer(16, 32, 9, 0.20, "a cloud over surfaces: cloud_sun measured 4.6% at 16^3");

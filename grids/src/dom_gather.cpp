@@ -153,7 +153,7 @@ Rgb Gather::sphere_correction(const Vec3& x, const Vec3& direction, const Rgb& m
     const double sin2 = (sphere.radius / d) * (sphere.radius / d), solid_angle = 2.0 * kPi * (1.0 - std::sqrt(1.0 - sin2));
     if (solid_angle < kSphereSolidAngle) continue;
     const Vec3 w = to_centre / d, n = -w;
-    const Rgb seen = surfaces_->reflected(*s, sphere.center + sphere.radius * n, n, n, false);
+    const Rgb seen = surfaces_->reflected(*s, sphere.center + sphere.radius * n, n, n);
     // Light arriving from w, scattered toward the eye (-direction), under the delta-M scaled phase.
     const double phase = volume_.phase.eval(-w, -direction) / (1.0 - solution_.delta_m_fraction);
     out += solid_angle * phase * (mean - seen);

@@ -86,9 +86,10 @@ class Gather {
   Rgb arriving(const Vec3& point, const Vec3& w, const Eigen::VectorXd& c, const Rgb& sky, const double* share, double cone) const;
   // The sweeps let the medium's light through spheres inside the grid. At x, for a step along
   // `direction`, a sphere seen in a cone of solid angle Omega about w sends what its nearest point
-  // reflects toward x, L_s, in place of the medium's light there, taken as its mean over
-  // directions `mean`: the in-scattering changes by Omega p'(w -> eye) (mean - L_s), returned
-  // (p' the delta-M scaled phase function). Camera rays passing a sphere only: in front of a
+  // reflects toward x (SurfaceLight::reflected, direct light through the whole BRDF), L_s, in
+  // place of the medium's light there, taken as its mean over directions `mean`: the
+  // in-scattering changes by Omega p'(w -> eye) (mean - L_s), returned (p' the delta-M scaled
+  // phase function). Camera rays passing a sphere only: in front of a
   // sphere a ray ends on, or from a surface's own gather, the mean is too crude where it matters
   // (the sphere fills half of what the steps next to it see).
   Rgb sphere_correction(const Vec3& x, const Vec3& direction, const Rgb& mean) const;

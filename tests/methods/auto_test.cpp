@@ -70,7 +70,7 @@ TEST(AutoMethod, SurfacesInFogGetTheDomThenTheReferenceWithMoreSamplesForLessErr
   EXPECT_EQ(loose.settings["resolution"].get<int>(), 16);
   ASSERT_EQ(mid.method, "dom");
   EXPECT_EQ(mid.settings["resolution"].get<int>(), 24);
-  // Under the dom's measured 2.25% with surfaces in fog: the path tracer, which adds samples until
+  // Under the dom's measured 2.2% with surfaces in fog: the path tracer, which adds samples until
   // its own noise is a fixed share of the tolerance.
   ASSERT_EQ(tight.method, "reference");
   EXPECT_DOUBLE_EQ(tight.settings["target_noise"].get<double>(), 0.75 * 0.02);

@@ -190,7 +190,7 @@ TEST(SurfaceLight, PropagationGathersTheSingleScatteredLightOntoTheFloor) {
 // the floor, all narrower than the spacing of the DOM gather's 64 directions (25 degrees), which
 // alias them into blotches and spikes. With the glow's share over a polar grid about the light,
 // the lobe over its own nodes and the gathers seeing other surfaces' Lambert part only, the floor's
-// pixels are 3.3% RMS from the full reference (noise removed; its own noise 1.5%) and the sphere's
+// pixels are 3.2% RMS from the full reference (noise removed; its own noise 1.5%) and the sphere's
 // 5.5% (2.0%); the 64 directions alone were 8.4% and 7.3% off. What the sphere still misses is the
 // floor's bright spot under the light, as small as the glow seen from it (docs/DOM.md).
 TEST(SurfaceLight, DomGathersALightsGlowAndAGlossyLobeWithoutAliasing) {
