@@ -22,6 +22,7 @@ constexpr int kMostNodes = 32;
 // kGlowOuter (radians), taken over kGlowRings x kGlowSpokes polar nodes (Gather::around).
 constexpr double kGlowInner = 0.3, kGlowOuter = 0.9;
 constexpr int kGlowRings = 3, kGlowSpokes = 4;
+constexpr size_t kMostGlows = 64;  // lights whose glow is taken apart, at most
 // Their rays carry one light's single scattering, smooth but near it (where the equiangular nodes
 // take over): steps kGlowStep times the gather's.
 constexpr double kGlowStep = 4.0;
@@ -163,6 +164,7 @@ Rgb Gather::sphere_correction(const Vec3& x, const Vec3& direction, const Rgb& m
 
 void Gather::glow_directions(const Vec3& point, std::vector<Vec3>& out) const {
   out.assign(delta_.lights.size(), Vec3(0.0));
+  if (out.size() > kMostGlows) return;  // every light's glow over the K directions then
   LightArrival a;
   for (size_t l = 0; l < delta_.lights.size(); ++l)
     if (arrival(delta_.lights[l], point, a) && std::isfinite(a.distance) && a.distance > 0.0) out[l] = a.to_light;
@@ -173,8 +175,8 @@ Vec3 Gather::orthogonal(const Vec3& u) {
 }
 
 Rgb Gather::arriving(const Vec3& point, int j, const Rgb& sky, const std::vector<Vec3>& to_light) const {
-  std::array<double, 64> share;
-  const bool shared = to_light.size() <= share.size();
+  std::array<double, kMostGlows> share;
+  const bool shared = to_light.size() <= share.size();  // else no light's glow is taken apart
   for (size_t l = 0; shared && l < to_light.size(); ++l)
     share[l] = to_light[l] == Vec3(0.0) ? 1.0 : 1.0 - glow_share(std::acos(std::clamp(glm::dot(to_light[l], around_[j]), -1.0, 1.0)));
   return arriving(point, around_[j], around_weights_[static_cast<size_t>(j)], sky, shared ? share.data() : nullptr, cone_);

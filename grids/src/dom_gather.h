@@ -28,6 +28,9 @@ class Gather {
   // the ray stands for a cone of directions of that tangent of its half-angle: a light nearer
   // than the cone's radius at the step, cone t, delivers its irradiance at that radius, no more
   // (a direction passing by a point light would otherwise count its 1 / d^2 peak for the whole cone).
+  // With cone 0 (a camera ray), a step near a point or spot light takes q1 over equiangular nodes
+  // (equiangular_nodes) and a sphere it passes replaces the medium's light from its direction
+  // (sphere_correction).
   Rgb along(const Ray& ray, double t_end, const Eigen::VectorXd& c, Rgb& transmittance, double cone = 0.0) const;
 
   // The light arriving at a surface point from the hemisphere about `normal`, weighted:
@@ -39,7 +42,8 @@ class Gather {
   // its direction u (like 1 / psi at an angle psi from it), which K directions alias: its share
   // s(psi) (1 below kGlowInner, smoothly 0 at kGlowOuter) is taken instead over a polar grid
   // about u (nodes w_i, psi uniform: the 1 / psi cancels sin psi), L1_i that light's single
-  // scattering toward w_i, and the K directions carry the rest, 1 - s(psi).
+  // scattering toward w_i, and the K directions carry the rest, 1 - s(psi) (for up to 64 lights;
+  // with more, the K directions carry every glow whole).
   template <class Weight>
   Rgb around(const Vec3& point, const Vec3& normal, const Rgb& sky, const Weight& weight) const {
     Rgb sum(0.0);
@@ -89,9 +93,9 @@ class Gather {
   // reflects toward x (SurfaceLight::reflected, direct light through the whole BRDF), L_s, in
   // place of the medium's light there, taken as its mean over directions `mean`: the
   // in-scattering changes by Omega p'(w -> eye) (mean - L_s), returned (p' the delta-M scaled
-  // phase function). Camera rays passing a sphere only: in front of a
-  // sphere a ray ends on, or from a surface's own gather, the mean is too crude where it matters
-  // (the sphere fills half of what the steps next to it see).
+  // phase function). Camera rays passing a sphere only: in front of a sphere a ray ends on, or
+  // from a surface's own gather, the mean is too crude where it matters (the sphere fills half of
+  // what the steps next to it see).
   Rgb sphere_correction(const Vec3& x, const Vec3& direction, const Rgb& mean) const;
   // Light l's single scattering arriving at `point` from direction w, up to the next surface.
   Rgb single(const Vec3& point, const Vec3& w, size_t l) const;
