@@ -199,9 +199,14 @@ double relative_rmse(const Image& a, const Image& reference) {
   return scale > 0.0 ? rmse(a, reference) / scale : rmse(a, reference);
 }
 
-LitPixelError lit_pixel_error(const Image& image, const Image& reference, const Image* reference_std_error, const Image* lit,
-                              double threshold) {
-  const Image& mask = lit ? *lit : reference;
+namespace {
+
+// Calls visit(x, y, d, se) for every lit pixel (luminance of `mask` at least `threshold` times its
+// peak), d = (image - reference) / reference and se = standard error / reference (0 without
+// reference_std_error), all in luminance: the pixels lit_pixel_error and worst_pixels measure.
+template <class Visit>
+void for_each_lit_pixel(const Image& image, const Image& reference, const Image* reference_std_error, const Image& mask,
+                        double threshold, const Visit& visit) {
   if (image.width() != reference.width() || image.height() != reference.height() || mask.width() != reference.width() ||
       mask.height() != reference.height())
     throw Error("image", to_text(image.width()) + " x " + to_text(image.height()),
@@ -209,16 +214,24 @@ LitPixelError lit_pixel_error(const Image& image, const Image& reference, const 
   double peak = 0.0;
   for (int y = 0; y < mask.height(); ++y)
     for (int x = 0; x < mask.width(); ++x) peak = std::max(peak, luminance(mask.at(x, y)));
-  LitPixelError e;
-  double squared = 0.0, noise = 0.0;
   for (int y = 0; y < reference.height(); ++y)
     for (int x = 0; x < reference.width(); ++x) {
       if (luminance(mask.at(x, y)) < threshold * peak) continue;
-      const double ref = luminance(reference.at(x, y)), d = (luminance(image.at(x, y)) - ref) / ref;
-      const double se = reference_std_error ? luminance(reference_std_error->at(x, y)) / ref : 0.0;
-      e.mean_abs += std::abs(d), e.signed_mean += d, squared += d * d, noise += se * se;
-      ++e.pixels;
+      const double ref = luminance(reference.at(x, y));
+      visit(x, y, (luminance(image.at(x, y)) - ref) / ref, reference_std_error ? luminance(reference_std_error->at(x, y)) / ref : 0.0);
     }
+}
+
+}  // namespace
+
+LitPixelError lit_pixel_error(const Image& image, const Image& reference, const Image* reference_std_error, const Image* lit,
+                              double threshold) {
+  LitPixelError e;
+  double squared = 0.0, noise = 0.0;
+  for_each_lit_pixel(image, reference, reference_std_error, lit ? *lit : reference, threshold, [&](int, int, double d, double se) {
+    e.mean_abs += std::abs(d), e.signed_mean += d, squared += d * d, noise += se * se;
+    ++e.pixels;
+  });
   if (e.pixels == 0) return e;
   const double n = e.pixels;
   e.mean_abs /= n, e.signed_mean /= n;
@@ -232,22 +245,12 @@ LitPixelError lit_pixel_error(const Image& image, const Image& reference, const 
 
 std::vector<PixelError> worst_pixels(const Image& image, const Image& reference, const Image* reference_std_error, int count,
                                      double threshold) {
-  const LitPixelError checked = lit_pixel_error(image, reference, reference_std_error, nullptr, threshold);  // sizes
-  double peak = 0.0;
-  for (int y = 0; y < reference.height(); ++y)
-    for (int x = 0; x < reference.width(); ++x) peak = std::max(peak, luminance(reference.at(x, y)));
   std::vector<PixelError> all;
-  all.reserve(static_cast<size_t>(checked.pixels));
   double total = 0.0;
-  for (int y = 0; y < reference.height(); ++y)
-    for (int x = 0; x < reference.width(); ++x) {
-      const double ref = luminance(reference.at(x, y));
-      if (ref < threshold * peak) continue;
-      PixelError e{x, y, (luminance(image.at(x, y)) - ref) / ref, reference_std_error ? luminance(reference_std_error->at(x, y)) / ref : 0.0};
-      e.share = e.relative * e.relative - e.noise * e.noise;
-      total += e.share;
-      all.push_back(e);
-    }
+  for_each_lit_pixel(image, reference, reference_std_error, reference, threshold, [&](int x, int y, double d, double se) {
+    all.push_back({x, y, d, se, d * d - se * se});
+    total += all.back().share;
+  });
   const auto n = std::min(all.size(), static_cast<size_t>(std::max(count, 0)));
   std::partial_sort(all.begin(), all.begin() + static_cast<std::ptrdiff_t>(n), all.end(),
                     [](const PixelError& a, const PixelError& b) { return a.share > b.share; });

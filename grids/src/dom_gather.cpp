@@ -91,6 +91,7 @@ Rgb Gather::along(const Ray& ray, double t_end, const Eigen::VectorXd* c, const 
   const double step = only == kAll ? step_ : kGlowStep * step_;
   const int steps = static_cast<int>(std::ceil((t1 - t0) / step));
   const double dt = (t1 - t0) / steps;
+  const bool beside_spheres = c && surfaces_ && cone == 0.0 && !spheres_.empty();  // camera rays: sphere_correction
   LightArrival a;
   for (int s = 0; s < steps; ++s) {
     const Vec3 p = ray.at(t0 + (s + 0.5) * dt);
@@ -105,13 +106,13 @@ Rgb Gather::along(const Ray& ray, double t_end, const Eigen::VectorXd* c, const 
         const float* cell = moments + stencil.offset[e] * n;
         for (size_t k = 0; k < n; ++k) m[k] += stencil.weight[e] * static_cast<double>(cell[k]);
       }
-      double j = 0.0, mean = 0.0;
-      for (size_t k = 0; k < n; ++k) j += (*c)(static_cast<int>(k)) * m[k], mean += mean_radiance_(static_cast<int>(k)) * m[k];
+      double j = 0.0;
+      for (size_t k = 0; k < n; ++k) j += (*c)(static_cast<int>(k)) * m[k];
       inscattered[ch] = j;
-      mean_scattered[ch] = mean;
+      for (size_t k = 0; beside_spheres && k < n; ++k) mean_scattered[ch] += mean_radiance_(static_cast<int>(k)) * m[k];
     }
     if (solution_.channels == 1) inscattered = Rgb(inscattered[0]), mean_scattered = Rgb(mean_scattered[0]);
-    if (c && surfaces_ && cone == 0.0) inscattered -= sphere_correction(p, ray.direction, mean_scattered);  // camera rays
+    if (beside_spheres) inscattered -= sphere_correction(p, ray.direction, mean_scattered);
     Rgb single(0.0);
     const double radius = cone * (t0 + (s + 0.5) * dt);
     for (size_t l = 0; l < delta_.lights.size(); ++l) {

@@ -206,7 +206,7 @@ FirstCollision Transport::first_collision(const ExtinctionVolume& volume, const 
   // 1 / d^2 peak, which its centre alone undercounts: by half in the light's own cell), over
   // midpoints of a kAverage^3 (kAverageOwn^3 in the light's own cell) subgrid; the light's own
   // cell scatters it isotropically.
-  const double near = kNearCells * std::max({h.x, h.y, h.z});
+  const double near = kNearCells * std::max({h.x, h.y, h.z}), on_light = 1e-3 * std::min({h.x, h.y, h.z});
   auto cell_irradiance = [&](const Light& light, const Vec3& x, int n) {
     double sum = 0.0;
     LightArrival b;
@@ -214,7 +214,7 @@ FirstCollision Transport::first_collision(const ExtinctionVolume& volume, const 
       const Vec3 f((c % n + 0.5) / n - 0.5, ((c / n) % n + 0.5) / n - 0.5, (c / (n * n) + 0.5) / n - 0.5);
       // A midpoint within a thousandth of a cell of the light (whose 1 / d^2 integrates to next
       // to nothing over that ball) counts nothing.
-      if (arrival(light, x + f * h, b) && b.distance > 1e-3 * std::min({h.x, h.y, h.z})) sum += b.irradiance[channel];
+      if (arrival(light, x + f * h, b) && b.distance > on_light) sum += b.irradiance[channel];
     }
     return sum / (n * n * n);
   };

@@ -4,6 +4,7 @@
 #include <haze/core/scene.h>
 
 #include <cmath>
+#include <optional>
 
 namespace haze::grids {
 
@@ -35,6 +36,21 @@ inline Scene lit_cloud(bool rbf, int width, int height) {
     scene.medium->density = ConstantDensity{1.0};
     scene.medium->bounds = {Vec3(-0.6, -0.5, -0.5), Vec3(0.6, 0.5, 0.5)};
   }
+  return scene;
+}
+
+// Homogeneous fog filling [-1, 1]^3, seen whole from (0, 0, 4) at 32 x 32 pixels; no lights. The
+// phase function is Henyey-Greenstein with g, isotropic without it.
+inline Scene fog_cube(double sigma_t, double albedo, std::optional<double> g = std::nullopt) {
+  Scene scene;
+  scene.camera.position = Vec3(0.0, 0.0, 4.0);
+  scene.camera.fov_y_deg = 40.0;
+  scene.camera.width_px = scene.camera.height_px = 32;
+  MediumDesc fog;
+  fog.bounds = {Vec3(-1.0), Vec3(1.0)};
+  fog.sigma_t = Rgb(sigma_t), fog.albedo = Rgb(albedo);
+  if (g) fog.phase = PhaseFunction::henyey_greenstein(*g);
+  scene.medium = fog;
   return scene;
 }
 

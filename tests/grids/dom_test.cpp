@@ -297,18 +297,11 @@ TEST(DomRender, WhiteFurnace) {
 // A point light inside fog (optical radius 1.5, albedo 0.9) at a cell's centre: its first-collision
 // source is the 1 / d^2 peak averaged over each cell near it, which the cell centres undercount (by
 // half in the light's own cell). The image's signed mean over the lit pixels is within 8% of the
-// reference (whose own standard error there is 0.6%): measured -4.6% at 16^3, -9.6% with the
-// centres' values (against a 4096-spp reference: -5.7% and -10.7% at 16^3, -3.8% and -6.6% at 32^3).
+// reference (whose own standard error there is 0.6%): measured -4.7% at 16^3, -9.6% with the
+// centres' values (against a 4096-spp reference: -5.8% and -10.7% at 16^3, -3.8% and -6.6% at 32^3).
 TEST(DomRender, PointLightInsideTheFog) {
   register_methods();
-  Scene scene;
-  scene.camera.position = Vec3(0.0, 0.0, 4.0);
-  scene.camera.fov_y_deg = 40.0;
-  scene.camera.width_px = scene.camera.height_px = 32;
-  MediumDesc fog;
-  fog.bounds = {Vec3(-1.0), Vec3(1.0)};
-  fog.sigma_t = Rgb(1.5), fog.albedo = Rgb(0.9);
-  scene.medium = fog;
+  Scene scene = fog_cube(1.5, 0.9);
   scene.lights.push_back(PointLight{Vec3(0.0625), Rgb(1.0)});  // a cell centre at 16^3
   RenderOptions reference_options;
   reference_options.settings = {{"spp", 1024}, {"seed", 3}};

@@ -7,6 +7,8 @@
 #include <haze/core/method.h>
 #include <haze/grids/methods.h>
 
+#include "../grids/cloud_scene.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -236,14 +238,7 @@ TEST(SurfaceLight, DomGathersALightsGlowAndAGlossyLobeWithoutAliasing) {
 // its standard error 0.2%; without the correction +4.9%).
 TEST(SurfaceLight, DomFogBesideASphereInsideTheGrid) {
   grids::register_methods();
-  Scene scene;
-  scene.camera.position = Vec3(0.0, 0.0, 4.0);
-  scene.camera.fov_y_deg = 40.0;
-  scene.camera.width_px = scene.camera.height_px = 32;
-  MediumDesc fog;
-  fog.bounds = {Vec3(-1.0), Vec3(1.0)};
-  fog.sigma_t = Rgb(2.0), fog.albedo = Rgb(0.95), fog.phase = PhaseFunction::henyey_greenstein(0.3);
-  scene.medium = fog;
+  Scene scene = grids::fog_cube(2.0, 0.95, 0.3);
   scene.lights.push_back(DirectionalLight{glm::normalize(Vec3(0.3, -1.0, -0.2)), Rgb(1.0)});
   const Sphere ball{Vec3(0.0), 0.35};
   scene.surfaces.push_back(Surface{ball, Rgb(0.1), Rgb(0.0), 1.0});
