@@ -93,6 +93,10 @@ int run(const RenderArgs& a) {
   const Stopwatch watch;
   RenderResult result = a.display == "gl" ? render_gl(scene, method, options) : render(scene, method, options);
   const double seconds = watch.seconds();
+  // The method's warnings (method auto's: those of the method it chose).
+  for (const nlohmann::json* stats : {&result.stats, result.stats.contains("method_stats") ? &result.stats["method_stats"] : nullptr})
+    if (stats && stats->contains("warnings") && (*stats)["warnings"].is_array())
+      for (const auto& line : (*stats)["warnings"]) std::cerr << "warning: " << line.get<std::string>() << "\n";
   std::filesystem::path out = a.out.empty() ? std::filesystem::path(a.scene).stem().string() + "_" + method + ".exr" : a.out;
   auto summary = save_result(result, method, seconds, out, !a.no_png);
   summary["scene"] = a.scene;

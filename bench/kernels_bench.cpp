@@ -178,10 +178,11 @@ Work march_work(bool scalar) {
           128.0 * static_cast<double>(n), 0.0, {density, depths, lights, in}};
 }
 
-// One DOM row of 64 cells, one octant of 16 directions, 25 terms (items: cell-directions).
-Work dom_work(bool scalar) {
+// One DOM row of 64 cells, one octant of 16 directions, 25 terms, by one spatial scheme (items:
+// cell-directions).
+Work dom_work(bool scalar, bool diamond) {
   const int p = 16, terms = 25, padded = 32, count = 64;
-  auto a = std::make_shared<std::vector<float>>(4 * p), lq = std::make_shared<std::vector<float>>(static_cast<size_t>(terms * p)),
+  auto a = std::make_shared<std::vector<float>>(5 * p, 0.0f), lq = std::make_shared<std::vector<float>>(static_cast<size_t>(terms * p)),
        q = std::make_shared<std::vector<float>>(static_cast<size_t>(p * padded), 0.0f);
   for (int d = 0; d < p; ++d) {
     float sum = 0.0f;
@@ -192,7 +193,7 @@ Work dom_work(bool scalar) {
       (*q)[static_cast<size_t>(d * padded + k)] = 0.02f * static_cast<float>((k * d) % 5);
     }
   }
-  auto octant = std::make_shared<simd::DomOctant>(simd::DomOctant{p, terms, padded, a->data(), lq->data(), q->data()});
+  auto octant = std::make_shared<simd::DomOctant>(simd::DomOctant{p, terms, padded, a->data(), lq->data(), q->data(), diamond});
   auto density = std::make_shared<std::vector<float>>(count, 1.0f), first = std::make_shared<std::vector<float>>(static_cast<size_t>(count * p), 0.1f);
   auto m_in = std::make_shared<std::vector<float>>(static_cast<size_t>(count * terms), 0.05f),
        m_out = std::make_shared<std::vector<float>>(static_cast<size_t>(count * terms));
@@ -356,7 +357,8 @@ int main(int argc, char** argv) {
   register_kernel("to_half", half_work);
   register_kernel("sweep_cells/64^3", sweep_work);
   register_kernel("march_rays/256_rays", march_work, false);
-  register_kernel("dom_sweep_row/64_cells", dom_work);
+  register_kernel("dom_sweep_row/step/64_cells", [](bool scalar) { return dom_work(scalar, false); });
+  register_kernel("dom_sweep_row/diamond/64_cells", [](bool scalar) { return dom_work(scalar, true); });
   benchmark::Initialize(&count, args.data());
   Collector collector;
   benchmark::RunSpecifiedBenchmarks(&collector);

@@ -46,14 +46,20 @@ bool GridWalk::next(CellSegment& segment) {
   return true;
 }
 
-TrilinearStencil::TrilinearStencil(const Aabb& bounds, const std::array<int, 3>& n, const Vec3& p) {
+TrilinearStencil::TrilinearStencil(const Aabb& bounds, const std::array<int, 3>& n, const Vec3& p, bool extrapolate) {
   const Vec3 u = (p - bounds.lo) / (bounds.extent() / Vec3(n[0], n[1], n[2])) - 0.5;
   size_t i[2][3];
   double f[3];
   for (int a = 0; a < 3; ++a) {
     const double fl = std::floor(u[a]);
-    f[a] = u[a] - fl;
     const int last = n[static_cast<size_t>(a)] - 1;
+    if (extrapolate && last > 0) {  // the cell pair within the grid, f beyond [0, 1] in the outer half cells
+      const int i0 = std::clamp(static_cast<int>(fl), 0, last - 1);
+      i[0][a] = static_cast<size_t>(i0), i[1][a] = static_cast<size_t>(i0 + 1);
+      f[a] = std::clamp(u[a] - i0, -0.5, 1.5);
+      continue;
+    }
+    f[a] = u[a] - fl;
     i[0][a] = static_cast<size_t>(std::clamp(static_cast<int>(fl), 0, last));
     i[1][a] = static_cast<size_t>(std::clamp(static_cast<int>(fl) + 1, 0, last));
   }

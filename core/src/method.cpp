@@ -92,6 +92,10 @@ SettingInfo SettingInfo::choice(std::string name, std::string fallback, std::vec
   return {std::move(name), Type::choice, std::move(fallback), 0.0, 0.0, std::move(choices), std::move(doc)};
 }
 
+SettingInfo SettingInfo::cells(std::string name, nlohmann::json fallback, long long min, long long max, std::string doc) {
+  return {std::move(name), Type::cells, std::move(fallback), static_cast<double>(min), static_cast<double>(max), {}, std::move(doc)};
+}
+
 namespace {
 std::string quoted_list(const std::vector<std::string>& names) {
   std::string out;
@@ -100,8 +104,11 @@ std::string quoted_list(const std::vector<std::string>& names) {
 }
 std::string range(const SettingInfo& s) {
   if (s.type == SettingInfo::Type::choice) return "one of " + quoted_list(s.choices);
-  if (s.type == SettingInfo::Type::integer)
-    return "an integer in [" + to_text(static_cast<long long>(s.min)) + ", " + to_text(static_cast<long long>(s.max)) + "]";
+  if (s.type == SettingInfo::Type::integer || s.type == SettingInfo::Type::cells) {
+    std::string out = "an integer in [" + to_text(static_cast<long long>(s.min)) + ", " + to_text(static_cast<long long>(s.max)) + "]";
+    if (s.type == SettingInfo::Type::cells) out += ", or three [nx, ny, nz]";
+    return out;
+  }
   return "a number in [" + to_text(s.min) + ", " + to_text(s.max) + "]";
 }
 }  // namespace
@@ -164,12 +171,24 @@ double Settings::number(const std::string& key, double fallback) {
   return it->get<double>();
 }
 
-std::string Settings::choice(const std::string& key) {
+std::string Settings::choice(const std::string& key) { return choice(key, info(key, SettingInfo::Type::choice).fallback.get<std::string>()); }
+std::string Settings::choice(const std::string& key, const std::string& fallback) {
   const SettingInfo& s = info(key, SettingInfo::Type::choice);
   auto it = settings_.find(key);
-  if (it == settings_.end()) return s.fallback.get<std::string>();
+  if (it == settings_.end()) return fallback;
   if (it->is_string() && std::find(s.choices.begin(), s.choices.end(), it->get<std::string>()) != s.choices.end()) return it->get<std::string>();
   throw Error("method." + key, it->dump(), range(s));
+}
+
+std::vector<int> Settings::cells(const std::string& key) {
+  const SettingInfo& s = info(key, SettingInfo::Type::cells);
+  auto it = settings_.find(key);
+  const nlohmann::json& value = it == settings_.end() ? s.fallback : *it;
+  auto in_range = [&](const nlohmann::json& v) { return v.is_number_integer() && v.get<double>() >= s.min && v.get<double>() <= s.max; };
+  if (in_range(value)) return {value.get<int>()};
+  if (value.is_array() && value.size() == 3 && std::all_of(value.begin(), value.end(), in_range))
+    return {value[0].get<int>(), value[1].get<int>(), value[2].get<int>()};
+  throw Error("method." + key, value.dump(), range(s));
 }
 
 void Settings::reject_unknown() const {

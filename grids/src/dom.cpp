@@ -14,9 +14,27 @@
 #include "dom_surfaces.h"
 #include "dom_internal.h"
 
+#include <algorithm>
+#include <cmath>
+
 namespace haze::grids {
 
 namespace {
+
+// The cells an integer resolution gives at least through a thinner side, per optical depth
+// through it (CellCount::per_optical_depth).
+constexpr double kCellsPerOpticalDepth = 4.0;
+
+// A cell's optical thickness across its thinnest side above which dom_fields warns.
+constexpr double kThickCell = 2.0;
+
+// The largest optical thickness of a cell across its thinnest side, at the largest sigma_t.
+double thickest_cell(const ExtinctionVolume& volume) {
+  const Vec3 h = volume.density.cell_size();
+  const std::vector<float>& rho = volume.density.values();
+  const float densest = rho.empty() ? 0.0f : *std::max_element(rho.begin(), rho.end());
+  return std::max({volume.sigma_t_scale.r, volume.sigma_t_scale.g, volume.sigma_t_scale.b}) * static_cast<double>(densest) * std::min({h.x, h.y, h.z});
+}
 
 // The depths the first-collision source reads at cell centres: those of the cells a surface hides
 // from a light made opaque (shadowed_depths); the depths themselves without surfaces.
@@ -166,7 +184,7 @@ class DomMethodSolution final : public GridSolution {
   DomMethodSolution(const Scene& scene, DomFields fields)
       : GridSolution(scene, std::move(fields.volume), std::move(fields.delta_depths), fields.step_cells),
         solution_(std::move(fields.solution)),
-        resolution_(fields.resolution),
+        cells_(fields.cells),
         settings_(fields.settings),
         depth_(fields.depth),
         warm_iterations_(fields.warm_iterations),
@@ -193,7 +211,7 @@ class DomMethodSolution final : public GridSolution {
     depth_.threads = settings_.threads = options.threads;
     if (change.medium) {
       const std::array<int, 3> shape = volume_.density.resolution();
-      report.redone.push_back(replace_volume(scene, change, resolution_, 0.0, options.threads));
+      report.redone.push_back(replace_volume(scene, change, cells_, 0.0, options.threads));
       if (volume_.density.resolution() != shape) return std::nullopt;  // a new shape: solve again
     }
     update_depths(scene, change.medium.has_value(), depth_, report);
@@ -222,7 +240,7 @@ class DomMethodSolution final : public GridSolution {
 
  private:
   DomSolution solution_;
-  int resolution_;
+  CellCount cells_;
   DomSettings settings_;
   DepthOptions depth_;
   int warm_iterations_;
@@ -240,13 +258,23 @@ class DomMethod final : public Method {
 
 DomFields dom_fields(const Scene& scene, const RenderOptions& options) {
   Settings settings(options.settings, "dom");
-  const int resolution = static_cast<int>(settings.integer("resolution"));
+  // Cells along the longest side, at least 4 per optical depth through a thinner axis (up to 32),
+  // or exactly the three counts given.
+  CellCount cells;
+  if (const std::vector<int> n = settings.cells("resolution"); n.size() == 3) {
+    cells.axes = {n[0], n[1], n[2]};
+  } else {
+    cells.longest = n[0];
+    cells.per_optical_depth = kCellsPerOpticalDepth;
+  }
   DomSettings dom;
   dom.directions = static_cast<int>(settings.integer("directions"));
   dom.terms = static_cast<int>(settings.integer("terms", std::min(dom.terms, dom.directions)));
   if (dom.terms > dom.directions)
     throw Error("method.terms", to_text(dom.terms), "at most method.directions (" + to_text(dom.directions) + "), or 0 for the full matrix");
   dom.scheme = dom_scheme_from_name(settings.choice("scheme"));
+  // The paper's scheme is the step scheme: it takes diamond only when asked (and refuses it).
+  dom.spatial = dom_spatial_from_name(settings.choice("spatial", dom.scheme == DomScheme::paper ? "step" : "diamond"));
   dom.accelerator = dom_accelerator_from_name(settings.choice("accelerator"));
   dom.max_iterations = static_cast<int>(settings.integer("iterations"));
   dom.tolerance = settings.number("tolerance");
@@ -263,7 +291,7 @@ DomFields dom_fields(const Scene& scene, const RenderOptions& options) {
   settings.reject_unknown();
 
   Stopwatch watch;
-  ExtinctionVolume volume = make_extinction_volume(scene, resolution, 0.0, options.threads);
+  ExtinctionVolume volume = make_extinction_volume(scene, cells, 0.0, options.threads);
   // Delta lights get depth volumes; the sky enters the solver through the boundary and reaches
   // the eye as background.
   std::vector<DenseGrid> delta_depths;
@@ -276,7 +304,7 @@ DomFields dom_fields(const Scene& scene, const RenderOptions& options) {
   const double solve_seconds = watch.lap();
   dom.progress = nullptr;
   solved_surfaces.solution.texel_surfaces = texel_surfaces;
-  DomFields fields{std::move(volume), std::move(delta_depths), std::move(solved_surfaces.solution), step_cells, {}, resolution, dom, depth,
+  DomFields fields{std::move(volume), std::move(delta_depths), std::move(solved_surfaces.solution), step_cells, {}, cells, dom, depth,
                    warm_iterations, surface_passes};
   const ExtinctionVolume& v = fields.volume;
   const DomSolution& solved = fields.solution;
@@ -286,6 +314,7 @@ DomFields dom_fields(const Scene& scene, const RenderOptions& options) {
                   {"phase_relative_error", solved.separable->relative_error()},
                   {"delta_m_fraction", solved.delta_m_fraction},
                   {"scheme", name(dom.scheme)},
+                  {"spatial", name(dom.spatial)},
                   {"accelerator", name(dom.accelerator)},
                   {"storage", name(dom.storage)},
                   {"channels", solved.channels},
@@ -299,6 +328,22 @@ DomFields dom_fields(const Scene& scene, const RenderOptions& options) {
                   {"memory_bytes", solved.bytes},
                   {"depth_seconds", depth_seconds},
                   {"solve_seconds", solve_seconds}};
+  // No silent failure: cells thicker than kThickCell across their thinnest side smear light
+  // (the diamond scheme falls back to the step scheme's first order there).
+  const double thickest = thickest_cell(v);
+  fields.stats["thickest_cell"] = thickest;
+  fields.stats["warnings"] = nlohmann::json::array();
+  if (thickest > kThickCell) {
+    std::string enough = "[";
+    for (int n : v.density.resolution())
+      (enough += enough.size() > 1 ? ", " : "") += to_text(static_cast<int>(std::min(1024.0, std::ceil(n * thickest / kThickCell))));
+    fields.stats["warnings"].push_back("dom: cells up to " + to_text(thickest) + " optical depths thick across (above " + to_text(kThickCell) +
+                                       ", errors of 5% and more are likely: docs/DOM.md); set resolution to " + enough + "] or more");
+  }
+  if (!solved.converged)
+    fields.stats["warnings"].push_back("dom: not converged in " + to_text(dom.max_iterations) + " iterations (last change " +
+                                       to_text(solved.changes.empty() ? 0.0 : solved.changes.back()) + " > tolerance " +
+                                       to_text(dom.tolerance) + "); raise iterations");
   return fields;
 }
 
@@ -348,10 +393,13 @@ MethodInfo dom_info() {
                   "planes and spheres: shadows, the medium's light onto them and theirs into it (outside the grid or on its faces), and between them", true};
   const DomSettings d;
   info.settings = {
-      SettingInfo::integer("resolution", 64, 2, 1024, "cells along the longest side of the medium's bounds (RBF and constant)"),
+      SettingInfo::cells("resolution", 64, 2, 1024,
+                         "RBF and constant media: cells along the longest side of the bounds (and at least 4 per optical depth through a thinner side, up to 32), or [nx, ny, nz]"),
       SettingInfo::integer("directions", d.directions, 8, 4096, "D, spherical Fibonacci directions"),
       SettingInfo::integer("terms", nullptr, 0, 4096, "N separable terms of the phase matrix: min(25, D); 0 or D: the full matrix"),
       SettingInfo::choice("scheme", "sweep", {"paper", "sweep"}, "sweep: upwind transport sweeps; paper: seed 000's Jacobi scheme"),
+      SettingInfo::choice("spatial", "diamond", {"step", "diamond"},
+                          "how radiance leaves a cell: weighted diamond difference (second order), or seed 000's step (step with scheme paper)"),
       SettingInfo::choice("accelerator", "gmres", {"none", "gmres"}, "GMRES on the moments, or plain source iteration"),
       SettingInfo::integer("iterations", d.max_iterations, 1, 100000, "transport sweeps per channel at most"),
       SettingInfo::number("tolerance", d.tolerance, 1e-9, 1.0, "stop when an iteration changes the moments by less (relative)"),

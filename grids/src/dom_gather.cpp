@@ -98,17 +98,21 @@ Rgb Gather::along(const Ray& ray, double t_end, const Eigen::VectorXd* c, const 
     const TrilinearStencil stencil(density.bounds(), density.resolution(), p);
     const double rho = stencil.apply(density.values().data());
     if (rho <= 0.0) continue;
+    // The moments and the depth to each light keep their slope into the outer half cells
+    // (clamped there, the top half cell of a slab under a grazing sun would be lit as deep as its
+    // centre, and a grazing view would see the centre's in-scattering up to the face).
+    const TrilinearStencil outer(density.bounds(), density.resolution(), p, true);
     Rgb inscattered(0.0), mean_scattered(0.0);
     for (int ch = 0; c && ch < solution_.channels; ++ch) {
       std::fill(m, m + n, 0.0);
       const float* moments = solution_.moments[static_cast<size_t>(ch)].data();
       for (int e = 0; e < 8; ++e) {
-        const float* cell = moments + stencil.offset[e] * n;
-        for (size_t k = 0; k < n; ++k) m[k] += stencil.weight[e] * static_cast<double>(cell[k]);
+        const float* cell = moments + outer.offset[e] * n;
+        for (size_t k = 0; k < n; ++k) m[k] += outer.weight[e] * static_cast<double>(cell[k]);
       }
       double j = 0.0;
       for (size_t k = 0; k < n; ++k) j += (*c)(static_cast<int>(k)) * m[k];
-      inscattered[ch] = j;
+      inscattered[ch] = std::max(0.0, j);
       for (size_t k = 0; beside_spheres && k < n; ++k) mean_scattered[ch] += mean_radiance_(static_cast<int>(k)) * m[k];
     }
     if (solution_.channels == 1) inscattered = Rgb(inscattered[0]), mean_scattered = Rgb(mean_scattered[0]);
@@ -133,7 +137,7 @@ Rgb Gather::along(const Ray& ray, double t_end, const Eigen::VectorXd* c, const 
       }
       if (q == Rgb(0.0)) continue;
       if (a.distance < radius) q *= (a.distance / radius) * (a.distance / radius);
-      const double depth = stencil.apply(depths_[l].values().data());
+      const double depth = std::max(0.0, outer.apply(depths_[l].values().data()));
       const double visible = visibility_.empty() ? 1.0 : stencil.apply(visibility_[l].values().data());
       single += (share ? share[l] : 1.0) * q * visible * glm::exp(-volume_.sigma_t_scale * depth);
     }

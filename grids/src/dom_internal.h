@@ -45,10 +45,10 @@ struct Faces {
 class Transport {
  public:
   Transport(const DenseGrid& density, const DirectionSet& directions, const PhaseMatrix& matrix, const SeparablePhase& separable,
-            bool scalar_kernel);
+            DomSpatial spatial, bool scalar_kernel);
 
-  // One upwind sweep of every direction with the step scheme (a face carries its upwind cell's
-  // value):  L_d = (sigma_s S_d + sum_e a_e L_up,e) / (sigma_t + sum_e a_e),  a_e = |w_e| / h_e,
+  // One upwind sweep of every direction by the spatial scheme (simd/dom_sweep.h; step:
+  // L_d = (sigma_s S_d + sum_e a_e L_up,e) / (sigma_t + sum_e a_e),  a_e = |w_e| / h_e), with
   //   S_d = first[cell][d] + sum_k lambda_k Q[d][k] m_in[cell * N + k]   (seed 000 eq. 9),
   // radiance `boundary` entering through every face (or, given, `faces`), and the moments of the
   // result  m_out[cell * N + k] = sum_d Q[d][k] L_d   (eq. 10).

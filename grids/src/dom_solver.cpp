@@ -24,6 +24,13 @@ DomScheme dom_scheme_from_name(const std::string& name) {
 }
 const char* name(DomScheme scheme) { return scheme == DomScheme::paper ? "paper" : "sweep"; }
 
+DomSpatial dom_spatial_from_name(const std::string& name) {
+  if (name == "step") return DomSpatial::step;
+  if (name == "diamond") return DomSpatial::diamond;
+  throw Error("spatial", name, "\"step\" or \"diamond\"");
+}
+const char* name(DomSpatial spatial) { return spatial == DomSpatial::step ? "step" : "diamond"; }
+
 DomAccelerator dom_accelerator_from_name(const std::string& name) {
   if (name == "none") return DomAccelerator::none;
   if (name == "gmres") return DomAccelerator::gmres;
@@ -267,6 +274,8 @@ DomSolution solve_dom(const ExtinctionVolume& volume, const std::vector<Light>& 
   if (!(settings.tolerance > 0.0)) throw Error("tolerance", to_text(settings.tolerance), "a relative change > 0");
   if (settings.storage == DomStorage::float16 && settings.scheme == DomScheme::paper)
     throw Error("storage", "float16", "float32 with scheme \"paper\" (float16 storage is for scheme \"sweep\")");
+  if (settings.spatial == DomSpatial::diamond && settings.scheme == DomScheme::paper)
+    throw Error("spatial", "diamond", "\"step\" with scheme \"paper\" (the paper's Jacobi update is the step scheme)");
   if (boundary && settings.scheme == DomScheme::paper)
     throw Error("scheme", "paper", "scheme \"sweep\" with a boundary (the paper's scheme takes only the sky's radiance)");
   std::vector<Light> delta_lights;
@@ -308,7 +317,7 @@ DomSolution solve_dom(const ExtinctionVolume& volume, const std::vector<Light>& 
   }
   out.matrix = std::make_shared<PhaseMatrix>(out.phase, *out.directions);
   out.separable = std::make_shared<SeparablePhase>(*out.matrix, kept_terms(settings));
-  const dom::Transport transport(volume.density, *out.directions, *out.matrix, *out.separable, settings.scalar_kernel);
+  const dom::Transport transport(volume.density, *out.directions, *out.matrix, *out.separable, settings.spatial, settings.scalar_kernel);
   const size_t size = volume.density.cell_count() * static_cast<size_t>(out.terms());
   const std::vector<dom::Faces> faces = boundary ? transport.faces(*boundary, volume.density, out.channels, settings.threads)
                                                  : std::vector<dom::Faces>();

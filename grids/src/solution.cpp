@@ -37,17 +37,17 @@ Rgb project(const DomSolution& s, const DenseGrid& grid, const Vec3& x, const Ei
 
 }  // namespace
 
-std::string GridSolution::replace_volume(const Scene& scene, const SceneChange& change, int resolution, double cutoff, int threads) {
+std::string GridSolution::replace_volume(const Scene& scene, const SceneChange& change, const CellCount& cells, double cutoff, int threads) {
   const MediumDesc& next = *change.medium;
   const auto* old_rbf = std::get_if<RbfDensity>(&scene_.medium->density);
   const auto* rbf = std::get_if<RbfDensity>(&next.density);
   std::string redone = "extinction volume";
   if (old_rbf && rbf && change.region && medium_bounds(next) == medium_bounds(*scene_.medium) &&
       injection_cutoff(rbf->blobs, cutoff) == injection_cutoff(old_rbf->blobs, cutoff)) {
-    const size_t cells = reinject_region(rbf->blobs, volume_.density, *change.region, injection_cutoff(rbf->blobs, cutoff), 8, threads);
-    redone += ": " + to_text(cells) + " of " + to_text(volume_.density.cell_count()) + " cells re-injected";
+    const size_t injected = reinject_region(rbf->blobs, volume_.density, *change.region, injection_cutoff(rbf->blobs, cutoff), 8, threads);
+    redone += ": " + to_text(injected) + " of " + to_text(volume_.density.cell_count()) + " cells re-injected";
   } else {
-    volume_.density = make_extinction_volume(scene, resolution, cutoff, threads).density;
+    volume_.density = make_extinction_volume(scene, cells, cutoff, threads).density;
   }
   volume_.sigma_t_scale = next.sigma_t, volume_.albedo = next.albedo, volume_.phase = next.phase;
   return redone;

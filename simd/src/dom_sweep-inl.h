@@ -16,6 +16,34 @@ HWY_BEFORE_NAMESPACE();
 namespace haze::simd::HWY_NAMESPACE {
 namespace hn = hwy::HWY_NAMESPACE;
 
+// The diamond scheme on one vector of directions (dom_sweep.h; the scalar reference's diamond_g,
+// lane by lane): the cell's mean radiance, and the leaving values stored into the faces x, y, z in
+// place of the entering ones. `sum`: a_x + a_y + a_z.
+template <class D, class V = hn::Vec<D>>
+HWY_INLINE V Diamond(D d, V sigma_t, V sigma_s_times_s, V pad, const V a[3], V sum, float* HWY_RESTRICT x, float* HWY_RESTRICT y,
+                     float* HWY_RESTRICT z) {
+  const V zero = hn::Zero(d), one = hn::Set(d, 1.0f), tiny = hn::Set(d, kDiamondTiny), two = hn::Set(d, 2.0f), three = hn::Set(d, 3.0f),
+          six = hn::Set(d, 6.0f);
+  const V sigma2 = hn::Mul(sigma_t, sigma_t), two_sigma = hn::Mul(two, sigma_t), three_sigma = hn::Mul(three, sigma_t);
+  const V around = hn::MulAdd(two, sum, sigma_t);  // sigma + 2 sum
+  float* HWY_RESTRICT face[3] = {x, y, z};
+  V in[3], g[3];
+  V num = sigma_s_times_s, den = hn::Add(sigma_t, pad);
+  for (int e = 0; e < 3; ++e) {
+    in[e] = hn::LoadU(d, face[e]);
+    const V g_tau = hn::Div(hn::MulAdd(a[e], hn::MulAdd(six, a[e], three_sigma), sigma2),
+                            hn::Max(hn::MulAdd(a[e], hn::MulAdd(three, a[e], two_sigma), sigma2), tiny));
+    const V q = hn::NegMulAdd(three, a[e], around), bound = hn::Div(hn::NegMulAdd(two, a[e], around), hn::Max(q, tiny));
+    g[e] = hn::IfThenElse(hn::Gt(q, zero), hn::Min(g_tau, bound), g_tau);
+    const V b = hn::Mul(a[e], g[e]);
+    num = hn::MulAdd(b, in[e], num);
+    den = hn::Add(den, b);
+  }
+  const V l = hn::Div(num, hn::Max(den, tiny));
+  for (int e = 0; e < 3; ++e) hn::StoreU(hn::NegMulAdd(hn::Sub(g[e], one), in[e], hn::Mul(g[e], l)), d, face[e]);
+  return l;
+}
+
 // Lanes over directions (at most 8, the padding unit), then over terms for the moments. Up to four
 // vectors accumulate side by side in registers: independent FMA chains, no store-load round trips.
 void DomSweepRow(const DomOctant& o, const DomRow& r) {
@@ -30,6 +58,7 @@ void DomSweepRow(const DomOctant& o, const DomRow& r) {
   const float* HWY_RESTRICT ay = o.a + p;
   const float* HWY_RESTRICT az = o.a + 2 * p;
   const float* HWY_RESTRICT asum = o.a + 3 * p;
+  const float* HWY_RESTRICT pad = o.a + 4 * p;
   for (int m = 0; m < r.count; ++m) {
     const size_t c = r.cell0 + static_cast<size_t>(static_cast<long>(m) * r.step);
     const auto x = static_cast<size_t>(r.x0 + m * r.step);
@@ -60,7 +89,13 @@ void DomSweepRow(const DomOctant& o, const DomRow& r) {
           if (count > 3) s[3] = hn::MulAdd(hn::LoadU(d, lq + 3 * lanes), mk, s[3]);
         }
       }
-      for (size_t v = 0; v < count; ++v) {
+      for (size_t v = 0; o.diamond && v < count; ++v) {
+        const size_t e = i + v * lanes;
+        const V a[3] = {hn::LoadU(d, ax + e), hn::LoadU(d, ay + e), hn::LoadU(d, az + e)};
+        const V sum = hn::Add(hn::Add(a[0], a[1]), a[2]);
+        hn::StoreU(Diamond(d, sigma_t, hn::Mul(sigma_s, s[v]), hn::LoadU(d, pad + e), a, sum, r.x_run + e, y + e, z + e), d, light + e);
+      }
+      for (size_t v = 0; !o.diamond && v < count; ++v) {
         const size_t e = i + v * lanes;
         V in = hn::Mul(hn::LoadU(d, ax + e), hn::LoadU(d, r.x_run + e));
         in = hn::MulAdd(hn::LoadU(d, ay + e), hn::LoadU(d, y + e), in);

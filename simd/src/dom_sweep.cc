@@ -7,10 +7,27 @@
 
 #include <hwy/highway.h>
 
+#include <algorithm>
+
 #if HWY_ONCE
 namespace haze::simd {
 
 HWY_EXPORT(DomSweepRow);
+
+namespace {
+
+// 1 / alpha_e of the diamond scheme on one axis (dom_sweep.h) for a cell of extinction sigma,
+// a = |w_e| / h_e and sum = a_x + a_y + a_z, without dividing by a (tau = sigma / a):
+//   1 / alpha(tau) = (sigma^2 + 3 sigma a + 6 a^2) / (sigma^2 + 2 sigma a + 3 a^2),
+//   1 / (1 - a / (sigma + 2 (sum - a))) = (sigma + 2 sum - 2 a) / (sigma + 2 sum - 3 a) where that
+//   bound is positive (else it does not bind), the smaller of the two.
+float diamond_g(float sigma, float a, float sum) {
+  const float g = (a * (6.0f * a + 3.0f * sigma) + sigma * sigma) / std::max(a * (3.0f * a + 2.0f * sigma) + sigma * sigma, kDiamondTiny);
+  const float q = sigma + 2.0f * sum - 3.0f * a;
+  return q > 0.0f ? std::min(g, (sigma + 2.0f * sum - 2.0f * a) / q) : g;
+}
+
+}  // namespace
 
 void dom_sweep_row_reference(const DomOctant& o, const DomRow& r) {
   const auto p = static_cast<size_t>(o.directions), n = static_cast<size_t>(o.terms), np = static_cast<size_t>(o.terms_padded);
@@ -28,8 +45,21 @@ void dom_sweep_row_reference(const DomOctant& o, const DomRow& r) {
                 : r.first_half ? r.first_scale[c] * static_cast<float>(r.first_half[c * r.first_stride + d]) : 0.0f;
       if (r.m_in && !empty)
         for (size_t k = 0; k < n; ++k) s += o.lq[k * p + d] * r.m_in[c * n + k];
-      const float l = (sigma_s * s + o.a[d] * r.x_run[d] + o.a[p + d] * y[d] + o.a[2 * p + d] * z[d]) / (sigma_t + o.a[3 * p + d]);
-      r.x_run[d] = y[d] = z[d] = light[d] = l;
+      if (!o.diamond) {
+        const float l = (sigma_s * s + o.a[d] * r.x_run[d] + o.a[p + d] * y[d] + o.a[2 * p + d] * z[d]) / (sigma_t + o.a[3 * p + d]);
+        r.x_run[d] = y[d] = z[d] = light[d] = l;
+        continue;
+      }
+      float* face[3] = {r.x_run + d, y + d, z + d};
+      const float sum = o.a[d] + o.a[p + d] + o.a[2 * p + d];
+      float g[3], num = sigma_s * s, den = sigma_t + o.a[4 * p + d];
+      for (size_t e = 0; e < 3; ++e) {
+        g[e] = diamond_g(sigma_t, o.a[e * p + d], sum);
+        num += o.a[e * p + d] * g[e] * *face[e], den += o.a[e * p + d] * g[e];
+      }
+      const float l = num / std::max(den, kDiamondTiny);
+      for (size_t e = 0; e < 3; ++e) *face[e] = g[e] * l - (g[e] - 1.0f) * *face[e];
+      light[d] = l;
     }
     float* out = r.m_out + c * n;
     for (size_t k = 0; k < n; ++k) {

@@ -2,6 +2,7 @@
 #include <haze/core/camera.h>
 #include <haze/core/directions.h>
 #include <haze/core/error.h>
+#include <haze/core/grid_walk.h>
 #include <haze/core/integrate.h>
 #include <haze/core/light.h>
 #include <haze/core/medium.h>
@@ -47,6 +48,24 @@ TEST(Aabb, ClipsRays) {
   EXPECT_FALSE(box.clip({Vec3(0, 3, -5), Vec3(0, 0, 1)}, t0, t1));
   EXPECT_FALSE(Aabb{}.bounded());
   EXPECT_TRUE(box.bounded());
+}
+
+// A field linear in x, y, z on a cell-centred 4 x 3 x 2 grid: trilinear weights reproduce it
+// anywhere between the outermost centres; in the half cells beyond them the clamped stencil holds
+// the last centre's value and the extrapolating one keeps the slope up to the faces.
+TEST(TrilinearStencil, ExtrapolatesALinearFieldToTheFaces) {
+  const Aabb box{Vec3(0.0), Vec3(4.0, 3.0, 2.0)};
+  const std::array<int, 3> n{4, 3, 2};
+  auto field = [](const Vec3& p) { return 2.0 * p.x - 3.0 * p.y + 0.5 * p.z + 1.0; };
+  std::vector<double> values;
+  for (int k = 0; k < 2; ++k)
+    for (int j = 0; j < 3; ++j)
+      for (int i = 0; i < 4; ++i) values.push_back(field(Vec3(i + 0.5, j + 0.5, k + 0.5)));
+  for (const Vec3& p : {Vec3(1.7, 1.2, 0.9), Vec3(0.1, 2.9, 1.8), Vec3(4.0, 0.0, 0.0), Vec3(3.8, 1.5, 1.95)}) {
+    EXPECT_NEAR(TrilinearStencil(box, n, p, true).apply(values.data()), field(p), 1e-12) << p.x << " " << p.y << " " << p.z;
+    const Vec3 inside = glm::clamp(p, Vec3(0.5), Vec3(3.5, 2.5, 1.5));  // what clamping sees
+    EXPECT_NEAR(TrilinearStencil(box, n, p).apply(values.data()), field(inside), 1e-12);
+  }
 }
 
 TEST(Surface, IntersectsPlanesAndSpheres) {

@@ -37,12 +37,15 @@ class GridWalk {
 
 // The eight cells around p on a cell-centred grid over bounds (x fastest) and their trilinear
 // weights, clamped to the outermost centres; computed once and applied to every grid on the same
-// cells (a density and each light's depth).
+// cells (a density and each light's depth). With `extrapolate`, a point in the half cell between
+// the outermost centres and the bounds takes the line through the last two centres instead (the
+// weights stay summing to 1, one of them negative): a field that varies linearly, such as the
+// optical depth to a light, keeps its slope up to the faces.
 struct TrilinearStencil {
   size_t offset[8];
   double weight[8];
 
-  TrilinearStencil(const Aabb& bounds, const std::array<int, 3>& n, const Vec3& p);
+  TrilinearStencil(const Aabb& bounds, const std::array<int, 3>& n, const Vec3& p, bool extrapolate = false);
   template <class T>
   double apply(const T* values) const {
     double v = 0.0;

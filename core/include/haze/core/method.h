@@ -33,7 +33,7 @@ class Method {
 
 // One setting of a method, as validation, `haze render --help` and docs/METHODS.md read it.
 struct SettingInfo {
-  enum class Type { integer, number, choice };
+  enum class Type { integer, number, choice, cells };  // cells: an integer, or three (per axis)
   std::string name;
   Type type = Type::integer;
   nlohmann::json fallback;  // the default; null when it follows from other settings (the doc says how)
@@ -44,6 +44,7 @@ struct SettingInfo {
   static SettingInfo integer(std::string name, nlohmann::json fallback, long long min, long long max, std::string doc);
   static SettingInfo number(std::string name, nlohmann::json fallback, double min, double max, std::string doc);
   static SettingInfo choice(std::string name, std::string fallback, std::vector<std::string> choices, std::string doc);
+  static SettingInfo cells(std::string name, nlohmann::json fallback, long long min, long long max, std::string doc);
   // "integer in [2, 1024], default 64" and the like.
   std::string describe() const;
 };
@@ -100,6 +101,9 @@ class Settings {
   double number(const std::string& key);
   double number(const std::string& key, double fallback);
   std::string choice(const std::string& key);
+  std::string choice(const std::string& key, const std::string& fallback);
+  // A cells setting: {n} for an integer n, {nx, ny, nz} for an array of three, each in the range.
+  std::vector<int> cells(const std::string& key);
   // Throws for any key not read.
   void reject_unknown() const;
 

@@ -35,6 +35,14 @@ enum class DomScheme {
 DomScheme dom_scheme_from_name(const std::string& name);  // "paper", "sweep"
 const char* name(DomScheme scheme);
 
+// How a cell's radiance leaves through its faces in scheme `sweep` (simd/dom_sweep.h).
+enum class DomSpatial {
+  step,     // seed 000: every face leaves with the cell's mean; first order in the cell size
+  diamond,  // weighted diamond difference, its weight following the cell's optical thickness: second order
+};
+DomSpatial dom_spatial_from_name(const std::string& name);  // "step", "diamond"
+const char* name(DomSpatial spatial);
+
 enum class DomAccelerator {
   none,
   gmres,  // restarted GMRES on the moments (a Krylov method on the source-iteration operator)
@@ -58,6 +66,7 @@ struct DomSettings {
   // come in groups of 2l + 1, so N = (L + 1)^2 cuts cleanly (25: l <= 4); seed 000 used 24.
   int terms = 25;
   DomScheme scheme = DomScheme::sweep;
+  DomSpatial spatial = DomSpatial::diamond;  // step with scheme paper (its Jacobi update is the step scheme's)
   DomAccelerator accelerator = DomAccelerator::gmres;
   int max_iterations = 500;  // per solved channel, the first-collision sweep included
   // Stop when a source iteration would change the moments by less than this, relative (L2 over
@@ -174,7 +183,7 @@ struct DomFields {
   double step_cells = 0.5;
   nlohmann::json stats;
   // The settings they were made with, for updates.
-  int resolution = 64;
+  CellCount cells;
   DomSettings settings;
   DepthOptions depth;
   int warm_iterations = 0;  // sweeps per update (source iteration); 0: GMRES to the tolerance

@@ -9,7 +9,9 @@
 #include <haze/grids/grid.h>
 #include <haze/grids/optical_depth.h>
 
+#include <array>
 #include <memory>
+#include <string>
 #include <vector>
 
 #pragma GCC visibility push(default)  // the public API: exported from shared builds
@@ -32,14 +34,31 @@ struct VolumeReport {
   double truncation_bound = 0.0;  // RBF injection: see InjectionReport
 };
 
-// From the scene's medium: an RBF density is injected into `resolution` cells along the longest
-// axis of its bounds (the others in proportion; an unbounded RBF medium gets the box where every
-// blob has fallen below the injection cutoff), a grid density is taken as it is, a constant
-// density fills a grid over the medium's bounds (it must have bounds). For those two, a plane
-// surface along an axis that cuts the bounds ends them at the plane, on the camera's side: the
-// other half is hidden behind the plane and exchanges no light with this one.
+// How many cells make_extinction_volume gives an RBF or constant density's bounds.
+struct CellCount {
+  int longest = 64;                  // along the longest side, the others in proportion (at least 2)
+  std::array<int, 3> axes{0, 0, 0};  // when all are set: exactly these, `longest` unused
+  // Cells per optical depth through the medium: an axis whose largest column optical depth (at
+  // the largest sigma_t) asks for more cells than its share of `longest` gets them, up to
+  // min(longest, most_for_depth). A thin, dense slab then still has cells through its thickness.
+  // 0: off.
+  double per_optical_depth = 0.0;
+  int most_for_depth = 32;
+
+  CellCount() = default;
+  CellCount(int longest_side) : longest(longest_side) {}  // NOLINT: an int is the cells along the longest side
+  bool per_axis() const { return axes[0] > 0 && axes[1] > 0 && axes[2] > 0; }
+  std::string text() const;  // "64" or "[64, 64, 16]"
+};
+
+// From the scene's medium: an RBF density is injected into cells over its bounds (`cells`; an
+// unbounded RBF medium gets the box where every blob has fallen below the injection cutoff), a
+// grid density is taken as it is, a constant density fills a grid over the medium's bounds (it
+// must have bounds). For those two, a plane surface along an axis that cuts the bounds ends them
+// at the plane, on the camera's side: the other half is hidden behind the plane and exchanges no
+// light with this one.
 // Throws haze::Error for a scene without a medium or with an unbounded constant one.
-ExtinctionVolume make_extinction_volume(const Scene& scene, int resolution = 64, double cutoff = 0.0, int threads = 0,
+ExtinctionVolume make_extinction_volume(const Scene& scene, const CellCount& cells = {}, double cutoff = 0.0, int threads = 0,
                                         VolumeReport* report = nullptr);
 
 struct MarchSettings {

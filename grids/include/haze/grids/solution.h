@@ -40,7 +40,7 @@ class GridSolution : public MethodSolution {
   // The extinction volume of change.medium (`scene`, the changed scene): an RBF over the same
   // bounds with the same cutoff re-injects only the bricks in change.region, anything else is
   // made again (make_extinction_volume). Returns what was redone, for the UpdateReport.
-  std::string replace_volume(const Scene& scene, const SceneChange& change, int resolution, double cutoff, int threads);
+  std::string replace_volume(const Scene& scene, const SceneChange& change, const CellCount& cells, double cutoff, int threads);
   // The depth volume of each point, spot and directional light of `scene`: every one after a new
   // density (`all`), else those that differ from scene_'s. Adds what it redid to the report.
   void update_depths(const Scene& scene, bool all, const DepthOptions& depth, UpdateReport& report);
