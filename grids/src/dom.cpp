@@ -325,6 +325,7 @@ DomFields dom_fields(const Scene& scene, const RenderOptions& options) {
                   {"final_change", solved.changes.empty() ? 0.0 : solved.changes.back()},
                   {"skipped_fraction", solved.skipped_fraction},
                   {"sweep_seconds", solved.sweep_seconds},
+                  {"first_collision_seconds", solved.first_collision_seconds},
                   {"memory_bytes", solved.bytes},
                   {"depth_seconds", depth_seconds},
                   {"solve_seconds", solve_seconds}};

@@ -328,8 +328,10 @@ DomSolution solve_dom(const ExtinctionVolume& volume, const std::vector<Light>& 
   for (int c = 0; c < out.channels; ++c) {
     const dom::Channel channel = dom::make_channel(volume, lights, c, out.delta_m_fraction);
     const dom::Faces* entering = boundary ? &faces[static_cast<size_t>(c)] : nullptr;
+    const Stopwatch source_watch;
     dom::FirstCollision first = transport.first_collision(volume, delta_lights, delta_depths, c, 1.0 / (1.0 - out.delta_m_fraction),
                                                           settings.storage == DomStorage::float16, settings.threads);
+    out.first_collision_seconds += source_watch.seconds();
     std::vector<float>& x = out.moments[static_cast<size_t>(c)];
     if (settings.scheme == DomScheme::paper) {
       x = transport.paper(channel, first, warm_fits ? &warm->moments[static_cast<size_t>(c)] : nullptr, settings, out.iterations,

@@ -129,6 +129,7 @@ struct DomSolution {
   // (exact; the sweep scheme without sky light only).
   double skipped_fraction = 0.0;
   double seconds = 0.0;            // wall time of the whole solve (phase matrix, first collision, sweeps)
+  double first_collision_seconds = 0.0;  // of which the first-collision source, every channel
   // With surfaces (dom_fields): the irradiance the medium's light gives them, which render_dom's
   // surfaces reflect toward each other; without, surfaces light each other not at all.
   std::shared_ptr<const SurfaceTexels> surfaces;
