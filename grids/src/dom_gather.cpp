@@ -69,7 +69,7 @@ Gather::Gather(const Scene& delta, const ExtinctionVolume& volume, const std::ve
   for (int r = 0; r < kGlowRings; ++r)
     for (int k = 0; k < kGlowSpokes; ++k) {
       const double psi = (r + 0.5) * d_psi, phi = (k + 0.5) * d_phi;
-      glow_.push_back({std::cos(psi), std::sin(psi), std::cos(phi), std::sin(phi), std::sin(psi) * d_psi * d_phi * glow_share(psi)});
+      glow_.push_back({Vec3(std::sin(psi) * std::cos(phi), std::sin(psi) * std::sin(phi), std::cos(psi)), std::sin(psi) * d_psi * d_phi * glow_share(psi)});
     }
 }
 
@@ -175,10 +175,6 @@ void Gather::glow_directions(const Vec3& point, std::vector<Vec3>& out) const {
     if (arrival(delta_.lights[l], point, a) && std::isfinite(a.distance) && a.distance > 0.0) out[l] = a.to_light;
 }
 
-Vec3 Gather::orthogonal(const Vec3& u) {
-  return glm::normalize(glm::cross(u, std::abs(u.x) < 0.9 ? Vec3(1.0, 0.0, 0.0) : Vec3(0.0, 1.0, 0.0)));
-}
-
 Rgb Gather::arriving(const Vec3& point, int j, const Rgb& sky, const std::vector<Vec3>& to_light) const {
   std::array<double, kMostGlows> share;
   const bool shared = to_light.size() <= share.size();  // else no light's glow is taken apart
@@ -200,16 +196,15 @@ Rgb Gather::arriving(const Vec3& point, const Vec3& w, const Eigen::VectorXd& c,
 
 Rgb Gather::glossy(const Vec3& point, const Vec3& normal, const Vec3& wo, const Surface& surface, const Rgb& sky) const {
   if (surface.ks == Rgb(0.0)) return Rgb(0.0);
-  const Vec3 r = 2.0 * glm::dot(wo, normal) * normal - wo, a = orthogonal(r), b = glm::cross(r, a);
+  const Vec3 r = 2.0 * glm::dot(wo, normal) * normal - wo;
   const double n = surface.shininess, weight = (n + 2.0) / (n + 1.0) / (kLobeRings * kLobeSpokes);
   // Each node stands for an equal share of the lobe's solid angle, about 2 pi / (n + 1).
   const double cone = cone_tangent(2 * static_cast<int>(std::ceil(n + 1.0)) * kLobeRings * kLobeSpokes);
   Rgb sum(0.0);
   for (int i = 0; i < kLobeRings; ++i) {
-    const double cos_alpha = std::pow((i + 0.5) / kLobeRings, 1.0 / (n + 1.0)), sin_alpha = std::sqrt(std::max(0.0, 1.0 - cos_alpha * cos_alpha));
+    const double cos_alpha = std::pow((i + 0.5) / kLobeRings, 1.0 / (n + 1.0));
     for (int k = 0; k < kLobeSpokes; ++k) {
-      const double phi = (k + 0.5) * 2.0 * kPi / kLobeSpokes;
-      const Vec3 w = cos_alpha * r + sin_alpha * (std::cos(phi) * a + std::sin(phi) * b);
+      const Vec3 w = direction_around(r, cos_alpha, (k + 0.5) * 2.0 * kPi / kLobeSpokes);
       const double cos_i = glm::dot(normal, w);
       if (cos_i <= 0.0) continue;
       sum += weight * cos_i * arriving(point, w, inscatter_weights(solution_, -w), sky, nullptr, cone);

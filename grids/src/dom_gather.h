@@ -56,9 +56,9 @@ class Gather {
     }
     for (size_t l = 0; l < to_light.size(); ++l) {
       if (to_light[l] == Vec3(0.0)) continue;
-      const Vec3 a = orthogonal(to_light[l]), b = glm::cross(to_light[l], a);
+      const Frame frame = Frame::from_z(to_light[l]);
       for (const PolarNode& node : glow_) {
-        const Vec3 w = node.cos_psi * to_light[l] + node.sin_psi * (node.cos_phi * a + node.sin_phi * b);
+        const Vec3 w = frame.to_world(node.local);
         const double cos_i = glm::dot(normal, w);
         if (cos_i <= 0.0) continue;
         sum += node.weight * cos_i * weight(w) * single(point, w, l);
@@ -77,11 +77,11 @@ class Gather {
 
  private:
   struct PolarNode {
-    double cos_psi, sin_psi, cos_phi, sin_phi, weight;  // weight: sin psi dpsi dphi s(psi)
+    Vec3 local;     // about +z: (sin psi cos phi, sin psi sin phi, cos psi)
+    double weight;  // sin psi dpsi dphi s(psi)
   };
   // Per delta light, the unit direction from `point` to it, or 0 for a directional light.
   void glow_directions(const Vec3& point, std::vector<Vec3>& out) const;
-  static Vec3 orthogonal(const Vec3& u);
   // K direction j's radiance: along() with each light's single scattering times 1 - s(psi).
   Rgb arriving(const Vec3& point, int j, const Rgb& sky, const std::vector<Vec3>& to_light) const;
   // The same toward any direction w, in-scattering weights c, each light's single scattering times

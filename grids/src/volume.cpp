@@ -54,6 +54,18 @@ std::array<int, 3> cells_for_depth(const DenseGrid& grid, double sigma_t, const 
   return n;
 }
 
+// A grid over `bounds` at cells_for's counts, filled by fill(grid), then again at
+// cells_for_depth's counts when its column optical depths ask for more.
+template <class Fill>
+void fitted_grid(DenseGrid& grid, const Aabb& bounds, const CellCount& cells, double sigma_t, const Fill& fill) {
+  grid = DenseGrid(cells_for(bounds, cells), bounds);
+  fill(grid);
+  if (const std::array<int, 3> n = cells_for_depth(grid, sigma_t, cells); n != grid.resolution()) {
+    grid = DenseGrid(n, bounds);
+    fill(grid);
+  }
+}
+
 }  // namespace
 
 std::string CellCount::text() const {
@@ -102,12 +114,8 @@ ExtinctionVolume make_extinction_volume(const Scene& scene, const CellCount& cel
       if (!bounds.bounded()) throw Error("medium.density.blobs", "weights all below the cutoff", "a blob above the injection cutoff");
     }
     bounds = clip_to_planes(bounds, scene);
-    volume.density = DenseGrid(cells_for(bounds, cells), bounds);
-    InjectionReport injected = inject_rbf(rbf->blobs, volume.density, cutoff, threads);
-    if (const std::array<int, 3> n = cells_for_depth(volume.density, largest(desc.sigma_t), cells); n != volume.density.resolution()) {
-      volume.density = DenseGrid(n, bounds);
-      injected = inject_rbf(rbf->blobs, volume.density, cutoff, threads);
-    }
+    InjectionReport injected;
+    fitted_grid(volume.density, bounds, cells, largest(desc.sigma_t), [&](DenseGrid& g) { injected = inject_rbf(rbf->blobs, g, cutoff, threads); });
     if (report) report->truncation_bound = injected.truncation_bound;
   } else if (const auto* field = std::get_if<FieldDensity>(&desc.density)) {
     if (!field->field) throw Error("medium.density", "a " + field->type + " field without data", "a density field");
@@ -121,12 +129,8 @@ ExtinctionVolume make_extinction_volume(const Scene& scene, const CellCount& cel
     const auto& constant = std::get<ConstantDensity>(desc.density);
     if (!bounds.bounded()) throw Error("medium.bounds", "unbounded", "bounds for a constant density in the propagation method");
     bounds = clip_to_planes(bounds, scene);
-    volume.density = DenseGrid(cells_for(bounds, cells), bounds);
-    std::fill(volume.density.values().begin(), volume.density.values().end(), static_cast<float>(constant.value));
-    if (const std::array<int, 3> n = cells_for_depth(volume.density, largest(desc.sigma_t), cells); n != volume.density.resolution()) {
-      volume.density = DenseGrid(n, bounds);
-      std::fill(volume.density.values().begin(), volume.density.values().end(), static_cast<float>(constant.value));
-    }
+    fitted_grid(volume.density, bounds, cells, largest(desc.sigma_t),
+                [&](DenseGrid& g) { std::fill(g.values().begin(), g.values().end(), static_cast<float>(constant.value)); });
   }
   return volume;
 }
