@@ -12,7 +12,8 @@
 #include <haze/grids/methods.h>
 #include <haze/grids/optical_depth.h>
 
-#include "cloud_scene.h"  // tests/grids: the scene the dom tests measure
+#include "cloud_scene.h"  // tests/grids: the scenes the dom tests measure
+#include "slab_scene.h"
 
 #include <cmath>
 #include <cstdio>
@@ -25,28 +26,9 @@ using namespace haze::grids;
 
 namespace {
 
-// The reference test's slab as a 9 x 9 x nz grid, 400 wide (the centre column sees no edge),
-// sigma_t 1, lit by a sun of cosine mu0 with DISORT's normalization (E = pi / mu0). The thick
-// slabs are 4000 wide (half = 2000): under a grazing sun their walls catch nearly as much light
-// as their top (tests/grids/dom_test.cpp).
-Scene slab_scene(int nz, double tau = 1.0, double omega = 1.0, double g = 0.75, double mu0 = 1.0, double half = 200.0) {
-  Scene scene;
-  MediumDesc m;
-  m.bounds = {Vec3(-half, -half, 0), Vec3(half, half, tau)};
-  m.density = GridDensity{{9, 9, nz}, std::vector<float>(static_cast<size_t>(81 * nz), 1.0f)};
-  m.albedo = Rgb(omega);
-  m.phase = g == 0.0 ? PhaseFunction::isotropic() : PhaseFunction::henyey_greenstein(g);
-  scene.medium = m;
-  scene.lights.push_back(DirectionalLight{Vec3(std::sqrt(1 - mu0 * mu0), 0.0, -mu0), Rgb(kPi / mu0)});
-  scene.camera.type = Camera::Type::orthographic;
-  scene.camera.height = 1e-6;
-  scene.camera.width_px = scene.camera.height_px = 1;
-  return scene;
-}
-
 void slab(std::FILE* csv, int directions, int terms, int nz, bool delta_m = true) {
   const double mus[3] = {1.0, 0.5, 0.1}, published[3] = {0.0395460, 0.101103, 0.151159};
-  Scene scene = slab_scene(nz);
+  Scene scene = slab_scene(1.0, 1.0, 0.75, 1.0, nz);
   Stopwatch start;
   const ExtinctionVolume volume = make_extinction_volume(scene);
   const std::vector<DenseGrid> depths{optical_depth(volume.density, scene.lights[0], {DepthScheme::exact})};
@@ -56,9 +38,7 @@ void slab(std::FILE* csv, int directions, int terms, int nz, bool delta_m = true
   const double solve = start.seconds();
   double error[3];
   for (int i = 0; i < 3; ++i) {
-    const Vec3 emergent(std::sqrt(1 - mus[i] * mus[i]), 0.0, mus[i]), top(0.0, 0.0, 1.0);
-    scene.camera.position = top + 10.0 * emergent;
-    scene.camera.look_at = top;
+    scene.camera = slab_camera(1.0, mus[i], true);
     error[i] = render_dom(scene, volume, depths, solution, 0.25).at(0, 0).r / published[i] - 1.0;
   }
   std::printf("| %d | %d%s | %d | %+.2f%% | %+.2f%% | %+.2f%% | %.2f | %d |\n", directions, solution.terms(),
@@ -68,21 +48,11 @@ void slab(std::FILE* csv, int directions, int terms, int nz, bool delta_m = true
   std::fflush(stdout);
 }
 
-// DISORT's thick test problems (published UU at the top, mu 1, 0.5, 0.1; van de Hulst 1980).
-struct ThickSlab {
-  const char* label;
-  double tau, omega, g, mu0;
-  double uu[3];
-};
-constexpr ThickSlab kThickSlabs[] = {{"1d: tau 32, omega 0.2, isotropic, mu0 0.1", 32.0, 0.2, 0.0, 0.1, {0.0502853, 0.0906967, 0.262972}},
-                                     {"1e: tau 32, omega 1, isotropic, mu0 0.1", 32.0, 1.0, 0.0, 0.1, {0.797199, 1.02732, 1.93321}},
-                                     {"3b: tau 8, omega 1, HG 0.75, mu0 1", 8.0, 1.0, 0.75, 1.0, {0.493302, 0.519598, 0.379740}}};
-
 // One thick slab at `per_depth` cells per optical depth through it, D = 128 (N = 1 isotropic, 49
 // with delta-M for HG), by one spatial scheme.
 void thick_slab(std::FILE* csv, const ThickSlab& p, int per_depth, DomSpatial spatial) {
   const int nz = static_cast<int>(p.tau) * per_depth;
-  Scene scene = slab_scene(nz, p.tau, p.omega, p.g, p.mu0, 2000.0);
+  Scene scene = slab_scene(p.tau, p.omega, p.g, p.mu0, nz, 2000.0);
   Stopwatch start;
   const ExtinctionVolume volume = make_extinction_volume(scene);
   const std::vector<DenseGrid> depths{optical_depth(volume.density, scene.lights[0], {DepthScheme::exact})};
@@ -90,17 +60,15 @@ void thick_slab(std::FILE* csv, const ThickSlab& p, int per_depth, DomSpatial sp
   settings.directions = 128, settings.terms = p.g == 0.0 ? 1 : 49, settings.tolerance = 1e-6, settings.spatial = spatial;
   const DomSolution solution = solve_dom(volume, scene.lights, depths, settings);
   const double solve = start.seconds();
-  double error[3];
-  const double mus[3] = {1.0, 0.5, 0.1};
+  double error[3];  // the top at mu 1, 0.5 and 0.1, thick_slabs()'s first three views
   for (int i = 0; i < 3; ++i) {
-    const Vec3 emergent(std::sqrt(1 - mus[i] * mus[i]), 0.0, mus[i]), top(0.0, 0.0, p.tau);
-    scene.camera.position = top + 10.0 * emergent;
-    scene.camera.look_at = top;
-    error[i] = render_dom(scene, volume, depths, solution, 0.25).at(0, 0).r / p.uu[i] - 1.0;
+    scene.camera = slab_camera(p.tau, p.views[static_cast<size_t>(i)].mu, true);
+    error[i] = render_dom(scene, volume, depths, solution, 0.25).at(0, 0).r / p.views[static_cast<size_t>(i)].uu - 1.0;
   }
-  std::printf("| %s | %s | %d | %+.2f%% | %+.2f%% | %+.2f%% | %.2f | %d |\n", p.label, name(spatial), per_depth, 100 * error[0], 100 * error[1],
+  const std::string label = std::string(p.label) + ": " + p.description;
+  std::printf("| %s | %s | %d | %+.2f%% | %+.2f%% | %+.2f%% | %.2f | %d |\n", label.c_str(), name(spatial), per_depth, 100 * error[0], 100 * error[1],
               100 * error[2], solve, solution.iterations);
-  std::fprintf(csv, "\"%s\",%s,%d,%g,%g,%g,%g,%d\n", p.label, name(spatial), per_depth, error[0], error[1], error[2], solve, solution.iterations);
+  std::fprintf(csv, "\"%s\",%s,%d,%g,%g,%g,%g,%d\n", label.c_str(), name(spatial), per_depth, error[0], error[1], error[2], solve, solution.iterations);
   std::fflush(stdout);
 }
 
@@ -134,7 +102,7 @@ int main(int argc, char** argv) {
   std::printf("Thick slabs (DISORT test problems, 9 x 9 x nz grid 4000 wide): UU at the top against the published values,\n"
               "D 128 (N 1 isotropic, 49 with delta-M for HG), tolerance 1e-6, solve seconds on 2 threads.\n\n");
   std::printf("| problem | scheme | cells per optical depth | mu 1 | mu 0.5 | mu 0.1 | seconds | sweeps |\n|---|---|---|---|---|---|---|---|\n");
-  for (const ThickSlab& p : kThickSlabs)
+  for (const ThickSlab& p : thick_slabs())
     for (DomSpatial spatial : {DomSpatial::step, DomSpatial::diamond})
       for (int per_depth : {2, 4, 8, 16}) thick_slab(thick_csv, p, per_depth, spatial);
   std::fclose(thick_csv);

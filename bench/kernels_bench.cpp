@@ -14,6 +14,9 @@
 
 #include <benchmark/benchmark.h>
 #include <hwy/targets.h>
+#if defined(__x86_64__)
+#include <immintrin.h>
+#endif
 #include <oneapi/tbb/parallel_for.h>
 #include <oneapi/tbb/task_arena.h>
 
@@ -61,6 +64,43 @@ void BM_Stream(benchmark::State& state) {
 }
 BENCHMARK(BM_Stream)->Name("stream/copy")->Args({0, 1})->Args({0, 2})->UseRealTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_Stream)->Name("stream/triad")->Args({1, 1})->Args({1, 2})->UseRealTime()->Unit(benchmark::kMillisecond);
+
+// ---- FMA peak: 12 independent chains of 8-lane AVX2 FMAs per thread (2 pipes x 4 cycles of
+// latency need 8), on 1 and 2 threads (items: floating-point operations, 2 per lane and FMA). The
+// yardstick for the DOM sweep's share of peak arithmetic (write_markdown's grind-time table).
+#if defined(__x86_64__)
+constexpr size_t kFmaRounds = size_t{1} << 22;
+
+__attribute__((target("avx2,fma"))) float fma_chains(float seed) {
+  const __m256 b = _mm256_set1_ps(0.999999f), c = _mm256_set1_ps(1e-7f);
+  // Twelve different starting values: equal ones would let the compiler fold the chains into one.
+  const __m256 step = _mm256_set1_ps(0.01f);
+  __m256 a0 = _mm256_set1_ps(seed), a1 = _mm256_add_ps(a0, step), a2 = _mm256_add_ps(a1, step), a3 = _mm256_add_ps(a2, step);
+  __m256 a4 = _mm256_add_ps(a3, step), a5 = _mm256_add_ps(a4, step), a6 = _mm256_add_ps(a5, step), a7 = _mm256_add_ps(a6, step);
+  __m256 a8 = _mm256_add_ps(a7, step), a9 = _mm256_add_ps(a8, step), a10 = _mm256_add_ps(a9, step), a11 = _mm256_add_ps(a10, step);
+  for (size_t r = 0; r < kFmaRounds; ++r) {
+    a0 = _mm256_fmadd_ps(a0, b, c), a1 = _mm256_fmadd_ps(a1, b, c), a2 = _mm256_fmadd_ps(a2, b, c), a3 = _mm256_fmadd_ps(a3, b, c);
+    a4 = _mm256_fmadd_ps(a4, b, c), a5 = _mm256_fmadd_ps(a5, b, c), a6 = _mm256_fmadd_ps(a6, b, c), a7 = _mm256_fmadd_ps(a7, b, c);
+    a8 = _mm256_fmadd_ps(a8, b, c), a9 = _mm256_fmadd_ps(a9, b, c), a10 = _mm256_fmadd_ps(a10, b, c), a11 = _mm256_fmadd_ps(a11, b, c);
+  }
+  const __m256 s = _mm256_add_ps(_mm256_add_ps(_mm256_add_ps(a0, a1), _mm256_add_ps(a2, a3)),
+                                 _mm256_add_ps(_mm256_add_ps(_mm256_add_ps(a4, a5), _mm256_add_ps(a6, a7)),
+                                               _mm256_add_ps(_mm256_add_ps(a8, a9), _mm256_add_ps(a10, a11))));
+  return _mm_cvtss_f32(_mm256_castps256_ps128(s));
+}
+
+void BM_FmaPeak(benchmark::State& state) {
+  const int threads = static_cast<int>(state.range(0));
+  tbb::task_arena arena(threads);
+  std::vector<float> out(static_cast<size_t>(threads));
+  for (auto _ : state) {
+    arena.execute([&] { tbb::parallel_for(0, threads, [&](int t) { out[static_cast<size_t>(t)] = fma_chains(1.0f + 0.01f * static_cast<float>(t)); }); });
+    benchmark::DoNotOptimize(out.data());
+  }
+  state.SetItemsProcessed(static_cast<int64_t>(state.iterations()) * threads * static_cast<int64_t>(kFmaRounds) * 12 * 8 * 2);
+  state.SetLabel(std::to_string(threads) + " thread" + (threads > 1 ? "s" : ""));
+}
+#endif
 
 // ---- Kernels. Each is registered once per compiled target (the dispatch forced to it) and once
 // as its scalar reference. The kernel reports its own items and bytes per call.
@@ -324,6 +364,33 @@ std::string fmt(const char* f, double v) {
   return b;
 }
 
+// The DOM sweep's grind time (ns per cell-direction and sweep), the arithmetic its 2 N FMAs per
+// cell-direction do (source and moments, N = 25 terms: 100 flops; the transport's few operations,
+// the diamond's weights and the divisions are not counted) against the fma/ peak at the same
+// threads, and, for the whole-solver rows, the memory it moves against STREAM copy: per cell and
+// octant pass the moments in and out (12 N bytes) and the density (4), per cell-direction the
+// first-collision source (4), with D = 128.
+void write_grind_times(std::ofstream& md, const std::vector<Collector::Entry>& entries, const std::map<int, double>& copy) {
+  std::map<int, double> peak;  // threads -> flops/s
+  for (const auto& e : entries)
+    if (e.name.rfind("fma/", 0) == 0) peak[e.label[0] - '0'] = e.items;
+  const double terms = 25.0, directions = 128.0, flops = 4.0 * terms;
+  const double bytes = (12.0 * terms + 4.0) * 8.0 / directions + 4.0;
+  md << "\n## The DOM sweep's grind time\n\n"
+     << "| benchmark | target | ns per cell-direction | GFLOP/s in its FMAs | of FMA peak | GB/s | of STREAM copy |\n|---|---|---|---|---|---|---|\n";
+  for (const auto& e : entries) {
+    const bool row = e.name.rfind("dom_sweep_row/", 0) == 0, solver = e.name.rfind("solver/dom_", 0) == 0;
+    if (!(row || solver) || e.items <= 0.0) continue;
+    const int threads = solver ? e.label[0] - '0' : 1;
+    const double gflops = e.items * flops * 1e-9;
+    const std::string of_peak = peak.count(threads) ? fmt("%.0f%%", 100.0 * gflops * 1e9 / peak.at(threads)) : "";
+    const std::string moved = solver ? fmt("%.1f", e.items * bytes * 1e-9) : "";
+    const std::string of_copy = solver && copy.count(threads) ? fmt("%.0f%%", 100.0 * e.items * bytes / copy.at(threads)) : "";
+    md << "| " << e.name << " | " << (solver ? e.label.substr(0, e.label.find(',')) : e.label) << " | " << fmt("%.2f", 1e9 / e.items) << " | "
+       << fmt("%.1f", gflops) << " | " << of_peak << " | " << moved << " | " << of_copy << " |\n";
+  }
+}
+
 void write_markdown(const std::string& file, const std::vector<Collector::Entry>& entries) {
   std::map<int, double> copy;  // threads -> bytes/s
   for (const auto& e : entries)
@@ -338,6 +405,7 @@ void write_markdown(const std::string& file, const std::vector<Collector::Entry>
     const std::string share = e.bytes > 0 && copy.count(1) && e.name.rfind("stream", 0) != 0 ? fmt("%.0f%%", 100.0 * e.bytes / copy[1]) : "";
     md << "| " << e.name << " | " << e.label << " | " << time << " | " << items << " | " << bytes << " | " << share << " |\n";
   }
+  write_grind_times(md, entries, copy);
 }
 
 }  // namespace
@@ -353,6 +421,10 @@ int main(int argc, char** argv) {
     args.push_back(argv[i]);
   }
   int count = static_cast<int>(args.size());
+#if defined(__x86_64__)
+  if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma"))
+    benchmark::RegisterBenchmark("fma/avx2_peak", BM_FmaPeak)->Arg(1)->Arg(2)->UseRealTime()->Unit(benchmark::kMillisecond);
+#endif
   register_kernel("phase_eval/hg", phase_work);
   register_kernel("to_half", half_work);
   register_kernel("sweep_cells/64^3", sweep_work);

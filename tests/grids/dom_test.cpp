@@ -8,43 +8,21 @@
 #include <haze/grids/optical_depth.h>
 
 #include "cloud_scene.h"
+#include "slab_scene.h"
 
 #include <gtest/gtest.h>
 
 #include <cstdio>
+#include <string>
 
 namespace haze::grids {
 namespace {
 
-// An orthographic pixel looking at the slab's top (or bottom) centre against the emergent
-// direction of cosine mu, at azimuth 0 (the sun's).
-Camera slab_camera(double tau, double mu, bool top) {
-  const Vec3 emergent(std::sqrt(1 - mu * mu), 0.0, top ? mu : -mu), at(0.0, 0.0, top ? tau : 0.0);
-  Camera camera;
-  camera.type = Camera::Type::orthographic;
-  camera.position = at + 10.0 * emergent;
-  camera.look_at = at;
-  camera.height = 1e-6;
-  camera.width_px = camera.height_px = 1;
-  return camera;
-}
-
-// The reference test's slab (sigma_t 1, black bottom, sun with DISORT's normalization
-// E = pi / mu0), as a grid density 9 x 9 x nz, `half` wide in x and y on either side: the centre
-// column sees no edge. A thick slab under a grazing sun takes half = 2000: its 32-high walls
-// catch nearly as much sunlight as its top, and at 400 wide its conservative scattering (1e)
-// carries that to the centre's bottom (+150% there).
-Scene slab(double omega, double g, double mu0, double mu, int nz, double tau = 1.0, double half = 200.0) {
-  Scene scene;
-  MediumDesc m;
-  m.bounds = {Vec3(-half, -half, 0), Vec3(half, half, tau)};
-  m.density = GridDensity{{9, 9, nz}, std::vector<float>(static_cast<size_t>(81 * nz), 1.0f)};
-  m.sigma_t = Rgb(1.0);
-  m.albedo = Rgb(omega);
-  m.phase = PhaseFunction::henyey_greenstein(g);
-  scene.medium = m;
-  scene.lights.push_back(DirectionalLight{Vec3(std::sqrt(1 - mu0 * mu0), 0.0, -mu0), Rgb(kPi / mu0)});
-  scene.camera = slab_camera(tau, mu, true);
+// The tau-1 slab of the reference tracer's tests (omega 1, HG 0.75, sun overhead), seen from the
+// top at cosine mu.
+Scene slab(double mu, int nz) {
+  Scene scene = slab_scene(1.0, 1.0, 0.75, 1.0, nz);
+  scene.camera = slab_camera(1.0, mu, true);
   return scene;
 }
 
@@ -61,7 +39,7 @@ TEST(DomSlab, MatchesPublishedReflection) {
   for (const SlabCase c : {SlabCase{1.0, 0.0395460}, SlabCase{0.5, 0.101103}, SlabCase{0.1, 0.151159}}) {
     RenderOptions options;
     options.settings = {{"directions", 256}, {"terms", 0}, {"step", 0.25}, {"tolerance", 1e-5}};
-    const RenderResult r = render(slab(1.0, 0.75, 1.0, c.mu, 128), "dom", options);
+    const RenderResult r = render(slab(c.mu, 128), "dom", options);
     const double uu = r.radiance.at(0, 0).r;
     std::printf("slab top mu %.1f: dom %.6f, published %.6f (%+.2f%%), %d iterations\n", c.mu, uu, c.uu, 100.0 * (uu / c.uu - 1.0),
                 r.stats["iterations"].get<int>());
@@ -70,42 +48,26 @@ TEST(DomSlab, MatchesPublishedReflection) {
   }
 }
 
-// Thick slabs at 8 cells per optical depth, sigma_t 1, against DISORT's test problems (published
-// UU; van de Hulst 1980): 1d and 1e (isotropic, tau 32, sun at mu0 0.1, absorbing omega 0.2 and
-// conservative) and 3b (HG g 0.75, tau 8, sun overhead, conservative; 49 terms, as 25 leave the
-// grazing views 2.7% off by the phase function's truncation alone). Each solved once and seen
+// Thick slabs at 8 cells per optical depth against DISORT's test problems 1d, 1e and 3b
+// (slab_scene.h; 3b with 49 terms, as 25 leave the grazing views 2.7% off by the phase
+// function's truncation alone). Each solved once and seen
 // from the top and the bottom with the default (diamond) scheme: within 2%, except what leaves
 // the conservative 1e through its bottom, 1.4% of what comes back up, at 3% (measured +2.4%;
 // 9% at 4 cells, 0.5% at 16: second order). The step scheme is 4% to 8% off on 1e
 // (docs/DOM.md has the table).
 TEST(DomSlab, ThickSlabsAtEightCellsPerOpticalDepth) {
   register_methods();
-  struct Look {
-    double mu;
-    bool top;
-    double uu;
-    double tolerance = 0.02;
-  };
-  struct Problem {
-    const char* label;
-    double tau, omega, g, mu0;
-    std::vector<Look> views;
-  };
-  const Problem problems[] = {
-      {"1d", 32.0, 0.2, 0.0, 0.1, {{0.1, true, 0.262972}, {0.5, true, 0.0906967}, {1.0, true, 0.0502853}}},
-      {"1e", 32.0, 1.0, 0.0, 0.1, {{0.1, true, 1.93321}, {0.5, true, 1.02732}, {1.0, true, 0.797199}, {1.0, false, 0.0271316, 0.03}, {0.5, false, 0.0187805, 0.03}}},
-      {"3b", 8.0, 1.0, 0.75, 1.0,
-       {{0.1, true, 0.379740}, {0.5, true, 0.519598}, {1.0, true, 0.493302}, {1.0, false, 0.669581}, {0.5, false, 0.422350}, {0.1, false, 0.236362}}}};
-  for (const Problem& p : problems) {
+  for (const ThickSlab& p : thick_slabs()) {
     const auto nz = static_cast<int>(8 * p.tau);
     RenderOptions options;
     options.settings = {{"directions", 128}, {"terms", p.g == 0.0 ? 1 : 49}, {"step", 0.25}, {"tolerance", 1e-6}};
-    const Solution solution = prepare(slab(p.omega, p.g, p.mu0, 1.0, nz, p.tau, 2000.0), "dom", options);
-    for (const Look& v : p.views) {
+    const Solution solution = prepare(slab_scene(p.tau, p.omega, p.g, p.mu0, nz, 2000.0), "dom", options);
+    for (const SlabView& v : p.views) {
       const double uu = solution.render(haze::View{slab_camera(p.tau, v.mu, v.top)}).radiance.at(0, 0).r;
       std::printf("%s %s mu %.1f: dom %.6f, published %.6f (%+.2f%%), %d iterations\n", p.label, v.top ? "top" : "bottom", v.mu, uu, v.uu,
                   100.0 * (uu / v.uu - 1.0), solution.stats()["iterations"].get<int>());
-      EXPECT_LT(std::abs(uu / v.uu - 1.0), v.tolerance) << p.label << (v.top ? " top" : " bottom") << " mu " << v.mu;
+      const double tolerance = std::string(p.label) == "1e" && !v.top ? 0.03 : 0.02;
+      EXPECT_LT(std::abs(uu / v.uu - 1.0), tolerance) << p.label << (v.top ? " top" : " bottom") << " mu " << v.mu;
     }
   }
 }
@@ -115,7 +77,7 @@ TEST(DomSlab, ThickSlabsAtEightCellsPerOpticalDepth) {
 // the longest side alone would give 1) and the top's radiance is within 3% of the published.
 TEST(DomSlab, WideSlabAtTheDefaults) {
   register_methods();
-  Scene scene = slab(1.0, 0.75, 1.0, 1.0, 1, 8.0);
+  Scene scene = slab_scene(8.0, 1.0, 0.75, 1.0, 1);
   MediumDesc& m = *scene.medium;
   m.density = ConstantDensity{1.0};
   const Solution solution = prepare(scene, "dom");
@@ -137,7 +99,7 @@ TEST(DomSlab, DeltaMHoldsTruncatedPhase) {
     for (int delta_m : {0, 1}) {
       RenderOptions options;
       options.settings = {{"directions", 256}, {"terms", 49}, {"delta_m", delta_m}, {"step", 0.25}, {"tolerance", 1e-5}};
-      error[delta_m] = render(slab(1.0, 0.75, 1.0, c.mu, 128), "dom", options).radiance.at(0, 0).r / c.uu - 1.0;
+      error[delta_m] = render(slab(c.mu, 128), "dom", options).radiance.at(0, 0).r / c.uu - 1.0;
     }
     std::printf("slab top mu %.1f, N 49: %+.2f%% plain, %+.2f%% with delta-M\n", c.mu, 100 * error[0], 100 * error[1]);
     EXPECT_LT(std::abs(error[1]), 0.025) << "mu " << c.mu;
@@ -367,8 +329,9 @@ TEST(DomRender, WhiteFurnace) {
 // A point light inside fog (optical radius 1.5, albedo 0.9) at a cell's centre: its first-collision
 // source is the 1 / d^2 peak averaged over each cell near it, which the cell centres undercount (by
 // half in the light's own cell). The image's signed mean over the lit pixels is within 8% of the
-// reference (whose own standard error there is 0.6%): measured -4.7% at 16^3, -9.6% with the
-// centres' values (against a 4096-spp reference: -5.8% and -10.7% at 16^3, -3.8% and -6.6% at 32^3).
+// reference (whose own standard error there is 0.6%): measured -1.6% at 16^3 with the diamond
+// scheme; with step -4.7%, and -9.6% with the centres' values (against a 4096-spp reference: -5.8%
+// and -10.7% at 16^3, -3.8% and -6.6% at 32^3).
 TEST(DomRender, PointLightInsideTheFog) {
   register_methods();
   Scene scene = fog_cube(1.5, 0.9);
@@ -451,6 +414,16 @@ TEST(DomErrors, ThickCellsAreSaid) {
   const RenderResult fine = render(scene, "dom", options);
   EXPECT_LE(fine.stats["thickest_cell"].get<double>(), 2.0);
   EXPECT_TRUE(fine.stats["warnings"].empty());
+  // A frame loop's denser medium thickens the same cells: the update says so, and so does the
+  // solution's stats from then on.
+  Solution solution = prepare(scene, "dom", options);
+  ASSERT_TRUE(solution.stats()["warnings"].empty());
+  MediumDesc denser = *scene.medium;
+  denser.sigma_t = Rgb(200.0);
+  const UpdateReport report = solution.update(SceneChange{.medium = denser}, options);
+  ASSERT_FALSE(report.rebuilt);
+  EXPECT_EQ(report.stats["warnings"].size(), 1u) << report.stats.dump();
+  EXPECT_EQ(solution.stats()["warnings"], report.stats["warnings"]);
 }
 
 }  // namespace

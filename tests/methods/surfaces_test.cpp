@@ -124,8 +124,8 @@ std::vector<std::pair<int, int>> shadowed_floor(const Scene& scene, const Medium
 // straight above: the floor in the cloud's shadow sees little but the light the cloud scatters onto
 // it, part of it light the floor itself sent up into the cloud. The DOM's mean over those floor
 // pixels is within 3% of the full reference (whose own noise there is 0.55%) with the default two
-// surface passes (measured -1.1%; one pass -1.7%). Without them, the floor's light left out of the
-// medium, it is 20% dark; before the first bounce onto surfaces it was 67% dark.
+// surface passes (measured -0.5%; one pass -1.1%). Without them, the floor's light left out of the
+// medium, it is 19% dark; before the first bounce onto surfaces it was 67% dark.
 TEST(SurfaceLight, FloorUnderACloudReceivesItsScatteredLight) {
   grids::register_methods();
   MediumDesc cloud;
@@ -193,7 +193,7 @@ TEST(SurfaceLight, PropagationGathersTheSingleScatteredLightOntoTheFloor) {
 // alias them into blotches and spikes. With the glow's share over a polar grid about the light,
 // the lobe over its own nodes and the gathers seeing other surfaces' Lambert part only, the floor's
 // pixels are 3.2% RMS from the full reference (noise removed; its own noise 1.5%) and the sphere's
-// 5.5% (2.0%); the 64 directions alone were 8.4% and 7.3% off. What the sphere still misses is the
+// 4.9% (2.0%); the 64 directions alone were 8.4% and 7.3% off. What the sphere still misses is the
 // floor's bright spot under the light, as small as the glow seen from it (docs/DOM.md).
 TEST(SurfaceLight, DomGathersALightsGlowAndAGlossyLobeWithoutAliasing) {
   grids::register_methods();
@@ -234,8 +234,9 @@ TEST(SurfaceLight, DomGathersALightsGlowAndAGlossyLobeWithoutAliasing) {
 // sweeps let the medium's scattered light through the sphere, so the fog beside it, where the
 // sphere fills much of what a point sees, comes out bright unless the gather takes the sphere's
 // own light there instead (Gather::sphere_correction). Over the fog pixels whose rays pass within
-// two radii of its centre, the DOM's signed mean is within 4% of the reference (measured -1.0%,
-// its standard error 0.2%; without the correction +4.9%).
+// two radii of its centre, the DOM's signed mean is within 4% of the reference (measured +2.3%,
+// its standard error 0.2%, with the diamond scheme; -1.0% with step; without the correction
+// +4.9% with step).
 TEST(SurfaceLight, DomFogBesideASphereInsideTheGrid) {
   grids::register_methods();
   Scene scene = grids::fog_cube(2.0, 0.95, 0.3);
