@@ -218,10 +218,10 @@ Work march_work(bool scalar) {
           128.0 * static_cast<double>(n), 0.0, {density, depths, lights, in}};
 }
 
-// One DOM row of 64 cells, one octant of 16 directions, 25 terms, by one spatial scheme (items:
-// cell-directions).
-Work dom_work(bool scalar, bool diamond) {
-  const int p = 16, terms = 25, padded = 32, count = 64;
+// One DOM row of 64 cells, one octant of p directions (16: D = 128; 8: D = 64) and `terms` terms, by
+// one spatial scheme (items: cell-directions).
+Work dom_work(bool scalar, bool diamond, int p, int terms) {
+  const int padded = (terms + 7) / 8 * 8, count = 64;
   auto a = std::make_shared<std::vector<float>>(5 * p, 0.0f), lq = std::make_shared<std::vector<float>>(static_cast<size_t>(terms * p)),
        q = std::make_shared<std::vector<float>>(static_cast<size_t>(p * padded), 0.0f);
   for (int d = 0; d < p; ++d) {
@@ -365,8 +365,8 @@ std::string fmt(const char* f, double v) {
 }
 
 // The DOM sweep's grind time (ns per cell-direction and sweep), the arithmetic its 2 N FMAs per
-// cell-direction do (source and moments, N = 25 terms: 100 flops; the transport's few operations,
-// the diamond's weights and the divisions are not counted) against the fma/ peak at the same
+// cell-direction do (source and moments, N terms, as a row's name says, else 25: 4 N flops; the
+// transport's few operations, the diamond's weights and its reciprocals are not counted) against the fma/ peak at the same
 // threads, and, for the whole-solver rows, the memory it moves against STREAM copy: per cell and
 // octant pass the moments in and out (12 N bytes) and the density (4), per cell-direction the
 // first-collision source (4), with D = 128.
@@ -374,15 +374,16 @@ void write_grind_times(std::ofstream& md, const std::vector<Collector::Entry>& e
   std::map<int, double> peak;  // threads -> flops/s
   for (const auto& e : entries)
     if (e.name.rfind("fma/", 0) == 0) peak[e.label[0] - '0'] = e.items;
-  const double terms = 25.0, directions = 128.0, flops = 4.0 * terms;
-  const double bytes = (12.0 * terms + 4.0) * 8.0 / directions + 4.0;
+  const double directions = 128.0, bytes = (12.0 * 25.0 + 4.0) * 8.0 / directions + 4.0;
   md << "\n## The DOM sweep's grind time\n\n"
      << "| benchmark | target | ns per cell-direction | GFLOP/s in its FMAs | of FMA peak | GB/s | of STREAM copy |\n|---|---|---|---|---|---|---|\n";
   for (const auto& e : entries) {
     const bool row = e.name.rfind("dom_sweep_row/", 0) == 0, solver = e.name.rfind("solver/dom_", 0) == 0;
     if (!(row || solver) || e.items <= 0.0) continue;
     const int threads = solver ? e.label[0] - '0' : 1;
-    const double gflops = e.items * flops * 1e-9;
+    const size_t n_at = e.name.find("_N");  // N terms: a row's name says; the solver's are 25
+    const double terms = n_at == std::string::npos ? 25.0 : std::stod(e.name.substr(n_at + 2));
+    const double gflops = e.items * 4.0 * terms * 1e-9;
     const std::string of_peak = peak.count(threads) ? fmt("%.0f%%", 100.0 * gflops * 1e9 / peak.at(threads)) : "";
     const std::string moved = solver ? fmt("%.1f", e.items * bytes * 1e-9) : "";
     const std::string of_copy = solver && copy.count(threads) ? fmt("%.0f%%", 100.0 * e.items * bytes / copy.at(threads)) : "";
@@ -429,8 +430,9 @@ int main(int argc, char** argv) {
   register_kernel("to_half", half_work);
   register_kernel("sweep_cells/64^3", sweep_work);
   register_kernel("march_rays/256_rays", march_work, false);
-  register_kernel("dom_sweep_row/step/64_cells", [](bool scalar) { return dom_work(scalar, false); });
-  register_kernel("dom_sweep_row/diamond/64_cells", [](bool scalar) { return dom_work(scalar, true); });
+  register_kernel("dom_sweep_row/step/64_cells_P16_N25", [](bool scalar) { return dom_work(scalar, false, 16, 25); });
+  register_kernel("dom_sweep_row/diamond/64_cells_P16_N25", [](bool scalar) { return dom_work(scalar, true, 16, 25); });
+  register_kernel("dom_sweep_row/diamond/64_cells_P8_N16", [](bool scalar) { return dom_work(scalar, true, 8, 16); });
   benchmark::Initialize(&count, args.data());
   Collector collector;
   benchmark::RunSpecifiedBenchmarks(&collector);

@@ -325,6 +325,7 @@ DomSolution solve_dom(const ExtinctionVolume& volume, const std::vector<Light>& 
                          warm->terms() == out.terms() && warm->directions && warm->directions->size() == settings.directions;
 
   out.moments.resize(static_cast<size_t>(out.channels));
+  double previous_source = 0.0;  // b . x of the channel solved last
   for (int c = 0; c < out.channels; ++c) {
     const dom::Channel channel = dom::make_channel(volume, lights, c, out.delta_m_fraction);
     const dom::Faces* entering = boundary ? &faces[static_cast<size_t>(c)] : nullptr;
@@ -360,8 +361,19 @@ DomSolution solve_dom(const ExtinctionVolume& volume, const std::vector<Light>& 
     transport.sweep(channel, &first, nullptr, channel.sky, b.data(), settings.threads, entering);
     ++out.iterations;
     first = {};
-    x = warm_fits ? warm->moments[static_cast<size_t>(c)] : b;
+    if (warm_fits) {
+      x = warm->moments[static_cast<size_t>(c)];
+    } else if (c > 0 && previous_source > 0.0) {
+      // The channels differ by a few percent in sigma_t and in the lights' colour: the previous
+      // channel's moments, scaled as its source projects onto them, start GMRES close.
+      x = out.moments[static_cast<size_t>(c - 1)];
+      const double scale = dot(b, x, settings.threads) / previous_source;
+      for (float& m : x) m *= static_cast<float>(scale);
+    } else {
+      x = b;
+    }
     solve_moments(transport, channel, b, x, settings, progress, out);
+    previous_source = dot(b, x, settings.threads);
   }
   out.converged = !out.changes.empty() && out.changes.back() < settings.tolerance;
   out.sweep_seconds = transport.seconds();

@@ -16,6 +16,14 @@ HWY_BEFORE_NAMESPACE();
 namespace haze::simd::HWY_NAMESPACE {
 namespace hn = hwy::HWY_NAMESPACE;
 
+// 1 / x to about float precision for finite x > 0: the approximate reciprocal and one Newton step,
+// a few cycles where a division takes ten or more.
+template <class D, class V = hn::Vec<D>>
+HWY_INLINE V Reciprocal(D d, V x) {
+  const V r = hn::ApproximateReciprocal(x);
+  return hn::Mul(r, hn::NegMulAdd(x, r, hn::Set(d, 2.0f)));
+}
+
 // The diamond scheme on one vector of directions (dom_sweep.h; the scalar reference's diamond_g,
 // lane by lane): the cell's mean radiance, and the leaving values stored into the faces x, y, z in
 // place of the entering ones. `sum`: a_x + a_y + a_z.
@@ -31,21 +39,47 @@ HWY_INLINE V Diamond(D d, V sigma_t, V sigma_s_times_s, V pad, const V a[3], V s
   V num = sigma_s_times_s, den = hn::Add(sigma_t, pad);
   for (int e = 0; e < 3; ++e) {
     in[e] = hn::LoadU(d, face[e]);
-    const V g_tau = hn::Div(hn::MulAdd(a[e], hn::MulAdd(six, a[e], three_sigma), sigma2),
-                            hn::Max(hn::MulAdd(a[e], hn::MulAdd(three, a[e], two_sigma), sigma2), tiny));
-    const V q = hn::NegMulAdd(three, a[e], around), bound = hn::Div(hn::NegMulAdd(two, a[e], around), hn::Max(q, tiny));
+    const V g_tau = hn::Mul(hn::MulAdd(a[e], hn::MulAdd(six, a[e], three_sigma), sigma2),
+                            Reciprocal(d, hn::Max(hn::MulAdd(a[e], hn::MulAdd(three, a[e], two_sigma), sigma2), tiny)));
+    const V q = hn::NegMulAdd(three, a[e], around), bound = hn::Mul(hn::NegMulAdd(two, a[e], around), Reciprocal(d, hn::Max(q, tiny)));
     g[e] = hn::IfThenElse(hn::Gt(q, zero), hn::Min(g_tau, bound), g_tau);
     const V b = hn::Mul(a[e], g[e]);
     num = hn::MulAdd(b, in[e], num);
     den = hn::Add(den, b);
   }
-  const V l = hn::Div(num, hn::Max(den, tiny));
+  const V l = hn::Mul(num, Reciprocal(d, hn::Max(den, tiny)));
   for (int e = 0; e < 3; ++e) hn::StoreU(hn::NegMulAdd(hn::Sub(g[e], one), in[e], hn::Mul(g[e], l)), d, face[e]);
   return l;
 }
 
-// Lanes over directions (at most 8, the padding unit), then over terms for the moments. Up to four
-// vectors accumulate side by side in registers: independent FMA chains, no store-load round trips.
+// acc[v] += sum_r rows[r * stride + v * lanes ...] w[r] for r < count_rows and kV vectors: the
+// rows split over 8 / kV interleaved accumulators per vector, so that about 8 independent FMA
+// chains hide the FMA's latency (one chain per vector left a 16-direction cell latency-bound).
+template <size_t kV, class D, class V = hn::Vec<D>>
+HWY_INLINE void DotRows(D d, const float* HWY_RESTRICT rows, size_t stride, const float* HWY_RESTRICT w, size_t count_rows, V* acc) {
+  constexpr size_t kJ = 8 / kV;
+  const size_t lanes = hn::Lanes(d);
+  V part[kJ][kV];
+  for (size_t j = 0; j < kJ; ++j)
+    for (size_t v = 0; v < kV; ++v) part[j][v] = hn::Zero(d);
+  size_t r = 0;
+  for (; r + kJ <= count_rows; r += kJ)
+    for (size_t j = 0; j < kJ; ++j) {
+      const V wr = hn::Set(d, w[r + j]);
+      for (size_t v = 0; v < kV; ++v) part[j][v] = hn::MulAdd(hn::LoadU(d, rows + (r + j) * stride + v * lanes), wr, part[j][v]);
+    }
+  for (; r < count_rows; ++r) {
+    const V wr = hn::Set(d, w[r]);
+    for (size_t v = 0; v < kV; ++v) part[0][v] = hn::MulAdd(hn::LoadU(d, rows + r * stride + v * lanes), wr, part[0][v]);
+  }
+  for (size_t v = 0; v < kV; ++v) {
+    for (size_t j = 1; j < kJ; ++j) part[0][v] = hn::Add(part[0][v], part[j][v]);
+    acc[v] = hn::Add(acc[v], part[0][v]);
+  }
+}
+
+// Lanes over directions (at most 8, the padding unit), then over terms for the moments, each a
+// DotRows over up to four vectors.
 void DomSweepRow(const DomOctant& o, const DomRow& r) {
   const hn::CappedTag<float, 8> d;
   using V = hn::Vec<decltype(d)>;
@@ -80,13 +114,12 @@ void DomSweepRow(const DomOctant& o, const DomRow& r) {
         for (size_t v = 0; v < count; ++v)
           s[v] = hn::Mul(hn::Set(d, r.first_scale[c]), hn::PromoteTo(d, hn::LoadU(dh, reinterpret_cast<const hwy::float16_t*>(first_half + i + v * lanes))));
       if (m_in) {
-        for (size_t k = 0; k < n; ++k) {
-          const V mk = hn::Set(d, m_in[k]);
-          const float* HWY_RESTRICT lq = o.lq + k * p + i;
-          s[0] = hn::MulAdd(hn::LoadU(d, lq), mk, s[0]);
-          if (count > 1) s[1] = hn::MulAdd(hn::LoadU(d, lq + lanes), mk, s[1]);
-          if (count > 2) s[2] = hn::MulAdd(hn::LoadU(d, lq + 2 * lanes), mk, s[2]);
-          if (count > 3) s[3] = hn::MulAdd(hn::LoadU(d, lq + 3 * lanes), mk, s[3]);
+        const float* HWY_RESTRICT lq = o.lq + i;
+        switch (count) {
+          case 1: DotRows<1>(d, lq, p, m_in, n, s); break;
+          case 2: DotRows<2>(d, lq, p, m_in, n, s); break;
+          case 3: DotRows<3>(d, lq, p, m_in, n, s); break;
+          default: DotRows<4>(d, lq, p, m_in, n, s); break;
         }
       }
       for (size_t v = 0; o.diamond && v < count; ++v) {
@@ -100,7 +133,7 @@ void DomSweepRow(const DomOctant& o, const DomRow& r) {
         V in = hn::Mul(hn::LoadU(d, ax + e), hn::LoadU(d, r.x_run + e));
         in = hn::MulAdd(hn::LoadU(d, ay + e), hn::LoadU(d, y + e), in);
         in = hn::MulAdd(hn::LoadU(d, az + e), hn::LoadU(d, z + e), in);
-        const V l = hn::Div(hn::MulAdd(sigma_s, s[v], in), hn::Add(sigma_t, hn::LoadU(d, asum + e)));
+        const V l = hn::Mul(hn::MulAdd(sigma_s, s[v], in), Reciprocal(d, hn::Add(sigma_t, hn::LoadU(d, asum + e))));
         hn::StoreU(l, d, r.x_run + e);
         hn::StoreU(l, d, y + e);
         hn::StoreU(l, d, z + e);
@@ -109,15 +142,13 @@ void DomSweepRow(const DomOctant& o, const DomRow& r) {
     }
     // Moments: lanes over terms, one direction (a broadcast) at a time.
     for (size_t k = 0; k < np; k += 4 * lanes) {
-      const size_t count = std::min<size_t>(4, (np - k) / lanes);
       V sum[4] = {hn::Zero(d), hn::Zero(d), hn::Zero(d), hn::Zero(d)};
-      for (size_t i = 0; i < p; ++i) {
-        const V li = hn::Set(d, light[i]);
-        const float* HWY_RESTRICT q = o.q + i * np + k;
-        sum[0] = hn::MulAdd(hn::LoadU(d, q), li, sum[0]);
-        if (count > 1) sum[1] = hn::MulAdd(hn::LoadU(d, q + lanes), li, sum[1]);
-        if (count > 2) sum[2] = hn::MulAdd(hn::LoadU(d, q + 2 * lanes), li, sum[2]);
-        if (count > 3) sum[3] = hn::MulAdd(hn::LoadU(d, q + 3 * lanes), li, sum[3]);
+      const size_t count = std::min<size_t>(4, (np - k) / lanes);
+      switch (count) {
+        case 1: DotRows<1>(d, o.q + k, np, light, p, sum); break;
+        case 2: DotRows<2>(d, o.q + k, np, light, p, sum); break;
+        case 3: DotRows<3>(d, o.q + k, np, light, p, sum); break;
+        default: DotRows<4>(d, o.q + k, np, light, p, sum); break;
       }
       for (size_t v = 0; v < count; ++v) hn::StoreU(sum[v], d, moments + k + v * lanes);
     }
