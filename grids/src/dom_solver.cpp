@@ -119,23 +119,46 @@ class KrylovBasis {
   void load(int i, std::vector<float>& w, int threads) const {  // w = v_i
     chunks(i, threads, [&](size_t b, size_t count, const float* v) { std::copy(v, v + count, w.data() + b); });
   }
-  double dot(const std::vector<float>& w, int i, int threads) const {
-    const auto chunk = static_cast<size_t>(kChunk);
-    std::vector<double> partial((size_ + chunk - 1) / chunk, 0.0);
-    chunks(i, threads, [&](size_t b, size_t count, const float* v) { partial[b / chunk] = chunk_dot(w.data() + b, v, count); });
-    double total = 0.0;
-    for (double p : partial) total += p;
-    return total;
+  // h_i = v_i . w for i < count: one pass over w and each v_i, chunk by chunk (classical
+  // Gram-Schmidt's projections, where modified Gram-Schmidt passes over w twice per vector).
+  std::vector<double> dots(const std::vector<float>& w, int count, int threads) const {
+    const auto chunk = static_cast<size_t>(kChunk), chunks_n = (size_ + chunk - 1) / chunk, vectors = static_cast<size_t>(count);
+    std::vector<double> partial(chunks_n * vectors, 0.0);
+    each_chunk(count, threads, [&](size_t b, size_t n, int i, const float* v) {
+      partial[b / chunk * vectors + static_cast<size_t>(i)] = chunk_dot(w.data() + b, v, n);
+    });
+    std::vector<double> h(vectors, 0.0);
+    for (size_t c = 0; c < chunks_n; ++c)
+      for (size_t i = 0; i < vectors; ++i) h[i] += partial[c * vectors + i];
+    return h;
   }
-  void axpy(std::vector<float>& w, double scale, int i, int threads) const {  // w += scale v_i
-    const auto s = static_cast<float>(scale);
-    chunks(i, threads, [&](size_t b, size_t count, const float* v) {
-      for (size_t e = 0; e < count; ++e) w[b + e] = w[b + e] + s * v[e];
+  // w -= sum_i h_i v_i for i < count, in one pass over w.
+  void subtract(std::vector<float>& w, const std::vector<double>& h, int count, int threads) const {
+    each_chunk(count, threads, [&](size_t b, size_t n, int i, const float* v) {
+      const auto s = static_cast<float>(h[static_cast<size_t>(i)]);
+      for (size_t e = 0; e < n; ++e) w[b + e] = w[b + e] - s * v[e];
     });
   }
 
  private:
-  // f(begin, count, v_i's values there as float32), per fixed chunk.
+  // f(begin, n, i, v_i's values there as float32) for i < count, per fixed chunk, the vectors in
+  // order within a chunk.
+  template <class F>
+  void each_chunk(int count, int threads, const F& f) const {
+    parallel_for(static_cast<long long>(size_), threads, kChunk, [&](long long i0, long long i1) {
+      const auto b = static_cast<size_t>(i0), n = static_cast<size_t>(i1 - i0);
+      std::vector<float> converted(half_ ? n : 0);
+      for (int i = 0; i < count; ++i) {
+        if (!half_) {
+          f(b, n, i, floats_[static_cast<size_t>(i)].data() + b);
+          continue;
+        }
+        simd::to_float(halves_[static_cast<size_t>(i)].data() + b, converted.data(), n);
+        f(b, n, i, converted.data());
+      }
+    });
+  }
+  // f for v_i alone.
   template <class F>
   void chunks(int i, int threads, const F& f) const {
     parallel_for(static_cast<long long>(size_), threads, kChunk, [&](long long i0, long long i1) {
@@ -188,8 +211,10 @@ void solve_moments(const dom::Transport& t, const dom::Channel& channel, const s
     }
     return;
   }
-  // GMRES(m) with modified Gram-Schmidt and Givens rotations (Saad, Iterative Methods, alg. 6.9).
-  // A float16 basis is not exactly orthonormal; the true residual at each restart still decides.
+  // GMRES(m) with Givens rotations (Saad, Iterative Methods, alg. 6.9), classical Gram-Schmidt:
+  // two passes over w per step instead of two per basis vector. Neither it nor a float16 basis is
+  // exactly orthonormal; the true residual, one more sweep after the estimate says converged,
+  // decides.
   const int m = kGmresRestart;
   KrylovBasis v(m + 1, x.size(), settings.storage == DomStorage::float16);
   std::vector<float> w(x.size());
@@ -211,10 +236,9 @@ void solve_moments(const dom::Transport& t, const dom::Channel& channel, const s
       t.sweep(channel, nullptr, w.data(), 0.0f, kx.data(), th);  // w = (I - K) v_j
       ++out.iterations;
       axpy(w, -1.0, kx, th);
-      for (int i = 0; i <= j; ++i) {
-        h(i, j) = v.dot(w, i, th);
-        v.axpy(w, -h(i, j), i, th);
-      }
+      const std::vector<double> projections = v.dots(w, j + 1, th);
+      v.subtract(w, projections, j + 1, th);
+      for (int i = 0; i <= j; ++i) h(i, j) = projections[static_cast<size_t>(i)];
       h(j + 1, j) = norm(w, th);
       if (h(j + 1, j) > 0.0) v.store(j + 1, w, 1.0 / h(j + 1, j), th);
       for (int i = 0; i < j; ++i) {
@@ -241,7 +265,9 @@ void solve_moments(const dom::Transport& t, const dom::Channel& channel, const s
     }
     // x += V_j y, with H_j y = g_j (upper triangular).
     Eigen::VectorXd y = h.topLeftCorner(j, j).triangularView<Eigen::Upper>().solve(g.head(j));
-    for (int i = 0; i < j; ++i) v.axpy(x, y(i), i, th);
+    std::vector<double> minus_y(static_cast<size_t>(j));
+    for (int i = 0; i < j; ++i) minus_y[static_cast<size_t>(i)] = -y(i);
+    v.subtract(x, minus_y, j, th);
   }
 }
 

@@ -140,7 +140,10 @@ void DomSweepRow(const DomOctant& o, const DomRow& r) {
         hn::StoreU(l, d, light + e);
       }
     }
-    // Moments: lanes over terms, one direction (a broadcast) at a time.
+    // Moments: lanes over terms, one direction (a broadcast) at a time, added to m_out in registers
+    // where a whole vector fits in the cell's N terms (a vector stored to the scratch and read
+    // back at another width stalls store-to-load forwarding), through the scratch for the rest.
+    float* HWY_RESTRICT out = r.m_out + c * n;
     for (size_t k = 0; k < np; k += 4 * lanes) {
       V sum[4] = {hn::Zero(d), hn::Zero(d), hn::Zero(d), hn::Zero(d)};
       const size_t count = std::min<size_t>(4, (np - k) / lanes);
@@ -150,10 +153,16 @@ void DomSweepRow(const DomOctant& o, const DomRow& r) {
         case 3: DotRows<3>(d, o.q + k, np, light, p, sum); break;
         default: DotRows<4>(d, o.q + k, np, light, p, sum); break;
       }
-      for (size_t v = 0; v < count; ++v) hn::StoreU(sum[v], d, moments + k + v * lanes);
+      for (size_t v = 0; v < count; ++v) {
+        const size_t at = k + v * lanes;
+        if (at + lanes <= n) {
+          hn::StoreU(hn::Add(hn::LoadU(d, out + at), sum[v]), d, out + at);
+        } else if (at < n) {
+          hn::StoreU(sum[v], d, moments + at);
+          for (size_t t = at; t < n; ++t) out[t] += moments[t];
+        }
+      }
     }
-    float* HWY_RESTRICT out = r.m_out + c * n;
-    for (size_t k = 0; k < n; ++k) out[k] += moments[k];
   }
 }
 
