@@ -360,6 +360,12 @@ DomFields dom_fields(const Scene& scene, const RenderOptions& options) {
 
 namespace {
 
+// Settings for fine cells: 64 directions (8 per octant, the kernel's lanes), 16 terms, float16
+// storage (the first-collision source and GMRES's basis; the dense cloud's image is unchanged).
+nlohmann::json fine_cell_settings(int resolution) {
+  return {{"resolution", resolution}, {"directions", 64}, {"terms", 16}, {"storage", "float16"}};
+}
+
 AutoOffer dom_offer(int resolution, int directions, int terms, double seconds, std::string why) {
   return AutoOffer{true, {{"resolution", resolution}, {"directions", directions}, {"terms", terms}}, seconds, std::move(why)};
 }
@@ -424,22 +430,25 @@ MethodInfo dom_info() {
                           "visible surfaces' scattered light: 64 rays per pixel, or the surfaces' texels (what the GL display shows)")};
   for (auto [resolution, directions, terms] : {std::tuple{16, 32, 9}, {24, 48, 16}, {32, 80, 25}, {48, 128, 25}, {64, 128, 25}, {96, 128, 25}})
     info.trade_sweep.push_back({{"resolution", resolution}, {"directions", directions}, {"terms", terms}});
-  // Trade suite, dense_cloud (albedo 0.99), against its 262144-spp reference, diamond scheme, 128
-  // directions (the trade run of 2026-12-02, a day this machine ran about 2x slower than the
-  // seconds below, measured before): error 20.2% at 16^3, 9.6% at 24^3, 5.7% at 32^3, 3.4% at 48^3
-  // (0.75 s), 2.1% at 64^3 (1.8 s), 1.1% at 96^3 (7.6 s); particle_cloud: 0.9% at 16^3 and 32
-  // directions in 3.7 s.
+  // Finer cells with fewer directions: 64 fill the kernel's 8 lanes in each octant, and the dense
+  // cloud's error is in the cell size, not the directions (at 64^3: 2.10% with 64, 2.12% with 128).
+  for (int resolution : {48, 68, 112, 128})
+    info.trade_sweep.push_back(fine_cell_settings(resolution));
+  // Trade suite, dense_cloud (albedo 0.99, three channels), against its 262144-spp reference,
+  // diamond scheme, 64 directions, 16 terms, float16 storage, 2 threads, measured 2026-12-02 (wall
+  // of `haze render`): 3.40% at 48^3 (0.72 s), 1.92% at 68^3 (1.7 s), 1.76% at 72^3 (2.2 s), 0.93%
+  // at 112^3 (9.5 s), 0.78% at 128^3 (15.6 s); particle_cloud: 0.9% at 16^3 and 32 directions in 3.7 s.
   info.offer = [](const SceneFeatures& f, double tolerance) {
     if (f.density == "particles")
       return AutoOffer{true, {{"resolution", 16}, {"directions", 32}, {"terms", 9}}, 3.7,
                        "on the particles' density: 0.9% on the suite's particle cloud"};
     if (f.surfaces) return surface_offer(f, tolerance);
     if (f.homogeneous && !f.bounded) return AutoOffer{false, {}, 0.0, "an unbounded homogeneous medium has no grid"};
-    if (tolerance < 0.015) return AutoOffer{false, {}, 0.0, "under its measured 1.1% at 96^3 on the suite's dense cloud"};
-    const int resolution = tolerance >= 0.04 ? 48 : tolerance >= 0.025 ? 64 : 96;
-    const double seconds = resolution == 48 ? 0.75 : resolution == 64 ? 1.8 : 7.6;
-    return AutoOffer{true, {{"resolution", resolution}, {"directions", 128}, {"terms", 25}}, seconds,
-                     to_text(resolution) + "^3 cells, 128 directions: the suite's dense cloud measured 3.4% at 48^3, 2.1% at 64^3 and 1.1% at 96^3"};
+    if (tolerance < 0.008) return AutoOffer{false, {}, 0.0, "under its measured 0.78% at 128^3 on the suite's dense cloud"};
+    const int resolution = tolerance >= 0.04 ? 48 : tolerance >= 0.025 ? 64 : tolerance >= 0.015 ? 72 : tolerance >= 0.01 ? 112 : 128;
+    const double seconds = resolution == 48 ? 0.7 : resolution == 64 ? 1.5 : resolution == 72 ? 2.2 : resolution == 112 ? 9.5 : 15.6;
+    return AutoOffer{true, fine_cell_settings(resolution), seconds,
+                     to_text(resolution) + "^3 cells, 64 directions: the suite's dense cloud measured 3.4% at 48^3, 2.1% at 64^3, 1.8% at 72^3, 0.93% at 112^3 and 0.78% at 128^3"};
   };
   return info;
 }
