@@ -125,6 +125,13 @@ nlohmann::json parse_compact(const std::string& text) {
   return settings;
 }
 
+// A CSV field in quotes, its quotes doubled (a string setting's value is quoted: storage="float16").
+std::string csv_quoted(const std::string& text) {
+  std::string out = "\"";
+  for (char ch : text) out += ch == '"' ? std::string("\"\"") : std::string(1, ch);
+  return out + "\"";
+}
+
 // The rows of an earlier trade.csv (so that --method reruns one method and keeps the others).
 std::vector<Row> read_rows(const std::filesystem::path& file) {
   std::vector<Row> rows;
@@ -135,8 +142,10 @@ std::vector<Row> read_rows(const std::filesystem::path& file) {
     std::vector<std::string> f;
     std::string cell;
     bool quoted = false;
-    for (char ch : line) {
-      if (ch == '"') quoted = !quoted;
+    for (size_t i = 0; i < line.size(); ++i) {
+      const char ch = line[i];
+      if (ch == '"' && quoted && i + 1 < line.size() && line[i + 1] == '"') cell += '"', ++i;  // "" in a quoted field
+      else if (ch == '"') quoted = !quoted;
       else if (ch == ',' && !quoted) f.push_back(cell), cell.clear();
       else cell += ch;
     }
@@ -450,8 +459,9 @@ int run(const TradeArgs& a) {
   csv << "scene,method,settings,seconds,error_rms_noise_removed,mean_abs,signed_mean,reference_noise_rms,lit_pixels,pareto,auto_chose,"
          "worst_of_seeds\n";
   for (const Row& r : all) {
-    csv << r.scene << "," << r.method << ",\"" << compact(r.settings) << "\"," << r.seconds << "," << r.measure() << "," << r.error.mean_abs << ","
-        << r.error.signed_mean << "," << r.error.noise_rms << "," << r.error.pixels << "," << r.pareto << ",\"" << r.chosen << "\",";
+    csv << r.scene << "," << r.method << "," << csv_quoted(compact(r.settings)) << "," << r.seconds << "," << r.measure() << ","
+        << r.error.mean_abs << "," << r.error.signed_mean << "," << r.error.noise_rms << "," << r.error.pixels << "," << r.pareto << ","
+        << csv_quoted(r.chosen) << ",";
     if (r.worst >= 0.0) csv << r.worst;
     csv << "\n";
   }

@@ -193,7 +193,9 @@ void Transport::sweep(const Channel& ch, const FirstCollision* first, const floa
       }
     }
   });
-  for (size_t i = 0; i < size; ++i) m_out[i] += scratch_[i];
+  parallel_for(static_cast<long long>(size), threads, 1 << 16, [&](long long i0, long long i1) {
+    for (auto i = static_cast<size_t>(i0); i < static_cast<size_t>(i1); ++i) m_out[i] += scratch_[i];
+  });
   cells_skipped_ += skipped[0] + skipped[1];
   cells_visited_ += 8 * static_cast<long long>(cells_);
   seconds_ += start.seconds();
