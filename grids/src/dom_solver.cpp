@@ -188,7 +188,7 @@ struct IterationProgress {
 
 // Source iteration x <- b + K x (each step one sweep), or restarted GMRES on (I - K) x = b.
 void solve_moments(const dom::Transport& t, const dom::Channel& channel, const std::vector<float>& b, std::vector<float>& x,
-                   const DomSettings& settings, const IterationProgress& progress, DomSolution& out) {
+                   const DomSettings& settings, const IterationProgress& progress, DomSolution& out, double tolerance) {
   const int limit = progress.start + settings.max_iterations;
   std::vector<float> kx(x.size());
   const int th = settings.threads;
@@ -207,7 +207,7 @@ void solve_moments(const dom::Transport& t, const dom::Channel& channel, const s
       const double change = norm(r, th) / std::max(norm(x, th), 1e-300);
       out.changes.push_back(change);
       progress(out.iterations);
-      if (change < settings.tolerance) return;
+      if (change < tolerance) return;
     }
     return;
   }
@@ -230,7 +230,7 @@ void solve_moments(const dom::Transport& t, const dom::Channel& channel, const s
     double beta = norm(w, th);
     out.changes.push_back(beta / x_norm);
     progress(out.iterations);
-    if (beta / x_norm < settings.tolerance || beta == 0.0) return;
+    if (beta / x_norm < tolerance || beta == 0.0) return;
     v.store(0, w, 1.0 / beta, th);
     g.setZero();
     g(0) = beta;
@@ -258,7 +258,7 @@ void solve_moments(const dom::Transport& t, const dom::Channel& channel, const s
       g(j) = cs(j) * g(j);
       out.changes.push_back(std::abs(g(j + 1)) / x_norm);
       progress(out.iterations);
-      if (std::abs(g(j + 1)) / x_norm < settings.tolerance) {
+      if (std::abs(g(j + 1)) / x_norm < tolerance) {
         ++j;
         estimated = true;
         break;
@@ -394,11 +394,12 @@ DomSolution solve_dom(const ExtinctionVolume& volume, const std::vector<Light>& 
     transport.sweep(channel, &first, nullptr, channel.sky, b.data(), settings.threads, entering);
     ++out.iterations;
     first = {};
+    bool from_channel = false;
     if (warm_fits) {
       x = warm->moments[static_cast<size_t>(c)];
-    } else if (c > 0 && previous_source > 0.0) {
+    } else if ((from_channel = c > 0 && previous_source > 0.0)) {
       // The channels differ by a few percent in sigma_t and in the lights' colour: the previous
-      // channel's moments, scaled as its source projects onto them, start GMRES close.
+      // channel's moments, scaled as its source projects onto them, start close.
       x = out.moments[static_cast<size_t>(c - 1)];
       const double scale = dot(b, x, settings.threads) / previous_source;
       for (float& m : x) m *= static_cast<float>(scale);
@@ -408,7 +409,10 @@ DomSolution solve_dom(const ExtinctionVolume& volume, const std::vector<Light>& 
     } else {
       x = b;
     }
-    solve_moments(transport, channel, b, x, settings, progress, out);
+    // A channel started from the previous one's moments keeps some of that start's slow (diffusive)
+    // error, which the residual shows only times (1 - albedo): half the tolerance for it (the
+    // particle cloud at 48^3: 0.592% at the full tolerance, 0.580% at half, 0.576% converged).
+    solve_moments(transport, channel, b, x, settings, progress, out, from_channel ? 0.5 * settings.tolerance : settings.tolerance);
     previous_source = dot(b, x, settings.threads);
   }
   out.converged = !out.changes.empty() && out.changes.back() < settings.tolerance;
