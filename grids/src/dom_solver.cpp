@@ -404,7 +404,8 @@ DomSolution solve_dom(const ExtinctionVolume& volume, const std::vector<Light>& 
       const double scale = dot(b, x, settings.threads) / previous_source;
       for (float& m : x) m *= static_cast<float>(scale);
     } else if (settings.accelerator == DomAccelerator::gmres) {
-      // GMRES from 0 spends no sweep on the first residual (b), and K_m(b) holds b + K_(m-1)(K b).
+      // GMRES from 0: the first residual is b, no sweep, and the Krylov space it builds holds what
+      // a start from b reaches in as many sweeps.
       x.assign(size, 0.0f);
     } else {
       x = b;

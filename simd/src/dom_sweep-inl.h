@@ -53,8 +53,8 @@ HWY_INLINE V Diamond(D d, V sigma_t, V sigma_s_times_s, V pad, const V a[3], V s
 }
 
 // acc[v] += sum_r rows[r * stride + v * lanes ...] w[r] for r < count_rows and kV vectors: the
-// rows split over 8 / kV interleaved accumulators per vector, so that about 8 independent FMA
-// chains hide the FMA's latency (one chain per vector left a 16-direction cell latency-bound).
+// rows split over 8 / kV interleaved accumulators per vector: about 8 independent FMA chains
+// where there was one per vector (with the reciprocals, about 12% per row).
 template <size_t kV, class D, class V = hn::Vec<D>>
 HWY_INLINE void DotRows(D d, const float* HWY_RESTRICT rows, size_t stride, const float* HWY_RESTRICT w, size_t count_rows, V* acc) {
   constexpr size_t kJ = 8 / kV;

@@ -61,7 +61,7 @@ TEST(AutoMethod, DomResolutionGrowsAsTheToleranceShrinksThenTheReferenceTakesOve
   ASSERT_EQ(fine.method, "dom");
   EXPECT_GT(mid.settings["resolution"].get<int>(), loose.settings["resolution"].get<int>());
   EXPECT_GT(fine.settings["resolution"].get<int>(), mid.settings["resolution"].get<int>());
-  // Under dom's measured 0.78% at 128^3 (it declines under 0.8%): the path tracer.
+  // Under dom's measured 0.76% at 128^3 (it declines under 0.8%): the path tracer.
   EXPECT_EQ(tight.method, "reference");
 }
 

@@ -23,7 +23,7 @@
 //   first order there (Godunov: no linear positive scheme is second order everywhere). With
 //   g_e = 1 / alpha_e and b_e = a_e g_e:
 //     L_d = (sigma_s S_d + sum_e b_e in_e) / (sigma_t + sum_e b_e),  out_e = g_e L_d - (g_e - 1) in_e.
-//   Divisions only, no exponential.
+//   Divisions only (reciprocals with a Newton step in the SIMD kernel), no exponential.
 // Then x_d, y_d, z_d take the leaving values (the upwind values the next cells read) and
 //   m_out[c][k] += sum_d Q[d][k] L_d          (eq. 10)
 // A cell of zero density (sigma_s = 0) reads no source: first and m_in are not touched there.
