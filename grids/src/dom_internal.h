@@ -31,6 +31,7 @@ struct FirstCollision {
   std::vector<float> values;
   std::vector<simd::Half> half;
   std::vector<float> scale;  // [cell], with `half`
+  std::vector<float> slope;  // [cell * 3 + axis]: the source's change across the cell over its mean
 };
 
 // Radiance entering through the grid's faces (DomBoundary) for one channel: per octant and the

@@ -27,28 +27,32 @@ HWY_INLINE V Reciprocal(D d, V x) {
 // The diamond scheme on one vector of directions (dom_sweep.h; the scalar reference's diamond_g,
 // lane by lane): the cell's mean radiance, and the leaving values stored into the faces x, y, z in
 // place of the entering ones. `sum`: a_x + a_y + a_z.
+// With `linear`, the first-collision source `first` is linear over the cell (dom_sweep.h):
+// `ts[e]` is sigma_s t_e.
 template <class D, class V = hn::Vec<D>>
 HWY_INLINE V Diamond(D d, V sigma_t, V sigma_s_times_s, V pad, const V a[3], V sum, float* HWY_RESTRICT x, float* HWY_RESTRICT y,
-                     float* HWY_RESTRICT z) {
+                     float* HWY_RESTRICT z, bool linear, V first, const V ts[3]) {
   const V zero = hn::Zero(d), one = hn::Set(d, 1.0f), tiny = hn::Set(d, kDiamondTiny), two = hn::Set(d, 2.0f), three = hn::Set(d, 3.0f),
           six = hn::Set(d, 6.0f);
   const V sigma2 = hn::Mul(sigma_t, sigma_t), two_sigma = hn::Mul(two, sigma_t), three_sigma = hn::Mul(three, sigma_t);
   const V around = hn::MulAdd(two, sum, sigma_t);  // sigma + 2 sum
   float* HWY_RESTRICT face[3] = {x, y, z};
-  V in[3], g[3];
+  V in[3], g[3], shift[3];
   V num = sigma_s_times_s, den = hn::Add(sigma_t, pad);
+  const V stay = linear ? hn::Mul(first, Reciprocal(d, hn::Add(hn::MulAdd(hn::Set(d, 12.0f), sum, two_sigma), tiny))) : zero;
   for (int e = 0; e < 3; ++e) {
     in[e] = hn::LoadU(d, face[e]);
+    shift[e] = hn::Mul(ts[e], stay);
     const V g_tau = hn::Mul(hn::MulAdd(a[e], hn::MulAdd(six, a[e], three_sigma), sigma2),
                             Reciprocal(d, hn::Max(hn::MulAdd(a[e], hn::MulAdd(three, a[e], two_sigma), sigma2), tiny)));
     const V q = hn::NegMulAdd(three, a[e], around), bound = hn::Mul(hn::NegMulAdd(two, a[e], around), Reciprocal(d, hn::Max(q, tiny)));
     g[e] = hn::IfThenElse(hn::Gt(q, zero), hn::Min(g_tau, bound), g_tau);
     const V b = hn::Mul(a[e], g[e]);
-    num = hn::MulAdd(b, in[e], num);
+    num = hn::MulAdd(b, hn::Sub(in[e], shift[e]), num);
     den = hn::Add(den, b);
   }
   const V l = hn::Mul(num, Reciprocal(d, hn::Max(den, tiny)));
-  for (int e = 0; e < 3; ++e) hn::StoreU(hn::NegMulAdd(hn::Sub(g[e], one), in[e], hn::Mul(g[e], l)), d, face[e]);
+  for (int e = 0; e < 3; ++e) hn::StoreU(hn::NegMulAdd(hn::Sub(g[e], one), in[e], hn::Mul(g[e], hn::Add(l, shift[e]))), d, face[e]);
   return l;
 }
 
@@ -105,6 +109,9 @@ void DomSweepRow(const DomOctant& o, const DomRow& r) {
     const float* HWY_RESTRICT m_in = r.m_in && !empty ? r.m_in + c * n : nullptr;
     const float* HWY_RESTRICT first = r.first && !empty ? r.first + c * r.first_stride : nullptr;
     const Half* HWY_RESTRICT first_half = !r.first && r.first_half && !empty ? r.first_half + c * r.first_stride : nullptr;
+    const bool linear = r.first_slope && (first || first_half) && o.diamond;
+    V ts[3];
+    for (int e = 0; e < 3; ++e) ts[e] = hn::Set(d, linear ? r.albedo * sigma_t_value * r.first_slope[c * 3 + static_cast<size_t>(e)] * o.sign[e] : 0.0f);
     for (size_t i = 0; i < p; i += 4 * lanes) {
       const size_t count = std::min<size_t>(4, (p - i) / lanes);
       // Source: the first-collision term plus lambda Q m_in, one term (a broadcast) at a time.
@@ -113,6 +120,7 @@ void DomSweepRow(const DomOctant& o, const DomRow& r) {
       if (first_half)
         for (size_t v = 0; v < count; ++v)
           s[v] = hn::Mul(hn::Set(d, r.first_scale[c]), hn::PromoteTo(d, hn::LoadU(dh, reinterpret_cast<const hwy::float16_t*>(first_half + i + v * lanes))));
+      const V fc[4] = {s[0], s[1], s[2], s[3]};  // the first-collision source alone
       if (m_in) {
         const float* HWY_RESTRICT lq = o.lq + i;
         switch (count) {
@@ -126,7 +134,8 @@ void DomSweepRow(const DomOctant& o, const DomRow& r) {
         const size_t e = i + v * lanes;
         const V a[3] = {hn::LoadU(d, ax + e), hn::LoadU(d, ay + e), hn::LoadU(d, az + e)};
         const V sum = hn::Add(hn::Add(a[0], a[1]), a[2]);
-        hn::StoreU(Diamond(d, sigma_t, hn::Mul(sigma_s, s[v]), hn::LoadU(d, pad + e), a, sum, r.x_run + e, y + e, z + e), d, light + e);
+        hn::StoreU(Diamond(d, sigma_t, hn::Mul(sigma_s, s[v]), hn::LoadU(d, pad + e), a, sum, r.x_run + e, y + e, z + e, linear, fc[v], ts), d,
+                   light + e);
       }
       for (size_t v = 0; !o.diamond && v < count; ++v) {
         const size_t e = i + v * lanes;

@@ -39,10 +39,14 @@ void dom_sweep_row_reference(const DomOctant& o, const DomRow& r) {
     float* y = r.y_row + x * p;
     float* z = r.z_row + x * p;
     const bool empty = sigma_t == 0.0f;  // scatters nothing: no source needed
+    float t[3] = {0.0f, 0.0f, 0.0f};     // the first-collision source's change along travel, over it
+    if (r.first_slope && !empty)
+      for (size_t e = 0; e < 3; ++e) t[e] = r.first_slope[c * 3 + e] * o.sign[e];
     for (size_t d = 0; d < p; ++d) {
-      float s = empty ? 0.0f
-                : r.first ? r.first[c * r.first_stride + d]
-                : r.first_half ? r.first_scale[c] * static_cast<float>(r.first_half[c * r.first_stride + d]) : 0.0f;
+      const float first = empty ? 0.0f
+                          : r.first ? r.first[c * r.first_stride + d]
+                          : r.first_half ? r.first_scale[c] * static_cast<float>(r.first_half[c * r.first_stride + d]) : 0.0f;
+      float s = first;
       if (r.m_in && !empty)
         for (size_t k = 0; k < n; ++k) s += o.lq[k * p + d] * r.m_in[c * n + k];
       if (!o.diamond) {
@@ -52,13 +56,15 @@ void dom_sweep_row_reference(const DomOctant& o, const DomRow& r) {
       }
       float* face[3] = {r.x_run + d, y + d, z + d};
       const float sum = o.a[d] + o.a[p + d] + o.a[2 * p + d];
-      float g[3], num = sigma_s * s, den = sigma_t + o.a[4 * p + d];
+      float g[3], shift[3], num = sigma_s * s, den = sigma_t + o.a[4 * p + d];
       for (size_t e = 0; e < 3; ++e) {
-        g[e] = diamond_g(sigma_t, o.a[e * p + d], sum);
-        num += o.a[e * p + d] * g[e] * *face[e], den += o.a[e * p + d] * g[e];
+        const float a = o.a[e * p + d];
+        g[e] = diamond_g(sigma_t, a, sum);
+        shift[e] = sigma_s * first * t[e] / (12.0f * sum + 2.0f * sigma_t + kDiamondTiny);
+        num += a * g[e] * (*face[e] - shift[e]), den += a * g[e];
       }
       const float l = num / std::max(den, kDiamondTiny);
-      for (size_t e = 0; e < 3; ++e) *face[e] = g[e] * l - (g[e] - 1.0f) * *face[e];
+      for (size_t e = 0; e < 3; ++e) *face[e] = g[e] * (l + shift[e]) - (g[e] - 1.0f) * *face[e];
       light[d] = l;
     }
     float* out = r.m_out + c * n;

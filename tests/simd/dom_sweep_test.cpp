@@ -29,7 +29,8 @@ TEST_P(DomSweep, MatchesScalarReferenceOnEveryTarget) {
   for (int p : {8, 24, 40})
     for (int n : {5, 24, 33})
       for (int step : {1, -1})
-        for (int sources = 0; sources < 12; ++sources) {  // first: none, float32, float16; m_in: no, yes; step, diamond
+        for (int case_ = 0; case_ < 24; ++case_) {  // first: none, float32, float16; m_in: no, yes; step, diamond; slopes: no, yes
+          const int sources = case_ % 12;
           const int np = (n + 7) / 8 * 8, count = 13, cells = 20;
           const auto up = static_cast<size_t>(p);
           std::vector<float> a(5 * up), lq(static_cast<size_t>(n) * up), q(up * static_cast<size_t>(np), 0.0f);
@@ -39,9 +40,10 @@ TEST_P(DomSweep, MatchesScalarReferenceOnEveryTarget) {
             a[4 * up + d] = 0.0f;
             for (int k = 0; k < n; ++k) q[d * static_cast<size_t>(np) + static_cast<size_t>(k)] = static_cast<float>(rng.uniform()) - 0.5f;
           }
-          const DomOctant octant{p, n, np, a.data(), lq.data(), q.data(), sources >= 6};
+          const DomOctant octant{p, n, np, a.data(), lq.data(), q.data(), sources >= 6, {1.0f, step > 0 ? 1.0f : -1.0f, -1.0f}};
           std::vector<float> density(cells), first(static_cast<size_t>(cells) * up), m_in(static_cast<size_t>(cells * n));
-          fill(density, 0.0f, 4.0f), fill(first, 0.0f, 1.0f), fill(m_in, 0.0f, 2.0f);
+          std::vector<float> slope(3 * static_cast<size_t>(cells));
+          fill(density, 0.0f, 4.0f), fill(first, 0.0f, 1.0f), fill(m_in, 0.0f, 2.0f), fill(slope, -2.0f, 2.0f);
           std::vector<Half> first_half(first.size());
           to_half_reference(first.data(), first_half.data(), first.size());
           std::vector<float> first_scale(density.size());
@@ -63,6 +65,7 @@ TEST_P(DomSweep, MatchesScalarReferenceOnEveryTarget) {
             row.first = sources % 3 == 1 ? first.data() : nullptr, row.first_stride = up;
             row.first_half = sources % 3 == 2 ? first_half.data() : nullptr, row.first_scale = first_scale.data();
             row.m_in = sources % 6 >= 3 ? m_in.data() : nullptr;
+            row.first_slope = case_ >= 12 ? slope.data() : nullptr;
             row.m_out = base;
             row.x_run = base + cells * n;
             row.y_row = row.x_run + up, row.z_row = row.y_row + static_cast<size_t>(count) * up;
@@ -72,7 +75,7 @@ TEST_P(DomSweep, MatchesScalarReferenceOnEveryTarget) {
           const float peak = *std::max_element(state[1].begin(), state[1].end());
           for (size_t i = 0; i < state[0].size(); ++i)
             ASSERT_NEAR(state[0][i], state[1][i], 1e-5f * std::abs(state[1][i]) + 1e-6f * peak)
-                << "P " << p << " N " << n << " step " << step << " sources " << sources << " at " << i << " target "
+                << "P " << p << " N " << n << " step " << step << " case " << case_ << " at " << i << " target "
                 << hwy::TargetName(GetParam());
         }
 }
@@ -84,7 +87,8 @@ struct Cell {
   std::array<float, 3> out;
   float mean;
 };
-Cell one_cell(std::array<float, 3> a, std::array<float, 3> in, float sigma_t, float s, bool diamond = true) {
+Cell one_cell(std::array<float, 3> a, std::array<float, 3> in, float sigma_t, float s, bool diamond = true,
+              std::array<float, 3> slope = {0.0f, 0.0f, 0.0f}) {
   const float octant_a[5 * 8] = {a[0], 0, 0, 0, 0, 0, 0, 0, a[1], 0, 0, 0, 0, 0, 0, 0, a[2], 0, 0, 0, 0, 0, 0, 0,
                                  a[0] + a[1] + a[2], 1, 1, 1, 1, 1, 1, 1, 0, 1, 1, 1, 1, 1, 1, 1};
   const float lq[8] = {}, q[8] = {};
@@ -93,6 +97,7 @@ Cell one_cell(std::array<float, 3> a, std::array<float, 3> in, float sigma_t, fl
   DomRow row;
   row.count = 1, row.density = &density, row.albedo = 1.0f, row.first = first, row.first_stride = 8;
   row.m_out = &m_out, row.x_run = x, row.y_row = y, row.z_row = z, row.scratch = scratch;
+  row.first_slope = slope.data();
   dom_sweep_row_reference(octant, row);
   return {{x[0], y[0], z[0]}, scratch[0]};
 }
@@ -100,7 +105,8 @@ Cell one_cell(std::array<float, 3> a, std::array<float, 3> in, float sigma_t, fl
 // The diamond scheme keeps the cell's balance sum_e a_e (out_e - in_e) + sigma_t L = sigma_s S
 // and leaves no negative radiance (to float rounding, where the light all but dies in the cell),
 // over random cells from optically thin to 50 thick and directions from along an axis to grazing:
-// where the plain diamond (alpha = 1/2) would leave negative radiance on a minor axis.
+// where the plain diamond (alpha = 1/2) would leave negative radiance on a minor axis. Half the
+// cells take their source as linear, changing by up to twice its mean across the cell.
 TEST(DomDiamond, BalancedAndPositive) {
   Rng rng(17);
   for (int i = 0; i < 20000; ++i) {
@@ -109,7 +115,10 @@ TEST(DomDiamond, BalancedAndPositive) {
     for (float& e : in) e = rng.uniform() < 0.3 ? 0.0f : static_cast<float>(rng.uniform());
     const float sigma_t = rng.uniform() < 0.2 ? 0.0f : static_cast<float>(50.0 * std::pow(rng.uniform(), 3.0));
     const float s = rng.uniform() < 0.5 ? 0.0f : static_cast<float>(rng.uniform());
-    const Cell c = one_cell(a, in, sigma_t, s);
+    std::array<float, 3> slope{0.0f, 0.0f, 0.0f};
+    if (i % 2)
+      for (float& e : slope) e = static_cast<float>(4.0 * rng.uniform() - 2.0);
+    const Cell c = one_cell(a, in, sigma_t, s, true, slope);
     const double sigma = sigma_t, mean = c.mean, source = s;
     double balance = sigma * mean - sigma * source, scale = sigma * mean + sigma * source + 1e-30;
     for (size_t e = 0; e < 3; ++e) {

@@ -24,6 +24,16 @@
 //   g_e = 1 / alpha_e and b_e = a_e g_e:
 //     L_d = (sigma_s S_d + sum_e b_e in_e) / (sigma_t + sum_e b_e),  out_e = g_e L_d - (g_e - 1) in_e.
 //   Divisions only (reciprocals with a Newton step in the SIMD kernel), no exponential.
+//   With first_slope, the first-collision source F is linear over the cell, changing by
+//   dF_e = F t_e across it along axis e in the direction of travel (t_e = slope_e sign_e, |t_e|
+//   <= 2); the cell's mean then sits below the diamond's face average by
+//   c_e = sigma_s dF_e / (12 (a_x + a_y + a_z) + 2 sigma_t) (in one dimension sigma_s dF / (12 a),
+//   exact for a linear source in a thin cell, and sigma_s dF / (2 sigma_t), the exit face's local
+//   equilibrium, in a thick one; the sum of the a_e bounds it by the time light stays in the
+//   cell): L = alpha_e out_e + (1 - alpha_e) in_e - c_e, so
+//     L_d = (sigma_s S_d + sum_e b_e (in_e - c_e)) / (sigma_t + sum_e b_e),
+//     out_e = g_e (L_d + c_e) - (g_e - 1) in_e,
+//   the cell's balance unchanged. Under a grazing sun a top cell's source is far from uniform.
 // Then x_d, y_d, z_d take the leaving values (the upwind values the next cells read) and
 //   m_out[c][k] += sum_d Q[d][k] L_d          (eq. 10)
 // A cell of zero density (sigma_s = 0) reads no source: first and m_in are not touched there.
@@ -52,6 +62,7 @@ struct DomOctant {
   const float* lq = nullptr;  // [k * P + d]: lambda_k Q[d][k]
   const float* q = nullptr;   // [d * terms_padded + k]: Q[d][k]
   bool diamond = false;       // the spatial scheme: weighted diamond difference, else step
+  float sign[3] = {1.0f, 1.0f, 1.0f};  // the sign of the octant's directions along x, y, z
 };
 
 // Cells x0 + m * step (step +1 or -1), m < count, of one grid row along x; cell0 is the linear
@@ -65,6 +76,9 @@ struct DomRow {
   const Half* first_half = nullptr;  // or the same in float16, times first_scale[cell]
   const float* first_scale = nullptr;
   size_t first_stride = 0;
+  // Or null: [cell * 3 + e], the first-collision source's change across the cell along axis e over
+  // its mean (the diamond scheme takes the source as linear over the cell; see above).
+  const float* first_slope = nullptr;
   const float* m_in = nullptr;     // [cell * terms + k], or null
   float* m_out = nullptr;          // [cell * terms + k], added to
   float* x_run = nullptr;          // [P]: radiance across x faces, carried along the row
