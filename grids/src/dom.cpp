@@ -439,9 +439,9 @@ MethodInfo dom_info() {
     info.trade_sweep.push_back(fine_cell_settings(resolution));
   // Trade suite, dense_cloud (albedo 0.99, three channels), against its 262144-spp reference,
   // diamond scheme, 64 directions, 16 terms, float16 storage, 2 threads (`haze bench trade
-  // --method dom`, 2026-12-02): 3.40% at 48^3 (0.55 s), 1.91% at 68^3 (1.42 s), 1.75% at 72^3
-  // (2.2 s), 0.91% at 112^3 (8.5 s), 0.76% at 128^3 (14.4 s); particle_cloud: 0.6% at 16^3 and
-  // 32 directions in 3.2 s.
+  // --method dom`, 2026-12-02, two runs): 3.4% at 48^3 (0.55 to 0.66 s), 1.9% at 68^3 (1.4 to
+  // 1.7 s), 1.75% at 72^3 (2.2 to 2.7 s), 0.91% at 112^3 (8.5 to 9.2 s), 0.76% at 128^3 (13 to
+  // 14 s); particle_cloud: 0.6% at 16^3 and 32 directions in 3.2 to 3.7 s.
   info.offer = [](const SceneFeatures& f, double tolerance) {
     if (f.density == "particles")
       return AutoOffer{true, {{"resolution", 16}, {"directions", 32}, {"terms", 9}}, 3.7,

@@ -285,12 +285,13 @@ size_t dom_memory_bytes(const std::array<int, 3>& resolution, int channels, cons
   const auto d = static_cast<size_t>(settings.directions), n = static_cast<size_t>(kept_terms(settings));
   const size_t padded = d + 8 * 7;  // the first-collision source pads each octant to a multiple of 8
   const size_t result = sizeof(float) * static_cast<size_t>(channels) * cells * n;
-  if (settings.scheme == DomScheme::paper)  // first-collision source; radiance twice, in-scatter; moments twice
-    return result + sizeof(float) * (cells * padded + 3 * cells * d + 2 * cells * n);
-  // The first-collision source (float16 adds a scale per cell) with b and the second half's sweep
-  // output; then, the source freed, b, K x, the sweep output, a work vector and GMRES's basis.
+  if (settings.scheme == DomScheme::paper)  // first-collision source and slopes; radiance twice, in-scatter; moments twice
+    return result + sizeof(float) * (cells * padded + 3 * cells + 3 * cells * d + 2 * cells * n);
+  // The first-collision source (its slopes, 3 per cell; float16 adds a scale per cell) with b and
+  // the second half's sweep output; then, the source freed, b, K x, the sweep output, a work
+  // vector and GMRES's basis.
   const bool half = settings.storage == DomStorage::float16;
-  const size_t first = half ? sizeof(simd::Half) * cells * padded + sizeof(float) * cells : sizeof(float) * cells * padded;
+  const size_t first = (half ? sizeof(simd::Half) * cells * padded + sizeof(float) * cells : sizeof(float) * cells * padded) + sizeof(float) * 3 * cells;
   const size_t basis = settings.accelerator == DomAccelerator::gmres ? kGmresRestart + 1 : 0;
   const size_t iterating = sizeof(float) * 4 * cells * n + (half ? sizeof(simd::Half) : sizeof(float)) * basis * cells * n;
   return result + std::max(first + sizeof(float) * 2 * cells * n, iterating);

@@ -43,6 +43,7 @@ double linear_change(double u) {
 // where the other neighbour is in a surface's shadow (kShadowDepth), and at most twice the
 // centre's depth (the depth stays >= 0 over the cell). The centre value alone undercounts the
 // light arriving over the cell: under a grazing sun 8 cells per optical depth lose 6% at the top.
+// u gets the u_e (0 on an axis left out).
 double cell_mean_attenuation(const DenseGrid& depth, int i, int j, int k, double sigma_t, std::array<double, 3>& u) {
   u = {0.0, 0.0, 0.0};
   const std::array<int, 3> n = depth.resolution(), at{i, j, k};
