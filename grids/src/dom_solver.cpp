@@ -117,14 +117,14 @@ class KrylovBasis {
     });
   }
   void load(int i, std::vector<float>& w, int threads) const {  // w = v_i
-    chunks(i, threads, [&](size_t b, size_t count, const float* v) { std::copy(v, v + count, w.data() + b); });
+    each_chunk(i, i + 1, threads, [&](size_t b, size_t n, int, const float* v) { std::copy(v, v + n, w.data() + b); });
   }
   // h_i = v_i . w for i < count: one pass over w and each v_i, chunk by chunk (classical
   // Gram-Schmidt's projections, where modified Gram-Schmidt passes over w twice per vector).
   std::vector<double> dots(const std::vector<float>& w, int count, int threads) const {
     const auto chunk = static_cast<size_t>(kChunk), chunks_n = (size_ + chunk - 1) / chunk, vectors = static_cast<size_t>(count);
     std::vector<double> partial(chunks_n * vectors, 0.0);
-    each_chunk(count, threads, [&](size_t b, size_t n, int i, const float* v) {
+    each_chunk(0, count, threads, [&](size_t b, size_t n, int i, const float* v) {
       partial[b / chunk * vectors + static_cast<size_t>(i)] = chunk_dot(w.data() + b, v, n);
     });
     std::vector<double> h(vectors, 0.0);
@@ -134,21 +134,21 @@ class KrylovBasis {
   }
   // w -= sum_i h_i v_i for i < count, in one pass over w.
   void subtract(std::vector<float>& w, const std::vector<double>& h, int count, int threads) const {
-    each_chunk(count, threads, [&](size_t b, size_t n, int i, const float* v) {
+    each_chunk(0, count, threads, [&](size_t b, size_t n, int i, const float* v) {
       const auto s = static_cast<float>(h[static_cast<size_t>(i)]);
       for (size_t e = 0; e < n; ++e) w[b + e] = w[b + e] - s * v[e];
     });
   }
 
  private:
-  // f(begin, n, i, v_i's values there as float32) for i < count, per fixed chunk, the vectors in
-  // order within a chunk.
+  // f(begin, n, i, v_i's values there as float32) for first <= i < last, per fixed chunk, the
+  // vectors in order within a chunk.
   template <class F>
-  void each_chunk(int count, int threads, const F& f) const {
+  void each_chunk(int first, int last, int threads, const F& f) const {
     parallel_for(static_cast<long long>(size_), threads, kChunk, [&](long long i0, long long i1) {
       const auto b = static_cast<size_t>(i0), n = static_cast<size_t>(i1 - i0);
       std::vector<float> converted(half_ ? n : 0);
-      for (int i = 0; i < count; ++i) {
+      for (int i = first; i < last; ++i) {
         if (!half_) {
           f(b, n, i, floats_[static_cast<size_t>(i)].data() + b);
           continue;
@@ -156,17 +156,6 @@ class KrylovBasis {
         simd::to_float(halves_[static_cast<size_t>(i)].data() + b, converted.data(), n);
         f(b, n, i, converted.data());
       }
-    });
-  }
-  // f for v_i alone.
-  template <class F>
-  void chunks(int i, int threads, const F& f) const {
-    parallel_for(static_cast<long long>(size_), threads, kChunk, [&](long long i0, long long i1) {
-      const auto b = static_cast<size_t>(i0), count = static_cast<size_t>(i1 - i0);
-      if (!half_) return f(b, count, floats_[static_cast<size_t>(i)].data() + b);
-      std::vector<float> converted(count);
-      simd::to_float(halves_[static_cast<size_t>(i)].data() + b, converted.data(), count);
-      f(b, count, converted.data());
     });
   }
   size_t size_;

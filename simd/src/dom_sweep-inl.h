@@ -27,11 +27,11 @@ HWY_INLINE V Reciprocal(D d, V x) {
 // The diamond scheme on one vector of directions (dom_sweep.h; the scalar reference's diamond_g,
 // lane by lane): the cell's mean radiance, and the leaving values stored into the faces x, y, z in
 // place of the entering ones. `sum`: a_x + a_y + a_z.
-// With `linear`, the first-collision source `first` is linear over the cell (dom_sweep.h):
-// `ts[e]` is sigma_s t_e.
-template <class D, class V = hn::Vec<D>>
+// With kLinear, the first-collision source `first` is linear over the cell (dom_sweep.h):
+// `ts[e]` is sigma_s t_e; without, the shifts are not computed (the sweeps with no such source).
+template <bool kLinear, class D, class V = hn::Vec<D>>
 HWY_INLINE V Diamond(D d, V sigma_t, V sigma_s_times_s, V pad, const V a[3], V sum, float* HWY_RESTRICT x, float* HWY_RESTRICT y,
-                     float* HWY_RESTRICT z, bool linear, V first, const V ts[3]) {
+                     float* HWY_RESTRICT z, V first, const V ts[3]) {
   const V zero = hn::Zero(d), one = hn::Set(d, 1.0f), tiny = hn::Set(d, kDiamondTiny), two = hn::Set(d, 2.0f), three = hn::Set(d, 3.0f),
           six = hn::Set(d, 6.0f);
   const V sigma2 = hn::Mul(sigma_t, sigma_t), two_sigma = hn::Mul(two, sigma_t), three_sigma = hn::Mul(three, sigma_t);
@@ -39,20 +39,22 @@ HWY_INLINE V Diamond(D d, V sigma_t, V sigma_s_times_s, V pad, const V a[3], V s
   float* HWY_RESTRICT face[3] = {x, y, z};
   V in[3], g[3], shift[3];
   V num = sigma_s_times_s, den = hn::Add(sigma_t, pad);
-  const V stay = linear ? hn::Mul(first, Reciprocal(d, hn::Add(hn::MulAdd(hn::Set(d, 12.0f), sum, two_sigma), tiny))) : zero;
+  V stay = zero;
+  if constexpr (kLinear) stay = hn::Mul(first, Reciprocal(d, hn::Add(hn::MulAdd(hn::Set(d, 12.0f), sum, two_sigma), tiny)));
   for (int e = 0; e < 3; ++e) {
     in[e] = hn::LoadU(d, face[e]);
-    shift[e] = hn::Mul(ts[e], stay);
+    shift[e] = kLinear ? hn::Mul(ts[e], stay) : zero;
     const V g_tau = hn::Mul(hn::MulAdd(a[e], hn::MulAdd(six, a[e], three_sigma), sigma2),
                             Reciprocal(d, hn::Max(hn::MulAdd(a[e], hn::MulAdd(three, a[e], two_sigma), sigma2), tiny)));
     const V q = hn::NegMulAdd(three, a[e], around), bound = hn::Mul(hn::NegMulAdd(two, a[e], around), Reciprocal(d, hn::Max(q, tiny)));
     g[e] = hn::IfThenElse(hn::Gt(q, zero), hn::Min(g_tau, bound), g_tau);
     const V b = hn::Mul(a[e], g[e]);
-    num = hn::MulAdd(b, hn::Sub(in[e], shift[e]), num);
+    num = hn::MulAdd(b, kLinear ? hn::Sub(in[e], shift[e]) : in[e], num);
     den = hn::Add(den, b);
   }
   const V l = hn::Mul(num, Reciprocal(d, hn::Max(den, tiny)));
-  for (int e = 0; e < 3; ++e) hn::StoreU(hn::NegMulAdd(hn::Sub(g[e], one), in[e], hn::Mul(g[e], hn::Add(l, shift[e]))), d, face[e]);
+  for (int e = 0; e < 3; ++e)
+    hn::StoreU(hn::NegMulAdd(hn::Sub(g[e], one), in[e], hn::Mul(g[e], kLinear ? hn::Add(l, shift[e]) : l)), d, face[e]);
   return l;
 }
 
@@ -134,8 +136,10 @@ void DomSweepRow(const DomOctant& o, const DomRow& r) {
         const size_t e = i + v * lanes;
         const V a[3] = {hn::LoadU(d, ax + e), hn::LoadU(d, ay + e), hn::LoadU(d, az + e)};
         const V sum = hn::Add(hn::Add(a[0], a[1]), a[2]);
-        hn::StoreU(Diamond(d, sigma_t, hn::Mul(sigma_s, s[v]), hn::LoadU(d, pad + e), a, sum, r.x_run + e, y + e, z + e, linear, fc[v], ts), d,
-                   light + e);
+        const V ss = hn::Mul(sigma_s, s[v]), pe = hn::LoadU(d, pad + e);
+        const V l = linear ? Diamond<true>(d, sigma_t, ss, pe, a, sum, r.x_run + e, y + e, z + e, fc[v], ts)
+                           : Diamond<false>(d, sigma_t, ss, pe, a, sum, r.x_run + e, y + e, z + e, fc[v], ts);
+        hn::StoreU(l, d, light + e);
       }
       for (size_t v = 0; !o.diamond && v < count; ++v) {
         const size_t e = i + v * lanes;
