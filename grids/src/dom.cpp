@@ -360,46 +360,54 @@ DomFields dom_fields(const Scene& scene, const RenderOptions& options) {
 
 namespace {
 
-// Settings for fine cells: 64 directions (8 per octant, the kernel's lanes), 16 terms, float16
-// storage (the first-collision source and GMRES's basis; the dense cloud's image is unchanged).
-nlohmann::json fine_cell_settings(int resolution) {
-  return {{"resolution", resolution}, {"directions", 64}, {"terms", 16}, {"storage", "float16"}};
+// Settings for fine cells: 64 directions (8 per octant, the kernel's lanes), float16 storage (the
+// first-collision source and GMRES's basis; the dense cloud's image is unchanged).
+nlohmann::json fine_cell_settings(int resolution, int terms) {
+  return {{"resolution", resolution}, {"directions", 64}, {"terms", terms}, {"storage", "float16"}};
 }
 
 AutoOffer dom_offer(int resolution, int directions, int terms, double seconds, std::string why) {
   return AutoOffer{true, {{"resolution", resolution}, {"directions", directions}, {"terms", terms}}, seconds, std::move(why)};
 }
 
+// Surfaces in fog: the diamond bounded in every cell, whose diffusion damps the lamps' ray effects
+// (fog_lamps 2.19% at 48^3 against 2.58% with the fix-up alone; thin_haze 1.61% and 1.59%).
+AutoOffer fog_offer(int resolution, int directions, int terms, double seconds, std::string why) {
+  AutoOffer offer = dom_offer(resolution, directions, terms, seconds, std::move(why));
+  offer.settings["spatial"] = "bounded";
+  return offer;
+}
+
 // With surfaces, from the trade suite's surface scenes (surface passes in the solve):
-//   cloud_sun (an RBF cloud over a floor, albedo 0.92; the trade run of 2026-12-02): 3.5% at
-//   16^3, 2.1% at 24^3, 1.3% at 32^3 (1.2 s), 0.74% at 48^3 with 64 directions (2.6 s), 0.58%
-//   with 128 (3.7 s), 0.43% at 64^3;
+//   cloud_sun (an RBF cloud over a floor, albedo 0.92; measured 2026-12-02 with the diamond's
+//   fix-up): 3.3% at 16^3, 1.9% at 24^3, 1.1% at 32^3 (1.2 s), 0.68% at 48^3 with 64 directions
+//   (2.4 s), 0.49% with 128 (4.0 s), 0.37% at 64^3;
 //   fog_lamps and thin_haze (constant fog over a floor with a sphere inside the grid; multiple
-//   shares 58% and 16%; measured 2026-12-02): 4.2% and 3.1% at 16^3 (0.35 s), 3.1% and 2.2% at
-//   24^3 (0.8 s), 2.4% and 1.7% at 32^3 (1.7 s), 2.2% and 1.6% at 48^3 (4 s), no better past it
-//   (2.4% and 1.6% at 96^3: the sphere neither blocks nor sends light in the sweeps).
+//   shares 58% and 16%; spatial bounded; measured 2026-12-02): 4.0% and 3.0% at 16^3 (0.35 s),
+//   3.1% and 2.0% at 24^3 (0.8 s), 2.3% and 1.6% at 32^3 (1.7 s), 2.2% and 1.6% at 48^3 (4 s), no
+//   better past it (2.4% and 1.6% at 96^3: the sphere neither blocks nor sends light in the sweeps).
 // Clouds of higher albedo than cloud_sun's take the dense cloud's resolutions (the rule below).
 AutoOffer surface_offer(const SceneFeatures& f, double tolerance) {
   if (f.homogeneous) {
-    if (tolerance >= 0.05) return dom_offer(16, 32, 9, 0.35, "surfaces in fog: fog_lamps and thin_haze measured 4.2% and 3.1% at 16^3");
-    if (tolerance >= 0.035) return dom_offer(24, 48, 16, 0.8, "surfaces in fog: fog_lamps and thin_haze measured 3.1% and 2.2% at 24^3");
-    if (tolerance >= 0.03) return dom_offer(32, 80, 25, 1.7, "surfaces in fog: fog_lamps and thin_haze measured 2.4% and 1.7% at 32^3");
+    if (tolerance >= 0.05) return fog_offer(16, 32, 9, 0.35, "surfaces in fog: fog_lamps and thin_haze measured 4.0% and 3.0% at 16^3");
+    if (tolerance >= 0.035) return fog_offer(24, 48, 16, 0.8, "surfaces in fog: fog_lamps and thin_haze measured 3.1% and 2.0% at 24^3");
+    if (tolerance >= 0.03) return fog_offer(32, 80, 25, 1.7, "surfaces in fog: fog_lamps and thin_haze measured 2.3% and 1.6% at 32^3");
     if (f.multiple_share < 0.3 && tolerance >= 0.02)
-      return dom_offer(32, 80, 25, 1.7, "surfaces in thin fog: thin_haze (multiple share 16%) measured 1.7% at 32^3");
-    if (tolerance >= 0.025) return dom_offer(48, 128, 25, 4.0, "surfaces in fog: fog_lamps measured 2.2% at 48^3");
+      return fog_offer(32, 80, 25, 1.7, "surfaces in thin fog: thin_haze (multiple share 16%) measured 1.6% at 32^3");
+    if (tolerance >= 0.025) return fog_offer(48, 128, 25, 4.0, "surfaces in fog: fog_lamps measured 2.2% at 48^3");
     return AutoOffer{false, {}, 0.0,
                      f.multiple_share < 0.3 ? "surfaces in thin fog: 1.6% at best on the suite"
                                             : "surfaces in fog: 2.2% at best on the suite (a sphere inside the grid is left out of the sweeps)"};
   }
   if (f.albedo > 0.95) return AutoOffer{false, {}, 0.0, "surfaces under a cloud of albedo over 0.95: not measured"};
-  if (tolerance >= 0.05) return dom_offer(16, 32, 9, 0.20, "a cloud over surfaces: cloud_sun measured 3.5% at 16^3");
-  if (tolerance >= 0.025) return dom_offer(24, 48, 16, 0.44, "a cloud over surfaces: cloud_sun measured 2.1% at 24^3");
-  if (tolerance >= 0.015) return dom_offer(32, 80, 25, 1.1, "a cloud over surfaces: cloud_sun measured 1.3% at 32^3");
-  if (tolerance >= 0.009)
-    return AutoOffer{true, fine_cell_settings(48), 2.6, "a cloud over surfaces: cloud_sun measured 0.74% at 48^3 with 64 directions"};
-  if (tolerance >= 0.008) return dom_offer(48, 128, 25, 3.9, "a cloud over surfaces: cloud_sun measured 0.58% at 48^3");
-  if (tolerance >= 0.005) return dom_offer(64, 128, 25, 7.6, "a cloud over surfaces: cloud_sun measured 0.43% at 64^3");
-  return AutoOffer{false, {}, 0.0, "a cloud over surfaces: 0.36% at best on the suite (96^3)"};
+  if (tolerance >= 0.04) return dom_offer(16, 32, 9, 0.20, "a cloud over surfaces: cloud_sun measured 3.3% at 16^3");
+  if (tolerance >= 0.025) return dom_offer(24, 48, 16, 0.44, "a cloud over surfaces: cloud_sun measured 1.9% at 24^3");
+  if (tolerance >= 0.014) return dom_offer(32, 80, 25, 1.2, "a cloud over surfaces: cloud_sun measured 1.1% at 32^3");
+  if (tolerance >= 0.008)
+    return AutoOffer{true, fine_cell_settings(48, 16), 2.4, "a cloud over surfaces: cloud_sun measured 0.68% at 48^3 with 64 directions"};
+  if (tolerance >= 0.006) return dom_offer(48, 128, 25, 4.0, "a cloud over surfaces: cloud_sun measured 0.49% at 48^3");
+  if (tolerance >= 0.0045) return dom_offer(64, 128, 25, 8.9, "a cloud over surfaces: cloud_sun measured 0.37% at 64^3");
+  return AutoOffer{false, {}, 0.0, "a cloud over surfaces: 0.37% at best measured (64^3)"};
 }
 
 }  // namespace
@@ -418,8 +426,9 @@ MethodInfo dom_info() {
       SettingInfo::integer("directions", d.directions, 8, 4096, "D, spherical Fibonacci directions"),
       SettingInfo::integer("terms", nullptr, 0, 4096, "N separable terms of the phase matrix: min(25, D); 0 or D: the full matrix"),
       SettingInfo::choice("scheme", "sweep", {"paper", "sweep"}, "sweep: upwind transport sweeps; paper: seed 000's Jacobi scheme"),
-      SettingInfo::choice("spatial", "diamond", {"step", "diamond"},
-                          "how radiance leaves a cell: weighted diamond difference (second order), or seed 000's step (step with scheme paper)"),
+      SettingInfo::choice("spatial", "diamond", {"step", "diamond", "bounded"},
+                          "how radiance leaves a cell: weighted diamond difference (second order; bounded where radiance would go below 0), "
+                          "bounded everywhere (damps lamps' ray effects in fog), or seed 000's step (step with scheme paper)"),
       SettingInfo::choice("accelerator", "gmres", {"none", "gmres"}, "GMRES on the moments, or plain source iteration"),
       SettingInfo::integer("iterations", d.max_iterations, 1, 100000, "transport sweeps per channel at most"),
       SettingInfo::number("tolerance", d.tolerance, 1e-9, 1.0, "stop when an iteration changes the moments by less (relative)"),
@@ -427,32 +436,36 @@ MethodInfo dom_info() {
       SettingInfo::choice("storage", "float32", {"float32", "float16"}, "float16 halves the first-collision source and GMRES basis"),
       SettingInfo::choice("optical_depth", "exact", {"exact", "paper", "sweep"}, "how the depth to each light is computed"),
       SettingInfo::number("step", 0.5, 0.01, 4.0, "camera gather's ray-march step in cells"),
-      SettingInfo::integer("warm_iterations", 0, 0, 100000, "sweeps per update, each with the first-collision source in it (0: GMRES to the tolerance)"),
+      SettingInfo::integer("warm_iterations", 0, 0, 100000, "source-iteration sweeps per update, after a first-collision sweep with spatial diamond (0: GMRES to the tolerance)"),
       SettingInfo::integer("surface_passes", 2, 0, 100, "solves with the light surfaces reflect into the medium, one more bounce each (scheme sweep)"),
       SettingInfo::choice("surface_view", "rays", {"rays", "texels"},
                           "visible surfaces' scattered light: 64 rays per pixel, or the surfaces' texels (what the GL display shows)")};
   for (auto [resolution, directions, terms] : {std::tuple{16, 32, 9}, {24, 48, 16}, {32, 80, 25}, {48, 128, 25}, {64, 128, 25}, {96, 128, 25}})
     info.trade_sweep.push_back({{"resolution", resolution}, {"directions", directions}, {"terms", terms}});
-  // Finer cells with fewer directions: 64 fill the kernel's 8 lanes in each octant, and the dense
-  // cloud's error is in the cell size, not the directions (at 64^3: 2.10% with 64, 2.12% with 128).
-  for (int resolution : {48, 68, 112, 128})
-    info.trade_sweep.push_back(fine_cell_settings(resolution));
-  // Trade suite, dense_cloud (albedo 0.99, three channels), against its 262144-spp reference,
-  // diamond scheme, 64 directions, 16 terms, float16 storage, 2 threads (`haze bench trade
-  // --method dom`, 2026-12-02, two runs): 3.4% at 48^3 (0.55 to 0.66 s), 1.9% at 68^3 (1.4 to
-  // 1.7 s), 1.75% at 72^3 (2.2 to 2.7 s), 0.91% at 112^3 (8.5 to 9.2 s), 0.76% at 128^3 (13 to
-  // 14 s); particle_cloud: 0.6% at 16^3 and 32 directions in 3.2 to 3.7 s.
+  // Finer cells with fewer directions and terms: 64 fill the kernel's 8 lanes in each octant, and
+  // the dense cloud's error is in the cell size, not the directions (at 64^3: 2.10% with 64, 2.12%
+  // with 128, bounded everywhere); 9 terms (delta-M's truncation at l = 3) beat 16 there (0.70%
+  // and 0.75% at 96^3), not on cloud_sun (1.18% and 0.68% at 48^3).
+  for (int resolution : {48, 60, 88, 128})
+    info.trade_sweep.push_back(fine_cell_settings(resolution, 9));
+  // Fog with lamps: bounded everywhere (fog_offer).
+  info.trade_sweep.push_back({{"resolution", 32}, {"directions", 80}, {"terms", 25}, {"spatial", "bounded"}});
+  info.trade_sweep.push_back({{"resolution", 48}, {"directions", 128}, {"terms", 25}, {"spatial", "bounded"}});
+  // The dense cloud (albedo 0.99, three channels) against its 262144-spp reference, the diamond
+  // with its fix-up, 64 directions, 9 terms, float16 storage, 2 threads (haze render, 2026-12-02):
+  // 2.75% at 48^3 (0.67 s), 1.75% at 60^3 (1.2 s), 1.22% at 72^3 (2.1 s), 0.82% at 88^3 (3.4 s),
+  // 0.45% at 128^3 (11 s); particle_cloud: 0.42% at 16^3 and 32 directions in 4 s.
   info.offer = [](const SceneFeatures& f, double tolerance) {
     if (f.density == "particles")
-      return AutoOffer{true, {{"resolution", 16}, {"directions", 32}, {"terms", 9}}, 3.7,
-                       "on the particles' density: 0.6% on the suite's particle cloud"};
+      return AutoOffer{true, {{"resolution", 16}, {"directions", 32}, {"terms", 9}}, 4.0,
+                       "on the particles' density: 0.42% on the suite's particle cloud"};
     if (f.surfaces) return surface_offer(f, tolerance);
     if (f.homogeneous && !f.bounded) return AutoOffer{false, {}, 0.0, "an unbounded homogeneous medium has no grid"};
-    if (tolerance < 0.008) return AutoOffer{false, {}, 0.0, "under its measured 0.76% at 128^3 on the suite's dense cloud"};
-    const int resolution = tolerance >= 0.04 ? 48 : tolerance >= 0.025 ? 64 : tolerance >= 0.015 ? 72 : tolerance >= 0.01 ? 112 : 128;
-    const double seconds = resolution == 48 ? 0.55 : resolution == 64 ? 1.3 : resolution == 72 ? 2.2 : resolution == 112 ? 8.5 : 14.4;
-    return AutoOffer{true, fine_cell_settings(resolution), seconds,
-                     to_text(resolution) + "^3 cells, 64 directions: the suite's dense cloud measured 3.4% at 48^3, 2.1% at 64^3, 1.8% at 72^3, 0.91% at 112^3 and 0.76% at 128^3"};
+    if (tolerance < 0.005) return AutoOffer{false, {}, 0.0, "under its measured 0.45% at 128^3 on the suite's dense cloud"};
+    const int resolution = tolerance >= 0.03 ? 48 : tolerance >= 0.02 ? 60 : tolerance >= 0.014 ? 72 : tolerance >= 0.009 ? 88 : 128;
+    const double seconds = resolution == 48 ? 0.67 : resolution == 60 ? 1.2 : resolution == 72 ? 2.1 : resolution == 88 ? 3.4 : 11.0;
+    return AutoOffer{true, fine_cell_settings(resolution, 9), seconds,
+                     to_text(resolution) + "^3 cells, 64 directions: the suite's dense cloud measured 2.75% at 48^3, 1.75% at 60^3, 1.22% at 72^3, 0.82% at 88^3 and 0.45% at 128^3"};
   };
   return info;
 }

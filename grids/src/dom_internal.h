@@ -6,6 +6,7 @@
 #include <haze/simd/dom_sweep.h>
 
 #include <array>
+#include <cstdint>
 #include <vector>
 
 namespace haze::grids::dom {
@@ -22,6 +23,11 @@ struct Channel {
   float sigma_t_scale = 1.0f, albedo = 0.0f;
   float sky = 0.0f;  // radiance entering through the boundary
   const float* density = nullptr;
+  // Or null (the bound everywhere): per cell and octant ([cell * 8 + octant]), 1 where the diamond
+  // scheme takes its positivity bound; set by a sweep of the first-collision source alone (no
+  // moments in) where a leaving radiance would go below 0 (simd/dom_sweep.h): the single-scattered
+  // light's sharp edges.
+  std::uint8_t* bounded = nullptr;
 };
 Channel make_channel(const ExtinctionVolume& volume, const std::vector<Light>& lights, int channel, double delta_m_fraction);
 
@@ -53,8 +59,9 @@ class Transport {
   //   S_d = first[cell][d] + sum_k lambda_k Q[d][k] m_in[cell * N + k]   (seed 000 eq. 9),
   // radiance `boundary` entering through every face (or, given, `faces`), and the moments of the
   // result  m_out[cell * N + k] = sum_d Q[d][k] L_d   (eq. 10).
-  // first (from first_collision) and m_in may be null. Rows run through simd::dom_sweep_row. Directions going up and
-  // going down run on two threads into separate buffers, summed in a fixed order.
+  // first (from first_collision) and m_in may be null; with first and no m_in it sets the
+  // channel's fix-up marks (Channel::bounded). Rows run through simd::dom_sweep_row. Directions
+  // going up and going down run on two threads into separate buffers, summed in a fixed order.
   void sweep(const Channel& channel, const FirstCollision* first, const float* m_in, float boundary, float* m_out, int threads,
              const Faces* faces = nullptr) const;
 

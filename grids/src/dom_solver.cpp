@@ -27,9 +27,12 @@ const char* name(DomScheme scheme) { return scheme == DomScheme::paper ? "paper"
 DomSpatial dom_spatial_from_name(const std::string& name) {
   if (name == "step") return DomSpatial::step;
   if (name == "diamond") return DomSpatial::diamond;
-  throw Error("spatial", name, "\"step\" or \"diamond\"");
+  if (name == "bounded") return DomSpatial::bounded;
+  throw Error("spatial", name, "\"step\", \"diamond\" or \"bounded\"");
 }
-const char* name(DomSpatial spatial) { return spatial == DomSpatial::step ? "step" : "diamond"; }
+const char* name(DomSpatial spatial) {
+  return spatial == DomSpatial::step ? "step" : spatial == DomSpatial::diamond ? "diamond" : "bounded";
+}
 
 DomAccelerator dom_accelerator_from_name(const std::string& name) {
   if (name == "none") return DomAccelerator::none;
@@ -273,7 +276,8 @@ size_t dom_memory_bytes(const std::array<int, 3>& resolution, int channels, cons
   const size_t cells = static_cast<size_t>(resolution[0]) * static_cast<size_t>(resolution[1]) * static_cast<size_t>(resolution[2]);
   const auto d = static_cast<size_t>(settings.directions), n = static_cast<size_t>(kept_terms(settings));
   const size_t padded = d + 8 * 7;  // the first-collision source pads each octant to a multiple of 8
-  const size_t result = sizeof(float) * static_cast<size_t>(channels) * cells * n;
+  const size_t result = sizeof(float) * static_cast<size_t>(channels) * cells * n +
+                        (settings.spatial == DomSpatial::diamond ? static_cast<size_t>(channels) * cells * 8 : 0);  // moments, marks
   if (settings.scheme == DomScheme::paper)  // first-collision source and slopes; radiance twice, in-scatter; moments twice
     return result + sizeof(float) * (cells * padded + 3 * cells + 3 * cells * d + 2 * cells * n);
   // The first-collision source (its slopes, 3 per cell; float16 adds a scale per cell) with b and
@@ -297,8 +301,8 @@ DomSolution solve_dom(const ExtinctionVolume& volume, const std::vector<Light>& 
   if (!(settings.tolerance > 0.0)) throw Error("tolerance", to_text(settings.tolerance), "a relative change > 0");
   if (settings.storage == DomStorage::float16 && settings.scheme == DomScheme::paper)
     throw Error("storage", "float16", "float32 with scheme \"paper\" (float16 storage is for scheme \"sweep\")");
-  if (settings.spatial == DomSpatial::diamond && settings.scheme == DomScheme::paper)
-    throw Error("spatial", "diamond", "\"step\" with scheme \"paper\" (the paper's Jacobi update is the step scheme)");
+  if (settings.spatial != DomSpatial::step && settings.scheme == DomScheme::paper)
+    throw Error("spatial", name(settings.spatial), "\"step\" with scheme \"paper\" (the paper's Jacobi update is the step scheme)");
   if (boundary && settings.scheme == DomScheme::paper)
     throw Error("scheme", "paper", "scheme \"sweep\" with a boundary (the paper's scheme takes only the sky's radiance)");
   std::vector<Light> delta_lights;
@@ -350,7 +354,12 @@ DomSolution solve_dom(const ExtinctionVolume& volume, const std::vector<Light>& 
   out.moments.resize(static_cast<size_t>(out.channels));
   double previous_source = 0.0;  // b . x of the channel solved last
   for (int c = 0; c < out.channels; ++c) {
-    const dom::Channel channel = dom::make_channel(volume, lights, c, out.delta_m_fraction);
+    dom::Channel channel = dom::make_channel(volume, lights, c, out.delta_m_fraction);
+    std::vector<std::uint8_t> bounded;  // the diamond's fix-up marks (dom::Channel)
+    if (settings.spatial == DomSpatial::diamond) {
+      bounded.assign(volume.density.cell_count() * 8, 0);
+      channel.bounded = bounded.data();
+    }
     const dom::Faces* entering = boundary ? &faces[static_cast<size_t>(c)] : nullptr;
     const Stopwatch source_watch;
     dom::FirstCollision first = transport.first_collision(volume, delta_lights, delta_depths, c, 1.0 / (1.0 - out.delta_m_fraction),
@@ -364,12 +373,25 @@ DomSolution solve_dom(const ExtinctionVolume& volume, const std::vector<Light>& 
     }
     const IterationProgress progress{settings, c, out.channels, out.iterations};
     if (warm_fits && settings.accelerator == DomAccelerator::none) {
-      // Source iteration from the warm moments with the first-collision source in every sweep,
-      // x <- b + K x in one sweep, where forming b apart would take one more.
+      // Source iteration from the warm moments, x <- b + K x: with the first-collision source in
+      // every sweep, where forming b apart would take one more; with the diamond's fix-up, b
+      // apart (its sweep sets the marks, as in a cold solve, the moving light's edges with them),
+      // one sweep more than the budget.
       x = warm->moments[static_cast<size_t>(c)];
-      std::vector<float> next(size);
-      while (out.iterations - progress.start < settings.max_iterations) {
-        transport.sweep(channel, &first, x.data(), channel.sky, next.data(), settings.threads, entering);
+      std::vector<float> next(size), b;
+      if (channel.bounded) {
+        b.resize(size);
+        transport.sweep(channel, &first, nullptr, channel.sky, b.data(), settings.threads, entering);
+        ++out.iterations;
+      }
+      const int budget = settings.max_iterations + (b.empty() ? 0 : 1);
+      while (out.iterations - progress.start < budget) {
+        if (b.empty()) {
+          transport.sweep(channel, &first, x.data(), channel.sky, next.data(), settings.threads, entering);
+        } else {
+          transport.sweep(channel, nullptr, x.data(), 0.0f, next.data(), settings.threads);
+          axpy(next, 1.0, b, settings.threads);
+        }
         ++out.iterations;
         axpy(x, -1.0, next, settings.threads);
         const double change = norm(x, settings.threads) / std::max(norm(next, settings.threads), 1e-300);

@@ -125,7 +125,7 @@ Transport::Transport(const DenseGrid& density, const DirectionSet& directions, c
       }
       for (size_t k = 0; k < n; ++k) oc.lq[k * p + e] = lq_[i * n + k], oc.q[e * np + k] = q_[i * n + k];
     }
-    oc.view = {static_cast<int>(p), n_terms_, static_cast<int>(np), oc.a.data(), oc.lq.data(), oc.q.data(), spatial == DomSpatial::diamond,
+    oc.view = {static_cast<int>(p), n_terms_, static_cast<int>(np), oc.a.data(), oc.lq.data(), oc.q.data(), spatial != DomSpatial::step,
                {o & 1 ? -1.0f : 1.0f, o & 2 ? -1.0f : 1.0f, o & 4 ? -1.0f : 1.0f}};
   }
 }
@@ -154,7 +154,7 @@ void Transport::sweep(const Channel& ch, const FirstCollision* first, const floa
         };
         auto dark = [&](const float* v) { return std::all_of(v, v + p, [](float e) { return e == 0.0f; }); };
         const auto sx = static_cast<size_t>(nx), sy = static_cast<size_t>(ny);
-        std::vector<float> z_plane(sx * sy * p), y_row(sx * p), x_run(p), scratch(p + static_cast<size_t>(oc.view.terms_padded));
+        std::vector<float> z_plane(sx * sy * p), y_row(sx * p), x_run(p), scratch(4 * p + static_cast<size_t>(oc.view.terms_padded));
         // Which upwind faces still carry exactly zero radiance (per x of the z plane and of the y
         // row): an empty cell between such faces stays dark, so a row's leading run of them is
         // skipped. Exact.
@@ -171,6 +171,7 @@ void Transport::sweep(const Channel& ch, const FirstCollision* first, const floa
         if (first && !first->slope.empty()) row.first_slope = first->slope.data();
         row.first_stride = padded_;
         row.m_in = m_in, row.m_out = out;
+        if (ch.bounded) row.bounded = ch.bounded + o, row.mark = first && !m_in;
         row.x_run = x_run.data(), row.y_row = y_row.data(), row.scratch = scratch.data();
         for (int kk = 0; kk < nz; ++kk) {
           const int k = o & 4 ? nz - 1 - kk : kk;

@@ -29,9 +29,11 @@ HWY_INLINE V Reciprocal(D d, V x) {
 // place of the entering ones. `sum`: a_x + a_y + a_z.
 // With kLinear, the first-collision source `first` is linear over the cell (dom_sweep.h):
 // `ts[e]` is sigma_s t_e; without, the shifts are not computed (the sweeps with no such source).
+// `bound`: with the positivity bound (dom_sweep.h); `lowest`, if given, takes the smallest leaving
+// value plus kFixUpSlack times the sum of the entering ones and the mean in size.
 template <bool kLinear, class D, class V = hn::Vec<D>>
 HWY_INLINE V Diamond(D d, V sigma_t, V sigma_s_times_s, V pad, const V a[3], V sum, float* HWY_RESTRICT x, float* HWY_RESTRICT y,
-                     float* HWY_RESTRICT z, V first, const V ts[3]) {
+                     float* HWY_RESTRICT z, V first, const V ts[3], bool bound, V* lowest) {
   const V zero = hn::Zero(d), one = hn::Set(d, 1.0f), tiny = hn::Set(d, kDiamondTiny), two = hn::Set(d, 2.0f), three = hn::Set(d, 3.0f),
           six = hn::Set(d, 6.0f);
   const V sigma2 = hn::Mul(sigma_t, sigma_t), two_sigma = hn::Mul(two, sigma_t), three_sigma = hn::Mul(three, sigma_t);
@@ -46,15 +48,23 @@ HWY_INLINE V Diamond(D d, V sigma_t, V sigma_s_times_s, V pad, const V a[3], V s
     shift[e] = kLinear ? hn::Mul(ts[e], stay) : zero;
     const V g_tau = hn::Mul(hn::MulAdd(a[e], hn::MulAdd(six, a[e], three_sigma), sigma2),
                             Reciprocal(d, hn::Max(hn::MulAdd(a[e], hn::MulAdd(three, a[e], two_sigma), sigma2), tiny)));
-    const V q = hn::NegMulAdd(three, a[e], around), bound = hn::Mul(hn::NegMulAdd(two, a[e], around), Reciprocal(d, hn::Max(q, tiny)));
-    g[e] = hn::IfThenElse(hn::Gt(q, zero), hn::Min(g_tau, bound), g_tau);
+    g[e] = g_tau;
+    if (bound) {
+      const V q = hn::NegMulAdd(three, a[e], around), limit = hn::Mul(hn::NegMulAdd(two, a[e], around), Reciprocal(d, hn::Max(q, tiny)));
+      g[e] = hn::IfThenElse(hn::Gt(q, zero), hn::Min(g_tau, limit), g_tau);
+    }
     const V b = hn::Mul(a[e], g[e]);
     num = hn::MulAdd(b, kLinear ? hn::Sub(in[e], shift[e]) : in[e], num);
     den = hn::Add(den, b);
   }
   const V l = hn::Mul(num, Reciprocal(d, hn::Max(den, tiny)));
-  for (int e = 0; e < 3; ++e)
-    hn::StoreU(hn::NegMulAdd(hn::Sub(g[e], one), in[e], hn::Mul(g[e], kLinear ? hn::Add(l, shift[e]) : l)), d, face[e]);
+  const V slack =
+      lowest ? hn::Mul(hn::Set(d, kFixUpSlack), hn::Add(hn::Add(hn::Abs(in[0]), hn::Abs(in[1])), hn::Add(hn::Abs(in[2]), hn::Abs(l)))) : zero;
+  for (int e = 0; e < 3; ++e) {
+    const V out = hn::NegMulAdd(hn::Sub(g[e], one), in[e], hn::Mul(g[e], kLinear ? hn::Add(l, shift[e]) : l));
+    hn::StoreU(out, d, face[e]);
+    if (lowest) *lowest = hn::Min(*lowest, hn::Add(out, slack));
+  }
   return l;
 }
 
@@ -94,6 +104,7 @@ void DomSweepRow(const DomOctant& o, const DomRow& r) {
   const auto p = static_cast<size_t>(o.directions), n = static_cast<size_t>(o.terms), np = static_cast<size_t>(o.terms_padded);
   float* HWY_RESTRICT light = r.scratch;
   float* HWY_RESTRICT moments = r.scratch + p;
+  float* HWY_RESTRICT saved = r.scratch + p + np;  // the entering faces, 3 P, where marking
   const float* HWY_RESTRICT ax = o.a;
   const float* HWY_RESTRICT ay = o.a + p;
   const float* HWY_RESTRICT az = o.a + 2 * p;
@@ -113,44 +124,67 @@ void DomSweepRow(const DomOctant& o, const DomRow& r) {
     const Half* HWY_RESTRICT first_half = !r.first && r.first_half && !empty ? r.first_half + c * r.first_stride : nullptr;
     const bool linear = r.first_slope && (first || first_half) && o.diamond;
     V ts[3];
-    for (int e = 0; e < 3; ++e) ts[e] = hn::Set(d, linear ? r.albedo * sigma_t_value * r.first_slope[c * 3 + static_cast<size_t>(e)] * o.sign[e] : 0.0f);
-    for (size_t i = 0; i < p; i += 4 * lanes) {
-      const size_t count = std::min<size_t>(4, (p - i) / lanes);
-      // Source: the first-collision term plus lambda Q m_in, one term (a broadcast) at a time.
-      V s[4];
-      for (size_t v = 0; v < 4; ++v) s[v] = first && v < count ? hn::LoadU(d, first + i + v * lanes) : hn::Zero(d);
-      if (first_half)
-        for (size_t v = 0; v < count; ++v)
-          s[v] = hn::Mul(hn::Set(d, r.first_scale[c]), hn::PromoteTo(d, hn::LoadU(dh, reinterpret_cast<const hwy::float16_t*>(first_half + i + v * lanes))));
-      const V fc[4] = {s[0], s[1], s[2], s[3]};  // the first-collision source alone
-      if (m_in) {
-        const float* HWY_RESTRICT lq = o.lq + i;
-        switch (count) {
-          case 1: DotRows<1>(d, lq, p, m_in, n, s); break;
-          case 2: DotRows<2>(d, lq, p, m_in, n, s); break;
-          case 3: DotRows<3>(d, lq, p, m_in, n, s); break;
-          default: DotRows<4>(d, lq, p, m_in, n, s); break;
+    for (int e = 0; e < 3; ++e)
+      ts[e] = hn::Set(d, linear ? r.albedo * sigma_t_value * r.first_slope[c * 3 + static_cast<size_t>(e)] * o.sign[e] : 0.0f);
+    // Where the cell may still take the bound (r.bounded, r.mark), its entering faces are kept and,
+    // if a leaving value comes out below 0, put back and the cell swept again with the bound.
+    bool bound = !r.bounded || r.bounded[c * 8] != 0;
+    const bool mark = o.diamond && r.mark && !bound;
+    if (mark) {
+      std::copy(r.x_run, r.x_run + p, saved);
+      std::copy(y, y + p, saved + p);
+      std::copy(z, z + p, saved + 2 * p);
+    }
+    for (bool again = true; again;) {
+      V lowest = hn::Zero(d);
+      V* HWY_RESTRICT low = mark && !bound ? &lowest : nullptr;
+      for (size_t i = 0; i < p; i += 4 * lanes) {
+        const size_t count = std::min<size_t>(4, (p - i) / lanes);
+        // Source: the first-collision term plus lambda Q m_in, one term (a broadcast) at a time.
+        V s[4];
+        for (size_t v = 0; v < 4; ++v) s[v] = first && v < count ? hn::LoadU(d, first + i + v * lanes) : hn::Zero(d);
+        if (first_half)
+          for (size_t v = 0; v < count; ++v)
+            s[v] = hn::Mul(hn::Set(d, r.first_scale[c]),
+                           hn::PromoteTo(d, hn::LoadU(dh, reinterpret_cast<const hwy::float16_t*>(first_half + i + v * lanes))));
+        const V fc[4] = {s[0], s[1], s[2], s[3]};  // the first-collision source alone
+        if (m_in) {
+          const float* HWY_RESTRICT lq = o.lq + i;
+          switch (count) {
+            case 1: DotRows<1>(d, lq, p, m_in, n, s); break;
+            case 2: DotRows<2>(d, lq, p, m_in, n, s); break;
+            case 3: DotRows<3>(d, lq, p, m_in, n, s); break;
+            default: DotRows<4>(d, lq, p, m_in, n, s); break;
+          }
+        }
+        for (size_t v = 0; o.diamond && v < count; ++v) {
+          const size_t e = i + v * lanes;
+          const V a[3] = {hn::LoadU(d, ax + e), hn::LoadU(d, ay + e), hn::LoadU(d, az + e)};
+          const V sum = hn::Add(hn::Add(a[0], a[1]), a[2]);
+          const V ss = hn::Mul(sigma_s, s[v]), pe = hn::LoadU(d, pad + e);
+          const V l = linear ? Diamond<true>(d, sigma_t, ss, pe, a, sum, r.x_run + e, y + e, z + e, fc[v], ts, bound, low)
+                             : Diamond<false>(d, sigma_t, ss, pe, a, sum, r.x_run + e, y + e, z + e, fc[v], ts, bound, low);
+          hn::StoreU(l, d, light + e);
+        }
+        for (size_t v = 0; !o.diamond && v < count; ++v) {
+          const size_t e = i + v * lanes;
+          V in = hn::Mul(hn::LoadU(d, ax + e), hn::LoadU(d, r.x_run + e));
+          in = hn::MulAdd(hn::LoadU(d, ay + e), hn::LoadU(d, y + e), in);
+          in = hn::MulAdd(hn::LoadU(d, az + e), hn::LoadU(d, z + e), in);
+          const V l = hn::Mul(hn::MulAdd(sigma_s, s[v], in), Reciprocal(d, hn::Add(sigma_t, hn::LoadU(d, asum + e))));
+          hn::StoreU(l, d, r.x_run + e);
+          hn::StoreU(l, d, y + e);
+          hn::StoreU(l, d, z + e);
+          hn::StoreU(l, d, light + e);
         }
       }
-      for (size_t v = 0; o.diamond && v < count; ++v) {
-        const size_t e = i + v * lanes;
-        const V a[3] = {hn::LoadU(d, ax + e), hn::LoadU(d, ay + e), hn::LoadU(d, az + e)};
-        const V sum = hn::Add(hn::Add(a[0], a[1]), a[2]);
-        const V ss = hn::Mul(sigma_s, s[v]), pe = hn::LoadU(d, pad + e);
-        const V l = linear ? Diamond<true>(d, sigma_t, ss, pe, a, sum, r.x_run + e, y + e, z + e, fc[v], ts)
-                           : Diamond<false>(d, sigma_t, ss, pe, a, sum, r.x_run + e, y + e, z + e, fc[v], ts);
-        hn::StoreU(l, d, light + e);
-      }
-      for (size_t v = 0; !o.diamond && v < count; ++v) {
-        const size_t e = i + v * lanes;
-        V in = hn::Mul(hn::LoadU(d, ax + e), hn::LoadU(d, r.x_run + e));
-        in = hn::MulAdd(hn::LoadU(d, ay + e), hn::LoadU(d, y + e), in);
-        in = hn::MulAdd(hn::LoadU(d, az + e), hn::LoadU(d, z + e), in);
-        const V l = hn::Mul(hn::MulAdd(sigma_s, s[v], in), Reciprocal(d, hn::Add(sigma_t, hn::LoadU(d, asum + e))));
-        hn::StoreU(l, d, r.x_run + e);
-        hn::StoreU(l, d, y + e);
-        hn::StoreU(l, d, z + e);
-        hn::StoreU(l, d, light + e);
+      again = low && !hn::AllFalse(d, hn::Lt(lowest, hn::Zero(d)));
+      if (again) {
+        std::copy(saved, saved + p, r.x_run);
+        std::copy(saved + p, saved + 2 * p, y);
+        std::copy(saved + 2 * p, saved + 3 * p, z);
+        bound = true;
+        r.bounded[c * 8] = 1;
       }
     }
     // Moments: lanes over terms, one direction (a broadcast) at a time, added to m_out in registers

@@ -9,6 +9,7 @@
 #include <array>
 #include <cstdio>
 #include <cmath>
+#include <cstdint>
 #include <vector>
 
 namespace haze::simd {
@@ -19,18 +20,22 @@ HWY_TARGET_INSTANTIATE_TEST_SUITE_P(DomSweep);
 
 // Random octant data (P = 8, 24 and 40 directions: one, three and five vectors of 8; N = 5, 24,
 // 33 terms), a row of 13 cells in both sweep orders and both spatial schemes, with and without the first-collision source
-// (in float32 or, scaled, in float16) and the incoming moments. Every output (the moments added to, the upwind values carried on)
-// within 1e-5 relative (plus 1e-6 of the largest) of the reference: FMA and summation order differ.
+// (in float32 or, scaled, in float16) and the incoming moments; the diamond bounded everywhere,
+// nowhere, and with the fix-up marking cells. Every output (the moments added to, the upwind values carried on)
+// within 1e-5 relative (plus 1e-6 of the largest) of the reference: FMA and summation order differ; the same cells marked.
 TEST_P(DomSweep, MatchesScalarReferenceOnEveryTarget) {
   Rng rng(3);
+  long marked = 0;
   auto fill = [&](std::vector<float>& v, float lo, float hi) {
     for (float& e : v) e = lo + (hi - lo) * static_cast<float>(rng.uniform());
   };
   for (int p : {8, 24, 40})
     for (int n : {5, 24, 33})
       for (int step : {1, -1})
-        for (int case_ = 0; case_ < 24; ++case_) {  // first: none, float32, float16; m_in: no, yes; step, diamond; slopes: no, yes
+        for (int case_ = 0; case_ < 72; ++case_) {  // first: none, float32, float16; m_in: no, yes; step, diamond; slopes: no, yes
           const int sources = case_ % 12;
+          const int bounds = case_ / 24;  // the diamond's bound everywhere; with the fix-up; nowhere
+          if (bounds > 0 && sources < 6) continue;  // step
           const int np = (n + 7) / 8 * 8, count = 13, cells = 20;
           const auto up = static_cast<size_t>(p);
           std::vector<float> a(5 * up), lq(static_cast<size_t>(n) * up), q(up * static_cast<size_t>(np), 0.0f);
@@ -55,9 +60,11 @@ TEST_P(DomSweep, MatchesScalarReferenceOnEveryTarget) {
             Rng same(9);
             for (float& e : s) e = static_cast<float>(same.uniform());
           }
+          std::vector<std::uint8_t> marks[2] = {std::vector<std::uint8_t>(8 * static_cast<size_t>(cells)),
+                                                std::vector<std::uint8_t>(8 * static_cast<size_t>(cells))};
           for (int which = 0; which < 2; ++which) {
             float* base = state[which].data();
-            std::vector<float> scratch(up + static_cast<size_t>(np));
+            std::vector<float> scratch(4 * up + static_cast<size_t>(np));
             DomRow row;
             row.count = count, row.step = step, row.x0 = step > 0 ? 0 : count - 1;
             row.cell0 = static_cast<size_t>(3 + row.x0);
@@ -65,7 +72,8 @@ TEST_P(DomSweep, MatchesScalarReferenceOnEveryTarget) {
             row.first = sources % 3 == 1 ? first.data() : nullptr, row.first_stride = up;
             row.first_half = sources % 3 == 2 ? first_half.data() : nullptr, row.first_scale = first_scale.data();
             row.m_in = sources % 6 >= 3 ? m_in.data() : nullptr;
-            row.first_slope = case_ >= 12 ? slope.data() : nullptr;
+            row.first_slope = case_ % 24 >= 12 ? slope.data() : nullptr;
+            if (bounds > 0) row.bounded = marks[which].data(), row.mark = bounds == 1;
             row.m_out = base;
             row.x_run = base + cells * n;
             row.y_row = row.x_run + up, row.z_row = row.y_row + static_cast<size_t>(count) * up;
@@ -77,7 +85,10 @@ TEST_P(DomSweep, MatchesScalarReferenceOnEveryTarget) {
             ASSERT_NEAR(state[0][i], state[1][i], 1e-5f * std::abs(state[1][i]) + 1e-6f * peak)
                 << "P " << p << " N " << n << " step " << step << " case " << case_ << " at " << i << " target "
                 << hwy::TargetName(GetParam());
+          ASSERT_EQ(marks[0], marks[1]) << "P " << p << " N " << n << " step " << step << " case " << case_;
+          marked += std::count(marks[0].begin(), marks[0].end(), 1);
         }
+  EXPECT_GT(marked, 100);  // the fix-up's path is taken
 }
 
 // One cell and direction through the scalar reference: the radiance leaving through the faces
@@ -88,18 +99,34 @@ struct Cell {
   float mean;
 };
 Cell one_cell(std::array<float, 3> a, std::array<float, 3> in, float sigma_t, float s, bool diamond = true,
-              std::array<float, 3> slope = {0.0f, 0.0f, 0.0f}) {
+              std::array<float, 3> slope = {0.0f, 0.0f, 0.0f}, std::uint8_t* bounded = nullptr, bool mark = false) {
   const float octant_a[5 * 8] = {a[0], 0, 0, 0, 0, 0, 0, 0, a[1], 0, 0, 0, 0, 0, 0, 0, a[2], 0, 0, 0, 0, 0, 0, 0,
                                  a[0] + a[1] + a[2], 1, 1, 1, 1, 1, 1, 1, 0, 1, 1, 1, 1, 1, 1, 1};
   const float lq[8] = {}, q[8] = {};
   const DomOctant octant{8, 1, 8, octant_a, lq, q, diamond};
-  float density = sigma_t, first[8] = {s}, m_out = 0.0f, x[8] = {in[0]}, y[8] = {in[1]}, z[8] = {in[2]}, scratch[16];
+  float density = sigma_t, first[8] = {s}, m_out = 0.0f, x[8] = {in[0]}, y[8] = {in[1]}, z[8] = {in[2]}, scratch[40];
   DomRow row;
   row.count = 1, row.density = &density, row.albedo = 1.0f, row.first = first, row.first_stride = 8;
   row.m_out = &m_out, row.x_run = x, row.y_row = y, row.z_row = z, row.scratch = scratch;
   row.first_slope = slope.data();
+  row.bounded = bounded, row.mark = mark;
   dom_sweep_row_reference(octant, row);
   return {{x[0], y[0], z[0]}, scratch[0]};
+}
+
+// A random cell from optically thin to 50 thick and a direction from along an axis to grazing:
+// a_e, entering radiance (30% of faces dark), sigma_t (20% empty) and source (half 0).
+struct RandomCell {
+  std::array<float, 3> a, in;
+  float sigma_t, s;
+};
+RandomCell random_cell(Rng& rng) {
+  RandomCell c;
+  for (float& e : c.a) e = static_cast<float>(3.0 * std::pow(rng.uniform(), 3.0));
+  for (float& e : c.in) e = rng.uniform() < 0.3 ? 0.0f : static_cast<float>(rng.uniform());
+  c.sigma_t = rng.uniform() < 0.2 ? 0.0f : static_cast<float>(50.0 * std::pow(rng.uniform(), 3.0));
+  c.s = rng.uniform() < 0.5 ? 0.0f : static_cast<float>(rng.uniform());
+  return c;
 }
 
 // The diamond scheme keeps the cell's balance sum_e a_e (out_e - in_e) + sigma_t L = sigma_s S
@@ -110,11 +137,7 @@ Cell one_cell(std::array<float, 3> a, std::array<float, 3> in, float sigma_t, fl
 TEST(DomDiamond, BalancedAndPositive) {
   Rng rng(17);
   for (int i = 0; i < 20000; ++i) {
-    std::array<float, 3> a, in;
-    for (float& e : a) e = static_cast<float>(3.0 * std::pow(rng.uniform(), 3.0));
-    for (float& e : in) e = rng.uniform() < 0.3 ? 0.0f : static_cast<float>(rng.uniform());
-    const float sigma_t = rng.uniform() < 0.2 ? 0.0f : static_cast<float>(50.0 * std::pow(rng.uniform(), 3.0));
-    const float s = rng.uniform() < 0.5 ? 0.0f : static_cast<float>(rng.uniform());
+    const auto [a, in, sigma_t, s] = random_cell(rng);
     std::array<float, 3> slope{0.0f, 0.0f, 0.0f};
     if (i % 2)
       for (float& e : slope) e = static_cast<float>(4.0 * rng.uniform() - 2.0);
@@ -130,6 +153,30 @@ TEST(DomDiamond, BalancedAndPositive) {
     ASSERT_GE(c.mean, 0.0f) << i;
     ASSERT_LT(std::abs(balance), 1e-5 * scale) << i << ": sigma_t " << sigma_t << ", a " << a[0] << " " << a[1] << " " << a[2];
   }
+}
+
+// The fix-up: over the same random cells, a cell is marked exactly where alpha(tau) alone would
+// send radiance below 0, and then leaves what the bound everywhere leaves; an unmarked cell leaves
+// what alpha(tau) alone leaves. Both happen often (the test is not vacuous).
+TEST(DomDiamond, FixUpBoundsExactlyTheCellsThatGoNegative) {
+  Rng rng(23);
+  int marked = 0, kept = 0;
+  for (int i = 0; i < 20000; ++i) {
+    const auto [a, in, sigma_t, s] = random_cell(rng);
+    std::uint8_t alone = 0, fixed = 0;
+    const Cell bounded = one_cell(a, in, sigma_t, s), free = one_cell(a, in, sigma_t, s, true, {}, &alone),
+               fix = one_cell(a, in, sigma_t, s, true, {}, &fixed, true);
+    bool negative = false;
+    for (size_t e = 0; e < 3; ++e) negative = negative || free.out[e] + kFixUpSlack * (in[0] + in[1] + in[2] + std::abs(free.mean)) < 0.0f;
+    ASSERT_EQ(alone, 0) << i;  // no marks without `mark`
+    ASSERT_EQ(fixed, negative ? 1 : 0) << i;
+    const Cell& expected = negative ? bounded : free;
+    for (size_t e = 0; e < 3; ++e) ASSERT_EQ(fix.out[e], expected.out[e]) << i << " axis " << e;
+    ASSERT_EQ(fix.mean, expected.mean) << i;
+    (negative ? marked : kept) += 1;
+  }
+  EXPECT_GT(marked, 500);
+  EXPECT_GT(kept, 5000);
 }
 
 // Light crossing an absorbing slab along x (optical thickness 2 in n cells; the closed form is

@@ -38,9 +38,15 @@ const char* name(DomScheme scheme);
 // How a cell's radiance leaves through its faces in scheme `sweep` (simd/dom_sweep.h).
 enum class DomSpatial {
   step,     // seed 000: every face leaves with the cell's mean; first order in the cell size
-  diamond,  // weighted diamond difference, its weight following the cell's optical thickness: second order
+  // Weighted diamond difference, its weight following the cell's optical thickness: second order;
+  // the positivity bound only in the cells (per octant) where the first-collision sweep would send
+  // radiance below 0 (the fix-up).
+  diamond,
+  // The same with the positivity bound in every cell: first order on oblique directions, whose
+  // numerical diffusion damps the ray effects of lamps in fog (docs/DOM.md).
+  bounded,
 };
-DomSpatial dom_spatial_from_name(const std::string& name);  // "step", "diamond"
+DomSpatial dom_spatial_from_name(const std::string& name);  // "step", "diamond", "bounded"
 const char* name(DomSpatial spatial);
 
 enum class DomAccelerator {
@@ -187,7 +193,7 @@ struct DomFields {
   CellCount cells;
   DomSettings settings;
   DepthOptions depth;
-  int warm_iterations = 0;  // sweeps per update (source iteration); 0: GMRES to the tolerance
+  int warm_iterations = 0;  // sweeps per update (source iteration; with spatial diamond after a first-collision sweep); 0: GMRES to the tolerance
   int surface_passes = 2;   // solves with the surfaces' reflected light entering the grid (dom_fields)
 };
 DomFields dom_fields(const Scene& scene, const RenderOptions& options);

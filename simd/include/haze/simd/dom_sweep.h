@@ -42,6 +42,7 @@
 #include <haze/simd/half.h>
 
 #include <cstddef>
+#include <cstdint>
 
 #pragma GCC visibility push(default)  // the public API: exported from shared builds
 
@@ -49,6 +50,11 @@ namespace haze::simd {
 
 // The diamond scheme's floor on a denominator (a cell with sigma_t = 0, a direction along a face).
 inline constexpr float kDiamondTiny = 1e-30f;
+
+// The fix-up (DomRow::mark) takes a leaving value as below 0 under -kFixUpSlack times the sum of
+// the direction's entering values and mean in size: the rounding of a value that is 0 in exact
+// arithmetic stays above.
+inline constexpr float kFixUpSlack = 1e-5f;
 
 // One octant's directions, padded to a multiple of 8 with directions that carry nothing (a = 0,
 // a_sum = 1, pad = 1, lq = q = 0).
@@ -84,7 +90,12 @@ struct DomRow {
   float* x_run = nullptr;          // [P]: radiance across x faces, carried along the row
   float* y_row = nullptr;          // [x * P]: across y faces, per x of the row
   float* z_row = nullptr;          // [x * P]: across z faces, per x of the row
-  float* scratch = nullptr;        // P + terms_padded floats
+  float* scratch = nullptr;        // 4 P + terms_padded floats
+  // Or null (every cell takes it): [cell * 8], 1 where the diamond scheme takes its positivity
+  // bound, 0 where alpha(tau) alone. With `mark`, a cell at 0 whose leaving radiance would go below
+  // 0 (kFixUpSlack) in some direction is set to 1 and swept again with the bound.
+  std::uint8_t* bounded = nullptr;
+  bool mark = false;
 };
 
 void dom_sweep_row(const DomOctant& octant, const DomRow& row);
