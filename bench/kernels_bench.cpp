@@ -21,6 +21,7 @@
 #include <oneapi/tbb/task_arena.h>
 
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <ctime>
@@ -219,7 +220,8 @@ Work march_work(bool scalar) {
 }
 
 // One DOM row of 64 cells, one octant of p directions (16: D = 128; 8: D = 64) and `terms` terms, by
-// one spatial scheme (items: cell-directions).
+// one spatial scheme (items: cell-directions); the diamond's cells unmarked by its fix-up (alpha(tau)
+// alone, most cells of a solve).
 Work dom_work(bool scalar, bool diamond, int p, int terms) {
   const int padded = (terms + 7) / 8 * 8, count = 64;
   auto a = std::make_shared<std::vector<float>>(5 * p, 0.0f), lq = std::make_shared<std::vector<float>>(static_cast<size_t>(terms * p)),
@@ -238,16 +240,18 @@ Work dom_work(bool scalar, bool diamond, int p, int terms) {
   auto m_in = std::make_shared<std::vector<float>>(static_cast<size_t>(count * terms), 0.05f),
        m_out = std::make_shared<std::vector<float>>(static_cast<size_t>(count * terms));
   auto x = std::make_shared<std::vector<float>>(p), y = std::make_shared<std::vector<float>>(static_cast<size_t>(count * p)),
-       z = std::make_shared<std::vector<float>>(static_cast<size_t>(count * p)), scratch = std::make_shared<std::vector<float>>(p + padded);
+       z = std::make_shared<std::vector<float>>(static_cast<size_t>(count * p)), scratch = std::make_shared<std::vector<float>>(4 * p + padded);
+  auto marks = std::make_shared<std::vector<std::uint8_t>>(8 * count, 0);
   auto row = std::make_shared<simd::DomRow>();
   row->count = count, row->density = density->data(), row->sigma_t_scale = 2.0f, row->albedo = 0.9f;
   row->first = first->data(), row->first_stride = static_cast<size_t>(p), row->m_in = m_in->data(), row->m_out = m_out->data();
   row->x_run = x->data(), row->y_row = y->data(), row->z_row = z->data(), row->scratch = scratch->data();
+  row->bounded = marks->data();
   return {[=] {
             (scalar ? simd::dom_sweep_row_reference : simd::dom_sweep_row)(*octant, *row);
             benchmark::DoNotOptimize(m_out->data());
           },
-          static_cast<double>(count * p), 0.0, {a, lq, q, density, first, m_in, x, y, z, scratch}};
+          static_cast<double>(count * p), 0.0, {a, lq, q, density, first, m_in, x, y, z, scratch, marks}};
 }
 
 // ---- Solver steps at 1 and 2 threads, on the 64^3 density with 2 point lights and the sun.

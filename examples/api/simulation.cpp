@@ -1,7 +1,7 @@
 // A simulation's frame loop: a puff of smoke drifts through a 48^3 density grid, and every frame
-// the DOM solution is updated (warm: from the previous frame's moments, two sweeps) instead of solved
-// again. Prints each frame's cost warm and cold and the fluence at the puff's centre, and writes
-// the frames as EXR files. Usage: simulation [OUT_DIR]
+// the DOM solution is updated (warm: from the previous frame's moments, two sweeps after the
+// first-collision one) instead of solved again. Prints each frame's cost warm and cold and the
+// fluence at the puff's centre, and writes the frames as EXR files. Usage: simulation [OUT_DIR]
 #include <haze/grids/methods.h>
 #include <haze/haze.h>
 
