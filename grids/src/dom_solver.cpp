@@ -276,8 +276,8 @@ size_t dom_memory_bytes(const std::array<int, 3>& resolution, int channels, cons
   const size_t cells = static_cast<size_t>(resolution[0]) * static_cast<size_t>(resolution[1]) * static_cast<size_t>(resolution[2]);
   const auto d = static_cast<size_t>(settings.directions), n = static_cast<size_t>(kept_terms(settings));
   const size_t padded = d + 8 * 7;  // the first-collision source pads each octant to a multiple of 8
-  const size_t result = sizeof(float) * static_cast<size_t>(channels) * cells * n +
-                        (settings.spatial == DomSpatial::diamond ? static_cast<size_t>(channels) * cells * 8 : 0);  // moments, marks
+  // The moments, and the fix-up's marks of the channel being solved (a byte per cell and octant).
+  const size_t result = sizeof(float) * static_cast<size_t>(channels) * cells * n + (settings.spatial == DomSpatial::diamond ? cells * 8 : 0);
   if (settings.scheme == DomScheme::paper)  // first-collision source and slopes; radiance twice, in-scatter; moments twice
     return result + sizeof(float) * (cells * padded + 3 * cells + 3 * cells * d + 2 * cells * n);
   // The first-collision source (its slopes, 3 per cell; float16 adds a scale per cell) with b and

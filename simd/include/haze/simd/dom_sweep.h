@@ -21,6 +21,8 @@
 //   a_f / alpha_f <= 2 a_f), so the scheme is positive and cannot oscillate while staying
 //   linear, as GMRES needs. It binds on the minor axes of oblique directions, which go toward
 //   first order there (Godunov: no linear positive scheme is second order everywhere). With
+//   DomRow::bounded, only the cells marked take the bound (the fix-up: a sweep with `mark` marks a
+//   cell where alpha(tau) alone would send radiance below 0, and sweeps it again bounded). With
 //   g_e = 1 / alpha_e and b_e = a_e g_e:
 //     L_d = (sigma_s S_d + sum_e b_e in_e) / (sigma_t + sum_e b_e),  out_e = g_e L_d - (g_e - 1) in_e.
 //   Divisions only (reciprocals with a Newton step in the SIMD kernel), no exponential.
