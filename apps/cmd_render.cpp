@@ -14,7 +14,11 @@ namespace haze::app {
 nlohmann::json save_result(const RenderResult& result, const std::string& method, double seconds,
                            const std::filesystem::path& exr, bool png) {
   if (exr.has_parent_path()) std::filesystem::create_directories(exr.parent_path());
-  write_exr(exr, result.radiance, result.std_error ? &*result.std_error : nullptr);
+  std::vector<std::pair<std::string, const Image*>> layers;
+  if (result.std_error) layers.emplace_back("stderr", &*result.std_error);
+  if (result.inscatter)
+    layers.insert(layers.end(), {{"inscatter", &*result.inscatter}, {"transmittance", &*result.transmittance}, {"surface", &*result.surface}});
+  write_exr(exr, result.radiance, layers);
   Rgb mean = result.radiance.mean();
   nlohmann::json out = {{"method", method},
                         {"seconds", seconds},
@@ -38,9 +42,9 @@ nlohmann::json save_result(const RenderResult& result, const std::string& method
 namespace {
 
 struct RenderArgs {
-  std::string scene, method, out, display = "cpu";
+  std::string scene, method, out, display = "cpu", depth;
   int threads = 0;
-  bool json = false, no_png = false, no_cache = false, explain = false;
+  bool json = false, no_png = false, no_cache = false, explain = false, layers = false;
   std::optional<double> tolerance;
   std::vector<std::string> set;
   // Shortcuts for the reference path tracer's settings; unset unless given.
@@ -91,7 +95,19 @@ int run(const RenderArgs& a) {
   ProgressBar bar(method);
   options.progress = bar.callback();
   const Stopwatch watch;
-  RenderResult result = a.display == "gl" ? render_gl(scene, method, options) : render(scene, method, options);
+  // A host's depth buffer and the layers it composites (View).
+  std::vector<float> depth;
+  if (!a.depth.empty()) {
+    int w = 0, h = 0;
+    depth = read_exr_depth(a.depth, w, h);
+    if (w != scene.camera.width_px || h != scene.camera.height_px)
+      throw Error("--depth " + a.depth, to_text(w) + " x " + to_text(h),
+                  "the camera's size, " + to_text(scene.camera.width_px) + " x " + to_text(scene.camera.height_px));
+  }
+  if (a.display == "gl" && (a.layers || !depth.empty()))
+    throw Error("--display", "gl", "cpu with --layers or --depth (the GL display renders the image only)");
+  const View view{scene.camera, depth, a.layers};
+  RenderResult result = a.display == "gl" ? render_gl(scene, method, options) : render(scene, method, options, view);
   const double seconds = watch.seconds();
   // The method's warnings (method auto's: those of the method it chose).
   for (const nlohmann::json* stats : {&result.stats, result.stats.contains("method_stats") ? &result.stats["method_stats"] : nullptr})
@@ -129,6 +145,11 @@ Command add_render(CLI::App& app) {
   sub->add_option("--tolerance", a->tolerance, "With --method auto: the relative error to stay under (default 0.05)")
       ->check(CLI::Range(1e-4, 0.99));
   sub->add_flag("--explain", a->explain, "With --method auto: print the method and settings chosen and why");
+  sub->add_option("--depth", a->depth, "A host's depth buffer: an EXR of the camera's size with one float channel Z (or depth), the "
+                                       "distance along each pixel's ray to the host's geometry (inf: none); rays end there")
+      ->check(CLI::ExistingFile);
+  sub->add_flag("--layers", a->layers, "Also write the layers a host composites, inscatter.R/G/B, transmittance.R/G/B and surface.R/G/B "
+                                       "(R/G/B = inscatter + transmittance * surface)");
   sub->add_flag("--json", a->json, "Print a JSON summary");
   sub->add_flag("--no-png", a->no_png, "Do not write the PNG preview");
   sub->add_flag("--no-cache", a->no_cache, "Rebuild precomputed tables instead of reading them from the cache");

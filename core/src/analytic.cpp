@@ -97,7 +97,7 @@ class AnalyticSolution final : public MethodSolution {
     const Camera& camera = view.camera;
     const Aabb bounds = medium_->bounds();
     const Stopwatch watch;
-    RenderResult result{Image(camera.width_px, camera.height_px), std::nullopt, {}};
+    RenderResult result = RenderResult::for_view(view);
     ProgressTracker progress(options.progress, camera.height_px);
     const AirlightBatchFunction add_airlight = airlight_batch_function();
     const SurfaceShading shade{*medium_, scene_.surfaces, lights_, sigma_t_, sigma_s_, grey_, surface_airlight_, lambert_, phong_};
@@ -129,7 +129,7 @@ class AnalyticSolution final : public MethodSolution {
           PixelHit& px = row[static_cast<size_t>(x)];
           px.ray = camera.pixel_ray(x, y);
           px.normal = Vec3(0.0);
-          px.hit = nearest_surface(scene_.surfaces, px.ray, kInfinity, px.t_hit, px.normal);
+          px.hit = nearest_surface(scene_.surfaces, px.ray, view.max_distance(x, y), px.t_hit, px.normal);
           const Ray& ray = px.ray;
           double t0 = 0.0, t1 = px.t_hit;
           slot[static_cast<size_t>(x)] = -1;
@@ -222,14 +222,10 @@ class AnalyticSolution final : public MethodSolution {
                 }
             }
           }
-          Rgb view_t = medium_->transmittance_along(ray.origin, ray.direction, t_hit);
-          if (hit) {
-            Rgb surface = shade(*hit, ray.at(t_hit), normal, ray.direction);
-            radiance += view_t * surface;
-          } else {
-            radiance += view_t * scene_.background;
-          }
-          result.radiance.set(x, y, radiance);
+          PixelLayers layers{radiance, medium_->transmittance_along(ray.origin, ray.direction, t_hit), Rgb(0.0)};
+          if (hit) layers.surface = shade(*hit, ray.at(t_hit), normal, ray.direction);
+          else if (std::isinf(t_hit)) layers.surface = scene_.background;  // not behind a host's depth
+          result.set(x, y, layers);
         }
         progress.advance();
       }
@@ -238,6 +234,7 @@ class AnalyticSolution final : public MethodSolution {
     result.stats = {{"seconds", watch.seconds()}};
     return result;
   }
+  bool renders_layers() const override { return true; }
 
  private:
   const Scene scene_;

@@ -1,8 +1,70 @@
 #include <haze/core/camera.h>
+#include <haze/core/error.h>
+
+#include <glm/matrix.hpp>
+
+#include <algorithm>
+#include <cmath>
 
 namespace haze {
 
+Camera Camera::from_matrices(const glm::dmat4& view, const glm::dmat4& projection, int width_px, int height_px) {
+  if (width_px < 1 || height_px < 1)
+    throw Error("camera.width_px", to_text(width_px) + " x " + to_text(height_px), "an image size of at least 1 x 1");
+  auto finite = [](const glm::dmat4& m) {
+    for (int c = 0; c < 4; ++c)
+      for (int r = 0; r < 4; ++r)
+        if (!std::isfinite(m[c][r])) return false;
+    return true;
+  };
+  if (!finite(view) || std::abs(glm::determinant(view)) < 1e-300) throw Error("camera.view", "a matrix that cannot be inverted", "an invertible world-to-eye matrix");
+  if (!finite(projection) || std::abs(glm::determinant(projection)) < 1e-300)
+    throw Error("camera.projection", "a matrix that cannot be inverted", "an invertible eye-to-clip matrix (glm::perspective, glm::ortho)");
+  Camera c;
+  c.type = Type::matrices;
+  c.width_px = width_px, c.height_px = height_px;
+  c.view = view, c.projection = projection;
+  c.view_inverse = glm::inverse(view), c.projection_inverse = glm::inverse(projection);
+  c.position = Vec3(c.view_inverse[3]);
+  return c;
+}
+
+Camera Camera::from_rays(std::shared_ptr<const std::vector<Ray>> rays, int width_px, int height_px) {
+  if (width_px < 1 || height_px < 1)
+    throw Error("camera.width_px", to_text(width_px) + " x " + to_text(height_px), "an image size of at least 1 x 1");
+  const size_t count = static_cast<size_t>(width_px) * static_cast<size_t>(height_px);
+  if (!rays || rays->size() != count)
+    throw Error("camera.rays", to_text(rays ? rays->size() : 0) + " rays", to_text(count) + " (width_px x height_px), one per pixel");
+  for (size_t i = 0; i < count; ++i) {
+    const Ray& r = (*rays)[i];
+    const double length = glm::length(r.direction);
+    if (!std::isfinite(r.origin.x + r.origin.y + r.origin.z) || !(std::abs(length - 1.0) <= 1e-6))
+      throw Error("camera.rays[" + to_text(i) + "]", "direction of length " + to_text(length) + ", origin (" + to_text(r.origin.x) + ", " +
+                      to_text(r.origin.y) + ", " + to_text(r.origin.z) + ")",
+                  "a finite origin and a unit direction");
+  }
+  Camera c;
+  c.type = Type::rays;
+  c.width_px = width_px, c.height_px = height_px;
+  c.rays = std::move(rays);
+  return c;
+}
+
 Ray Camera::generate_ray(double px, double py) const {
+  if (type == Type::rays) {
+    const int x = std::clamp(static_cast<int>(px), 0, width_px - 1), y = std::clamp(static_cast<int>(py), 0, height_px - 1);
+    return (*rays)[static_cast<size_t>(y) * static_cast<size_t>(width_px) + static_cast<size_t>(x)];
+  }
+  if (type == Type::matrices) {
+    // The pixel's point on the near plane in eye space; a perspective projection (w depends on z)
+    // sends rays from the eye through it, an orthographic one along -z from the eye plane.
+    const double nx = 2.0 * px / width_px - 1.0, ny = 1.0 - 2.0 * py / height_px;
+    const glm::dvec4 near = projection_inverse * glm::dvec4(nx, ny, -1.0, 1.0);
+    const Vec3 p = Vec3(near) / near.w;
+    const bool perspective = projection[2][3] != 0.0;
+    const Vec3 origin = perspective ? Vec3(0.0) : Vec3(p.x, p.y, 0.0), direction = perspective ? p : Vec3(0.0, 0.0, -1.0);
+    return {Vec3(view_inverse * glm::dvec4(origin, 1.0)), glm::normalize(Vec3(view_inverse * glm::dvec4(direction, 0.0)))};
+  }
   Vec3 forward = glm::normalize(look_at - position);
   Vec3 right = glm::normalize(glm::cross(forward, up));
   Vec3 true_up = glm::cross(right, forward);

@@ -45,18 +45,38 @@ void check_same_size(const Image& a, const Image& b, const char* what) {
                 "the size of the image, " + to_text(a.width()) + " x " + to_text(a.height()));
 }
 
+// One float channel of an open EXR, x fastest from its data window's corner; its size through
+// width and height.
+std::vector<float> read_channel(Imf::InputFile& file, const char* channel, int& width, int& height) {
+  const auto window = file.header().dataWindow();
+  width = window.max.x - window.min.x + 1, height = window.max.y - window.min.y + 1;
+  std::vector<float> values(static_cast<size_t>(width) * static_cast<size_t>(height));
+  Imf::FrameBuffer fb;
+  char* base = reinterpret_cast<char*>(values.data()) -
+               (static_cast<ptrdiff_t>(window.min.y) * width + window.min.x) * static_cast<ptrdiff_t>(sizeof(float));
+  fb.insert(channel, Imf::Slice(Imf::FLOAT, base, sizeof(float), sizeof(float) * static_cast<size_t>(width)));
+  file.setFrameBuffer(fb);
+  file.readPixels(window.min.y, window.max.y);
+  return values;
+}
+
 }  // namespace
 
 void write_exr(const std::filesystem::path& path, const Image& image, const Image* std_error) {
-  if (std_error) check_same_size(image, *std_error, "std_error image size");
+  write_exr(path, image, std_error ? std::vector<std::pair<std::string, const Image*>>{{"stderr", std_error}}
+                                   : std::vector<std::pair<std::string, const Image*>>{});
+}
+
+void write_exr(const std::filesystem::path& path, const Image& image, const std::vector<std::pair<std::string, const Image*>>& layers) {
+  for (const auto& [name, layer] : layers) check_same_size(image, *layer, (name + " image size").c_str());
   try {
     Imf::Header header(image.width(), image.height());
     Imf::FrameBuffer fb;
     for (const char* c : kChannels) header.channels().insert(c, Imf::Channel(Imf::FLOAT));
     insert_layer(fb, "", image);
-    if (std_error) {
-      for (const char* c : kChannels) header.channels().insert(std::string("stderr.") + c, Imf::Channel(Imf::FLOAT));
-      insert_layer(fb, "stderr.", *std_error);
+    for (const auto& [name, layer] : layers) {
+      for (const char* c : kChannels) header.channels().insert(name + "." + c, Imf::Channel(Imf::FLOAT));
+      insert_layer(fb, name + ".", *layer);
     }
     Imf::OutputFile file(path.string().c_str(), header);
     file.setFrameBuffer(fb);
@@ -91,6 +111,19 @@ Image read_exr(const std::filesystem::path& path, std::optional<Image>* std_erro
   }
 }
 
+std::vector<float> read_exr_depth(const std::filesystem::path& path, int& width, int& height) {
+  try {
+    Imf::InputFile file(path.string().c_str());
+    const char* channel = file.header().channels().findChannel("Z") ? "Z" : file.header().channels().findChannel("depth") ? "depth" : nullptr;
+    if (!channel) throw Error("depth " + path.string(), "no channel Z or depth", "an EXR with a float channel Z (or depth): distances along each pixel's ray");
+    return read_channel(file, channel, width, height);
+  } catch (const Error&) {
+    throw;
+  } catch (const std::exception& e) {
+    throw Error("depth " + path.string(), e.what(), "a readable OpenEXR file");
+  }
+}
+
 void write_exr_table(const std::filesystem::path& path, int width, int height, const std::vector<float>& values,
                      const std::map<std::string, std::string>& attributes) {
   if (width <= 0 || height <= 0 || values.size() != static_cast<size_t>(width) * static_cast<size_t>(height))
@@ -114,8 +147,6 @@ std::vector<float> read_exr_table(const std::filesystem::path& path, int& width,
                                   std::map<std::string, std::string>& attributes) {
   try {
     Imf::InputFile file(path.string().c_str());
-    auto window = file.header().dataWindow();
-    width = window.max.x - window.min.x + 1, height = window.max.y - window.min.y + 1;
     if (!file.header().channels().findChannel("T")) throw Error("exr table " + path.string(), "no channel T", "a Haze table");
     attributes.clear();
     for (auto it = file.header().begin(); it != file.header().end(); ++it) {
@@ -123,14 +154,7 @@ std::vector<float> read_exr_table(const std::filesystem::path& path, int& width,
       if (name.rfind("haze.", 0) != 0) continue;
       if (auto* a = dynamic_cast<const Imf::StringAttribute*>(&it.attribute())) attributes[name.substr(5)] = a->value();
     }
-    std::vector<float> values(static_cast<size_t>(width) * static_cast<size_t>(height));
-    Imf::FrameBuffer fb;
-    char* base = reinterpret_cast<char*>(values.data()) -
-                 (static_cast<ptrdiff_t>(window.min.y) * width + window.min.x) * static_cast<ptrdiff_t>(sizeof(float));
-    fb.insert("T", Imf::Slice(Imf::FLOAT, base, sizeof(float), sizeof(float) * static_cast<size_t>(width)));
-    file.setFrameBuffer(fb);
-    file.readPixels(window.min.y, window.max.y);
-    return values;
+    return read_channel(file, "T", width, height);
   } catch (const Error&) {
     throw;
   } catch (const std::exception& e) {

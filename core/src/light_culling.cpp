@@ -47,6 +47,7 @@ bool cone_outside(const Vec3& p, const Vec3& a, double theta, const Vec3& n, dou
 // one of the four that hold the film's edges (planes through the eye for a pinhole camera,
 // parallel to the view for an orthographic one)?
 bool cone_misses_view(const Vec3& p, const Vec3& a, double theta, const Camera& camera) {
+  if (camera.type != Camera::Type::pinhole && camera.type != Camera::Type::orthographic) return false;  // a host's: not culled
   const Vec3 forward = glm::normalize(camera.look_at - camera.position);
   const Vec3 right = glm::normalize(glm::cross(forward, camera.up));
   const Vec3 up = glm::cross(right, forward);

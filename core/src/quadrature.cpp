@@ -72,10 +72,11 @@ struct Context {
     return sum;
   }
 
-  Rgb pixel(const Ray& ray, const std::vector<double>& gl_nodes, const std::vector<double>& gl_weights) const {
+  // The pixel's layers along `ray` up to Haze's nearest surface or `t_max` (a host's depth).
+  PixelLayers pixel(const Ray& ray, double t_max, const std::vector<double>& gl_nodes, const std::vector<double>& gl_weights) const {
     double t_hit;
     Vec3 normal(0.0);
-    const Surface* hit = nearest_surface(scene.surfaces, ray, kInfinity, t_hit, normal);
+    const Surface* hit = nearest_surface(scene.surfaces, ray, t_max, t_hit, normal);
     Rgb radiance(0.0), view_t(1.0);
     double t0 = 0.0, t1 = t_hit;
     if (medium && medium->bounds().clip(ray, t0, t1) && t1 > t0) {
@@ -125,13 +126,10 @@ struct Context {
       }
       view_t *= glm::exp(-medium->sigma_t_scale() * medium->density_integral(previous, ray.at(t1)));
     }
-    if (hit) {
-      Vec3 p = ray.at(t_hit);
-      radiance += view_t * surface_radiance(*hit, p, normal, -ray.direction);
-    } else if (std::isinf(t_hit)) {
-      radiance += view_t * (scene.background + sky);
-    }
-    return radiance;
+    PixelLayers layers{radiance, view_t, Rgb(0.0)};
+    if (hit) layers.surface = surface_radiance(*hit, ray.at(t_hit), normal, -ray.direction);
+    else if (std::isinf(t_hit)) layers.surface = scene.background + sky;
+    return layers;
   }
 };
 
@@ -149,11 +147,11 @@ class QuadratureSolution final : public MethodSolution {
   RenderResult render(const View& view, const RenderOptions& options) const override {
     const Stopwatch watch;
     const Camera& camera = view.camera;
-    RenderResult result{Image(camera.width_px, camera.height_px), std::nullopt, {}};
+    RenderResult result = RenderResult::for_view(view);
     ProgressTracker progress(options.progress, camera.height_px);
     parallel_for(camera.height_px, options.threads, 1, [&](long long y0, long long y1) {
       for (auto y = static_cast<int>(y0); y < y1 && !progress.cancelled(); ++y) {
-        for (int x = 0; x < camera.width_px; ++x) result.radiance.set(x, y, ctx_.pixel(camera.pixel_ray(x, y), nodes_, weights_));
+        for (int x = 0; x < camera.width_px; ++x) result.set(x, y, ctx_.pixel(camera.pixel_ray(x, y), view.max_distance(x, y), nodes_, weights_));
         progress.advance();
       }
     });
@@ -161,6 +159,7 @@ class QuadratureSolution final : public MethodSolution {
     result.stats = {{"seconds", watch.seconds()}};
     return result;
   }
+  bool renders_layers() const override { return true; }
 
  private:
   const Scene scene_;

@@ -107,8 +107,39 @@ const Scene& Solution::scene() const { return state_->scene; }
 const nlohmann::json& Solution::stats() const { return state_->solution->stats; }
 const MethodSolution& Solution::method_solution() const { return state_->solution->fields_owner(); }
 
+RenderResult RenderResult::for_view(const View& view) {
+  const int w = view.camera.width_px, h = view.camera.height_px;
+  RenderResult r{Image(w, h), std::nullopt, nlohmann::json::object()};
+  if (view.layers) r.inscatter = Image(w, h), r.transmittance = Image(w, h), r.surface = Image(w, h);
+  return r;
+}
+
+void RenderResult::set(int x, int y, const PixelLayers& pixel) {
+  radiance.set(x, y, pixel.radiance());
+  if (inscatter) inscatter->set(x, y, pixel.inscatter), transmittance->set(x, y, pixel.transmittance), surface->set(x, y, pixel.surface);
+}
+
+namespace {
+
+// A host's depth buffer: one value per pixel, each >= 0 or +inf.
+void check_depth(const View& view) {
+  if (view.depth.empty()) return;
+  const size_t count = static_cast<size_t>(view.camera.width_px) * static_cast<size_t>(view.camera.height_px);
+  if (view.depth.size() != count)
+    throw Error("view.depth", to_text(view.depth.size()) + " values", to_text(count) + " (width_px x height_px), one distance per pixel");
+  for (size_t i = 0; i < count; ++i)
+    if (!(view.depth[i] >= 0.0f))
+      throw Error("view.depth[" + to_text(i) + "]", to_text(view.depth[i]), "a distance along the pixel's ray >= 0, or +inf for none");
+}
+
+}  // namespace
+
 RenderResult Solution::render(const View& view, const RenderOptions& options) const {
   const State& s = *state_;
+  check_depth(view);
+  if ((view.layers || !view.depth.empty()) && !s.solution->renders_layers())
+    throw Error("view", view.layers ? "layers" : "a depth buffer",
+                "a method that renders layers and takes a depth buffer: analytic or quadrature (the others are to come, tracker issue 24)");
   if (!options.settings.is_null() && (!options.settings.is_object() || !options.settings.empty()))
     throw Error("settings", options.settings.dump(), "none when rendering a solution (settings are given to haze::prepare)");
   if (s.options.single_view && !(view.camera == s.scene.camera))
@@ -199,6 +230,10 @@ Solution prepare(const Scene& scene, const std::string& method_name, RenderOptio
 }
 
 RenderResult render(const Scene& scene, const std::string& method_name, RenderOptions options) {
+  return render(scene, method_name, std::move(options), View{scene.camera});
+}
+
+RenderResult render(const Scene& scene, const std::string& method_name, RenderOptions options, const View& view) {
   const ProgressCallback progress = options.progress;
   const int threads = options.threads;
   options.single_view = true;
@@ -208,7 +243,7 @@ RenderResult render(const Scene& scene, const std::string& method_name, RenderOp
   RenderOptions render_options;
   render_options.threads = threads;
   render_options.progress = progress ? [&](double f) { return progress(0.5 + 0.5 * f); } : ProgressCallback();
-  return solution.render(render_options);
+  return solution.render(view, render_options);
 }
 
 }  // namespace haze

@@ -9,10 +9,15 @@
 #include <haze/core/phase.h>
 #include <haze/core/surface.h>
 
+#include <glm/ext/matrix_clip_space.hpp>
+#include <glm/ext/matrix_transform.hpp>
+#include <glm/trigonometric.hpp>
 #include <gtest/gtest.h>
 
 #include <array>
 #include <cmath>
+#include <memory>
+#include <vector>
 
 namespace haze {
 namespace {
@@ -36,6 +41,46 @@ TEST(Camera, RowsRunTopToBottomAndCentreLooksAtTarget) {
   Ray ortho_top = cam.generate_ray(2.0, 0.0);
   EXPECT_NEAR(ortho_top.origin.y, 1.0, 1e-12);
   EXPECT_NEAR(glm::length(ortho_top.direction - Vec3(0, 0, -1)), 0.0, 1e-12);
+}
+
+// A host's OpenGL matrices (glm::lookAt with glm::perspective or glm::ortho) give the rays of the
+// pinhole and orthographic cameras they describe, on and off the pixel centres; per-pixel rays
+// come back as given; bad matrices and rays are haze::Errors naming the field.
+TEST(Camera, HostMatricesAndRaysGiveTheSameRays) {
+  Camera pin;
+  pin.position = Vec3(0.3, 1.2, 4.0), pin.look_at = Vec3(-0.2, 0.1, 0.0), pin.up = Vec3(0.1, 1.0, 0.0);
+  pin.width_px = 16, pin.height_px = 9, pin.fov_y_deg = 50.0;
+  const glm::dmat4 view = glm::lookAt(pin.position, pin.look_at, pin.up);
+  const double aspect = 16.0 / 9.0;
+  const Camera host = Camera::from_matrices(view, glm::perspective(glm::radians(50.0), aspect, 0.1, 100.0), 16, 9);
+  Camera ortho = pin;
+  ortho.type = Camera::Type::orthographic, ortho.height = 3.0;
+  const Camera host_ortho = Camera::from_matrices(view, glm::ortho(-1.5 * aspect, 1.5 * aspect, -1.5, 1.5, 0.1, 100.0), 16, 9);
+  for (const auto& [px, py] : {std::pair{0.5, 0.5}, {15.5, 8.5}, {7.25, 3.0}, {0.0, 9.0}}) {
+    for (const auto& [own, matrices] : {std::pair{&pin, &host}, {&ortho, &host_ortho}}) {
+      const Ray a = own->generate_ray(px, py), b = matrices->generate_ray(px, py);
+      EXPECT_NEAR(glm::length(a.origin - b.origin), 0.0, 1e-9) << px << " " << py;
+      EXPECT_NEAR(glm::length(a.direction - b.direction), 0.0, 1e-12) << px << " " << py;
+    }
+  }
+  auto rays = std::make_shared<std::vector<Ray>>();
+  for (int y = 0; y < 9; ++y)
+    for (int x = 0; x < 16; ++x) rays->push_back(pin.pixel_ray(x, y));
+  const Camera given = Camera::from_rays(rays, 16, 9);
+  EXPECT_EQ(given.pixel_ray(7, 4).direction, pin.pixel_ray(7, 4).direction);
+  EXPECT_EQ(given.generate_ray(7.9, 4.1).origin, pin.pixel_ray(7, 4).origin);
+  auto expect_error = [](auto make, const std::string& field) {
+    try {
+      make();
+      ADD_FAILURE() << "no error for " << field;
+    } catch (const Error& e) {
+      EXPECT_EQ(e.field().rfind(field, 0), 0u) << e.what();
+    }
+  };
+  expect_error([&] { Camera::from_matrices(view, glm::dmat4(0.0), 16, 9); }, "camera.projection");
+  expect_error([&] { Camera::from_rays(rays, 16, 8); }, "camera.rays");
+  (*rays)[5].direction *= 2.0;
+  expect_error([&] { Camera::from_rays(rays, 16, 9); }, "camera.rays[5]");
 }
 
 TEST(Aabb, ClipsRays) {

@@ -2,7 +2,14 @@
 #include <haze/core/error.h>
 #include <haze/core/image.h>
 
+#include <ImfChannelList.h>
+#include <ImfFrameBuffer.h>
+#include <ImfHeader.h>
+#include <ImfInputFile.h>
+#include <ImfOutputFile.h>
 #include <gtest/gtest.h>
+
+#include <cmath>
 
 #include <fstream>
 
@@ -32,6 +39,44 @@ TEST(Image, ExrRoundTripKeepsLinearFloats) {
   write_exr(path, img);
   read_exr(path, &err_back);
   EXPECT_FALSE(err_back.has_value());
+  std::filesystem::remove(path);
+}
+
+// Layers beside the image as name.R/G/B; a host's depth buffer read from a Z (or depth) channel,
+// and a file with neither is an error naming the file.
+TEST(Image, ExrLayersAndDepthChannel) {
+  Image img(3, 2), l(3, 2);
+  l.set(2, 1, Rgb(0.5, 0.25, 4.0));
+  const auto path = temp_path("layers.exr");
+  write_exr(path, img, {{"inscatter", &l}, {"transmittance", &img}});
+  {
+    Imf::InputFile file(path.string().c_str());
+    for (const char* c : {"R", "inscatter.R", "inscatter.B", "transmittance.G"}) EXPECT_NE(file.header().channels().findChannel(c), nullptr) << c;
+  }
+  const std::vector<float> z = {1.0f, 2.5f, INFINITY, 0.0f, 7.0f, 3.0f};
+  int w = 0, h = 0;
+  for (const char* name : {"Z", "depth"}) {
+    {
+      Imf::Header header(3, 2);
+      header.channels().insert(name, Imf::Channel(Imf::FLOAT));
+      Imf::FrameBuffer fb;
+      fb.insert(name, Imf::Slice(Imf::FLOAT, const_cast<char*>(reinterpret_cast<const char*>(z.data())), sizeof(float), 3 * sizeof(float)));
+      Imf::OutputFile out(path.string().c_str(), header);
+      out.setFrameBuffer(fb);
+      out.writePixels(2);
+    }
+    EXPECT_EQ(read_exr_depth(path, w, h), z) << name;
+    EXPECT_EQ(w, 3);
+    EXPECT_EQ(h, 2);
+  }
+  write_exr(path, img);
+  try {
+    read_exr_depth(path, w, h);
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_NE(e.field().find(path.string()), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("no channel Z or depth"), std::string::npos) << e.what();
+  }
   std::filesystem::remove(path);
 }
 

@@ -1,15 +1,30 @@
-// Cameras: pinhole and orthographic. Image rows run top to bottom; pixel (x, y)'s ray goes through
-// its centre, (x + 0.5, y + 0.5).
+// Cameras: pinhole and orthographic, a host renderer's own view and projection matrices, or its
+// own per-pixel rays. Image rows run top to bottom; pixel (x, y)'s ray goes through its centre,
+// (x + 0.5, y + 0.5). Ray directions are unit vectors, so distances along a ray (a depth buffer's)
+// are world lengths from its origin.
 #pragma once
 
 #include <haze/core/math.h>
+
+#include <glm/mat4x4.hpp>
+
+#include <memory>
+#include <vector>
 
 #pragma GCC visibility push(default)  // the public API: exported from shared builds
 
 namespace haze {
 
 struct Camera {
-  enum class Type { pinhole, orthographic };
+  // matrices: OpenGL's conventions (docs/HOST.md): `view` takes world to eye space, the eye looking
+  // down -z; `projection` takes eye to clip space, NDC x, y, z in [-1, 1] after the divide by w
+  // (glm::perspective, glm::ortho, glm::frustum: column-major glm::dmat4). Pixel (x, y) is at
+  // NDC x = 2 (x + 0.5) / width_px - 1, y = 1 - 2 (y + 0.5) / height_px (row 0 at the top, as
+  // Haze's images; GL's window rows run bottom up). A perspective ray starts at the eye, an
+  // orthographic one on the eye plane (eye z = 0), through the pixel's point on the near plane.
+  // rays: `rays` holds width_px * height_px rays, row-major, rows top to bottom, unit directions;
+  // shared, not copied.
+  enum class Type { pinhole, orthographic, matrices, rays };
   Type type = Type::pinhole;
   Vec3 position{0.0, 0.0, 5.0};
   Vec3 look_at{0.0};
@@ -18,6 +33,15 @@ struct Camera {
   double fov_y_deg = 40.0; // pinhole: full vertical field of view
   int width_px = 64;
   int height_px = 64;
+  // Type::matrices, set by from_matrices (with their inverses, which rays are made from).
+  glm::dmat4 view{1.0}, projection{1.0}, view_inverse{1.0}, projection_inverse{1.0};
+  std::shared_ptr<const std::vector<Ray>> rays;  // Type::rays
+
+  // A camera from a host's matrices or rays, checked: a projection that cannot be inverted, or
+  // rays of the wrong count or with a direction not of unit length (within 1e-6) or not finite,
+  // throw haze::Error naming the field.
+  static Camera from_matrices(const glm::dmat4& view, const glm::dmat4& projection, int width_px, int height_px);
+  static Camera from_rays(std::shared_ptr<const std::vector<Ray>> rays, int width_px, int height_px);
 
   // Ray through film position (px, py) in pixels, (0, 0) the top-left corner.
   Ray generate_ray(double px, double py) const;

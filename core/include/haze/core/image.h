@@ -8,6 +8,7 @@
 #include <map>
 #include <string>
 #include <optional>
+#include <utility>
 #include <vector>
 
 #pragma GCC visibility push(default)  // the public API: exported from shared builds
@@ -42,6 +43,12 @@ class Image {
 
 // Writes linear float RGB ("R", "G", "B"); with std_error, also its layer "stderr.R/G/B".
 void write_exr(const std::filesystem::path& path, const Image& image, const Image* std_error = nullptr);
+// The same with named layers of the same size beside it, each as "name.R/G/B" ("stderr",
+// "inscatter", "transmittance", "surface").
+void write_exr(const std::filesystem::path& path, const Image& image, const std::vector<std::pair<std::string, const Image*>>& layers);
+// A host's depth buffer: the one float channel "Z" (or "depth") of an EXR, rows top to bottom;
+// its size comes back through width and height. A file without either channel throws haze::Error.
+std::vector<float> read_exr_depth(const std::filesystem::path& path, int& width, int& height);
 // Reads the "R", "G", "B" channels; with std_error, also the "stderr" layer when present.
 Image read_exr(const std::filesystem::path& path, std::optional<Image>* std_error = nullptr);
 // 8-bit sRGB preview, tone-mapped with exposure then Reinhard x / (1 + x): not data.

@@ -173,6 +173,8 @@ Solution prepare(const Scene& scene, const std::string& method_name = "", Render
 // prepare() (with options.single_view) and render() of the scene's camera in a row; the stats hold
 // both steps' figures.
 RenderResult render(const Scene& scene, const std::string& method_name, RenderOptions options = {});
+// The same for a view of the scene's camera with a host's depth buffer or layers (View).
+RenderResult render(const Scene& scene, const std::string& method_name, RenderOptions options, const View& view);
 
 }  // namespace haze
 

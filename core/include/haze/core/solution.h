@@ -14,6 +14,7 @@
 
 #include <filesystem>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -39,15 +40,44 @@ struct RenderOptions {
 // $HAZE_CACHE_DIR, else $XDG_CACHE_HOME/haze, else $HOME/.cache/haze, else the temporary directory.
 std::filesystem::path default_cache_dir();
 
-// What a solution renders: a camera (the caller's matrices and depth buffer are to come).
+// What a solution renders: a camera (Haze's own, or a host's matrices or rays, camera.h), and
+// optionally the host's depth buffer and a request for the layers a host composites.
 struct View {
   Camera camera;
+  // Empty, or per pixel (row-major, rows top to bottom: width_px * height_px values) the distance
+  // along the pixel's ray to the host's opaque geometry, +inf where there is none. The ray ends
+  // there (or at a nearer surface of Haze's own), and no background is added behind it. Viewed,
+  // not copied: it must outlive the render.
+  std::span<const float> depth = {};
+  // Render the layers (RenderResult::inscatter, transmittance, surface) beside the image.
+  bool layers = false;
+
+  // The distance the pixel's ray may go: its depth, or +inf.
+  double max_distance(int x, int y) const {
+    return depth.empty() ? kInfinity : static_cast<double>(depth[static_cast<size_t>(y) * static_cast<size_t>(camera.width_px) + static_cast<size_t>(x)]);
+  }
+};
+
+// A pixel's light as a host composites it (DESIGN.md, "Callers"): the radiance scattered toward
+// the camera along the ray up to its end (`inscatter`, L_in), the ray's transmittance to its end
+// (T), and the radiance leaving its end toward the camera (C: Haze's own surface, shaded, or the
+// background; 0 where the host's depth ends it). The image is L_in + T C.
+struct PixelLayers {
+  Rgb inscatter{0.0}, transmittance{1.0}, surface{0.0};
+  Rgb radiance() const { return inscatter + transmittance * surface; }
 };
 
 struct RenderResult {
   Image radiance;
   std::optional<Image> std_error;                   // per-pixel standard error, for Monte Carlo methods
   nlohmann::json stats = nlohmann::json::object();  // method-specific figures for --json
+  // With View::layers: L_in, T and C per pixel (PixelLayers), radiance = inscatter + transmittance * surface.
+  std::optional<Image> inscatter = std::nullopt, transmittance = std::nullopt, surface = std::nullopt;
+
+  // A result for `view`: the image, and the layers when it asks for them.
+  static RenderResult for_view(const View& view);
+  // Pixel (x, y): the image's radiance, and the layers when there are any.
+  void set(int x, int y, const PixelLayers& pixel);
 };
 
 // What a prepared method's renderer needs of `scene` seen from `camera`: its lights, surfaces,
@@ -81,6 +111,9 @@ class MethodSolution {
   virtual ~MethodSolution() = default;
   // The scene's medium, lights and surfaces as prepared, seen from view.camera.
   virtual RenderResult render(const View& view, const RenderOptions& options) const = 0;
+  // Whether render honours View::depth and View::layers (the methods that do not yet are refused
+  // such views with a haze::Error).
+  virtual bool renders_layers() const { return false; }
   // Applies `change` in place, given `scene` with the change applied, and reports what it redid;
   // std::nullopt when nothing can be reused (the Solution then prepares again). The default.
   virtual std::optional<UpdateReport> update(const Scene& scene, const SceneChange& change, const RenderOptions& options);

@@ -1,0 +1,123 @@
+// A host's view (DESIGN.md, "Callers"): the layers L_in, T and C per pixel, and a depth buffer
+// that ends the rays, for the methods that render them (analytic, quadrature).
+#include <haze/core/error.h>
+#include <haze/core/method.h>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+namespace haze {
+namespace {
+
+// Homogeneous fog in a box over a floor at y = -1, a point light above it; with `sphere`, a ball
+// in the fog (which shadows it).
+Scene fog_scene(bool floor, bool black_floor, bool sphere) {
+  Scene scene;
+  scene.camera.position = Vec3(0.2, 0.6, 5.0), scene.camera.look_at = Vec3(0.0, -0.4, 0.0);
+  scene.camera.width_px = 24, scene.camera.height_px = 16;
+  MediumDesc medium;
+  medium.bounds = {Vec3(-2.0, -1.0, -2.0), Vec3(2.0, 2.0, 2.0)};
+  medium.sigma_t = Rgb(0.4, 0.5, 0.6);
+  medium.albedo = Rgb(0.8);
+  medium.phase = PhaseFunction::henyey_greenstein(0.3);
+  scene.medium = medium;
+  scene.background = Rgb(0.05, 0.1, 0.2);
+  scene.lights.push_back(PointLight{Vec3(0.5, 1.2, 0.3), Rgb(4.0, 3.5, 3.0)});
+  const Rgb kd = black_floor ? Rgb(0.0) : Rgb(0.5), ks = black_floor ? Rgb(0.0) : Rgb(0.2);
+  if (floor) scene.surfaces.push_back({Plane{Vec3(0.0, -1.0, 0.0), Vec3(0.0, 1.0, 0.0)}, kd, ks, 20.0});
+  if (sphere) scene.surfaces.push_back({Sphere{Vec3(0.3, -0.4, 0.0), 0.5}, Rgb(0.6, 0.3, 0.2), Rgb(0.0), 1.0});
+  scene.method = {{"name", "quadrature"}, {"steps", 64}};
+  return scene;
+}
+
+// The largest difference over the channels relative to b, or to `floor` where b is smaller.
+double relative(const Rgb& a, const Rgb& b, double floor = 1e-6) {
+  double worst = 0.0;
+  for (int c = 0; c < 3; ++c) worst = std::max(worst, std::abs(a[c] - b[c]) / std::max(std::abs(b[c]), floor));
+  return worst;
+}
+
+// With Haze's own surfaces, T C + L_in is Haze's own image (to float rounding), the image is the
+// one rendered without layers, T lies in (0, 1], and a pixel that sees the background has it as C.
+TEST(Layers, CompositeIsTheImage) {
+  const Scene scene = fog_scene(true, false, true);
+  for (const char* method : {"analytic", "quadrature"}) {
+    const RenderResult plain = render(scene, method);
+    const RenderResult layered = render(scene, method, {}, View{scene.camera, {}, true});
+    ASSERT_TRUE(layered.inscatter && layered.transmittance && layered.surface) << method;
+    EXPECT_EQ(layered.radiance.data(), plain.radiance.data()) << method;
+    int background = 0;
+    for (int y = 0; y < scene.camera.height_px; ++y)
+      for (int x = 0; x < scene.camera.width_px; ++x) {
+        const Rgb l = layered.inscatter->at(x, y), t = layered.transmittance->at(x, y), c = layered.surface->at(x, y);
+        ASSERT_LT(relative(l + t * c, plain.radiance.at(x, y)), 1e-6) << method << " at " << x << ", " << y;
+        for (int k = 0; k < 3; ++k) ASSERT_TRUE(t[k] > 0.0 && t[k] <= 1.0) << method << " at " << x << ", " << y;
+        const Ray ray = scene.camera.pixel_ray(x, y);
+        double t_hit;
+        Vec3 n;
+        if (!nearest_surface(scene.surfaces, ray, kInfinity, t_hit, n)) {
+          EXPECT_LT(relative(c, scene.background), 1e-6) << method << " at " << x << ", " << y;
+          ++background;
+        }
+      }
+    EXPECT_GT(background, 20) << method;  // the test sees the background
+  }
+}
+
+// A host's depth buffer in place of Haze's floor: with the floor removed and its distances given
+// as the depth, the layers equal those of the scene with a black floor (it shadows no part of the
+// view rays: the light is above it), C is 0 where the depth ends a ray, and the background
+// elsewhere.
+TEST(Layers, DepthBufferEndsTheRaysAsASurfaceWould) {
+  const Scene black = fog_scene(true, true, false), open = fog_scene(false, false, false);
+  const Camera& camera = black.camera;
+  std::vector<float> depth;
+  int cut = 0;
+  for (int y = 0; y < camera.height_px; ++y)
+    for (int x = 0; x < camera.width_px; ++x) {
+      double t;
+      Vec3 n;
+      const bool hit = nearest_surface(black.surfaces, camera.pixel_ray(x, y), kInfinity, t, n);
+      depth.push_back(hit ? static_cast<float>(t) : std::numeric_limits<float>::infinity());
+      cut += hit;
+    }
+  ASSERT_GT(cut, 50);
+  ASSERT_LT(cut, camera.width_px * camera.height_px);
+  for (const char* method : {"analytic", "quadrature"}) {
+    const RenderResult a = render(black, method, {}, View{camera, {}, true}), b = render(open, method, {}, View{camera, depth, true});
+    // The depth is a float: where a ray's segment in the fog is short, its rounding (about 1e-7 of
+    // the distance) is a larger share of the in-scatter, which is small there.
+    const double floor = 0.01 * a.inscatter->mean().r;
+    for (int y = 0; y < camera.height_px; ++y)
+      for (int x = 0; x < camera.width_px; ++x) {
+        const float d = depth[static_cast<size_t>(y * camera.width_px + x)];
+        EXPECT_LT(relative(b.inscatter->at(x, y), a.inscatter->at(x, y), floor), 1e-5) << method << " at " << x << ", " << y;
+        EXPECT_LT(relative(b.transmittance->at(x, y), a.transmittance->at(x, y)), 1e-5) << method << " at " << x << ", " << y;
+        EXPECT_EQ(b.surface->at(x, y), std::isinf(d) ? a.surface->at(x, y) : Rgb(0.0)) << method << " at " << x << ", " << y;
+        EXPECT_LT(relative(b.inscatter->at(x, y) + b.transmittance->at(x, y) * b.surface->at(x, y), b.radiance.at(x, y)), 1e-6);
+      }
+  }
+}
+
+TEST(Layers, BadViewsAreClearErrors) {
+  const Scene scene = fog_scene(true, false, false);
+  auto field_of = [&](const std::string& method, const View& view) {
+    try {
+      render(scene, method, {}, view);
+    } catch (const Error& e) {
+      return e.field();
+    }
+    return std::string("no error");
+  };
+  const size_t count = static_cast<size_t>(scene.camera.width_px * scene.camera.height_px);
+  std::vector<float> short_depth(count - 1, 1.0f), negative(count, 1.0f);
+  negative[3] = -0.5f;
+  EXPECT_EQ(field_of("quadrature", View{scene.camera, short_depth, false}), "view.depth");
+  EXPECT_EQ(field_of("quadrature", View{scene.camera, negative, false}), "view.depth[3]");
+  EXPECT_EQ(field_of("reference", View{scene.camera, {}, true}), "view");  // not yet
+}
+
+}  // namespace
+}  // namespace haze
