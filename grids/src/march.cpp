@@ -64,9 +64,10 @@ struct Marcher {
     return out;
   }
 
-  Hit hit(const Ray& ray) const {
+  // The nearest surface before t_max (a host's depth); h.t is t_max where there is none.
+  Hit hit(const Ray& ray, double t_max = kInfinity) const {
     Hit h;
-    h.surface = nearest_surface(scene.surfaces, ray, kInfinity, h.t, h.normal);
+    h.surface = nearest_surface(scene.surfaces, ray, t_max, h.t, h.normal);
     return h;
   }
 
@@ -116,10 +117,11 @@ struct Marcher {
     }
   }
 
-  // What reaches the eye: the medium's radiance, then the background or (eq. 10) the surface's
-  // shading, each light attenuated by its depth to the surface point, seen through the medium.
-  Rgb finish(const Ray& ray, const Hit& h, const Rgb& radiance, const Rgb& transmittance) const {
-    if (!h.surface) return radiance + transmittance * scene.background;
+  // What reaches the eye: the medium's radiance, then the background (not behind a host's depth)
+  // or (eq. 10) the surface's shading, each light attenuated by its depth to the surface point,
+  // seen through the medium.
+  PixelLayers finish(const Ray& ray, const Hit& h, const Rgb& radiance, const Rgb& transmittance) const {
+    if (!h.surface) return {radiance, transmittance, std::isinf(h.t) ? scene.background : Rgb(0.0)};
     const Vec3 p = ray.at(h.t);
     Rgb surface = surface_direct(scene.lights, scene.surfaces, volume.density, depths, sigma_t, *h.surface, p, h.normal, -ray.direction);
     for (int j = 0; gather && j < around.size(); ++j) {
@@ -130,11 +132,11 @@ struct Marcher {
       march(up, steps(up, hit(up).t), arriving, unused, cone);
       surface += around.weight(j) * cos_i * h.surface->brdf(around[j], -ray.direction, h.normal) * arriving;
     }
-    return radiance + transmittance * surface;
+    return {radiance, transmittance, surface};
   }
 
-  Rgb pixel(const Ray& ray) const {
-    const Hit h = hit(ray);
+  PixelLayers pixel(const Ray& ray, double t_max) const {
+    const Hit h = hit(ray, t_max);
     Rgb radiance, transmittance;
     march(ray, steps(ray, h.t), radiance, transmittance);
     return finish(ray, h, radiance, transmittance);
@@ -185,15 +187,15 @@ bool simd_volume(const Marcher& m, std::vector<simd::MarchLight>& lights, simd::
 }
 
 // One image row through the SIMD kernel; surfaces and the background per pixel after it.
-void march_row(const Marcher& m, const simd::MarchVolume& v, int y, Image& image) {
-  const Camera& camera = m.scene.camera;
+void march_row(const Marcher& m, const simd::MarchVolume& v, const View& view, int y, RenderResult& result) {
+  const Camera& camera = view.camera;
   const auto width = static_cast<size_t>(camera.width_px);
   std::vector<float> in(9 * width), out(6 * width, 0.0f);
   std::vector<Ray> rays(width);
   std::vector<Hit> hits(width);
   for (size_t x = 0; x < width; ++x) {
     rays[x] = camera.pixel_ray(static_cast<int>(x), y);
-    hits[x] = m.hit(rays[x]);
+    hits[x] = m.hit(rays[x], view.max_distance(static_cast<int>(x), y));
     const Steps s = m.steps(rays[x], hits[x].t);
     const double values[9] = {rays[x].origin.x, rays[x].origin.y, rays[x].origin.z, rays[x].direction.x, rays[x].direction.y,
                               rays[x].direction.z, s.t0, s.dt, static_cast<double>(s.count)};
@@ -210,7 +212,7 @@ void march_row(const Marcher& m, const simd::MarchVolume& v, int y, Image& image
       radiance[c] = static_cast<double>(row(out, channel)[x]);
       transmittance[c] = static_cast<double>(row(out, 3 + channel)[x]);
     }
-    image.set(static_cast<int>(x), y, m.finish(rays[x], hits[x], radiance, transmittance));
+    result.set(static_cast<int>(x), y, m.finish(rays[x], hits[x], radiance, transmittance));
   }
 }
 
@@ -218,6 +220,11 @@ void march_row(const Marcher& m, const simd::MarchVolume& v, int y, Image& image
 
 Image march_image(const Scene& scene, const ExtinctionVolume& volume, const std::vector<DenseGrid>& depths,
                   const MarchSettings& settings, const RenderOptions& options, const std::vector<DenseGrid>* visibility) {
+  return march_view(scene, volume, depths, settings, options, View{scene.camera}, visibility).radiance;
+}
+
+RenderResult march_view(const Scene& scene, const ExtinctionVolume& volume, const std::vector<DenseGrid>& depths, const MarchSettings& settings,
+                        const RenderOptions& options, const View& view, const std::vector<DenseGrid>* visibility) {
   if (depths.size() != scene.lights.size())
     throw Error("depths", to_text(depths.size()) + " volumes", "one per light (" + to_text(scene.lights.size()) + ")");
   if (!(settings.step_cells > 0.0)) throw Error("step", to_text(settings.step_cells), "a step > 0 cells");
@@ -229,21 +236,21 @@ Image march_image(const Scene& scene, const ExtinctionVolume& volume, const std:
   std::vector<simd::MarchLight> lights;
   simd::MarchVolume simd_view;
   const bool use_simd = !settings.scalar && simd_volume(marcher, lights, simd_view);
-  const Camera& camera = scene.camera;
-  Image image(camera.width_px, camera.height_px);
+  const Camera& camera = view.camera;
+  RenderResult result = RenderResult::for_view(view);
   ProgressTracker progress(options.progress, camera.height_px);
   parallel_for(camera.height_px, options.threads, 4, [&](long long y0, long long y1) {
     for (auto y = static_cast<int>(y0); y < y1 && !progress.cancelled(); ++y) {
       if (use_simd) {
-        march_row(marcher, simd_view, y, image);
+        march_row(marcher, simd_view, view, y, result);
       } else {
-        for (int x = 0; x < camera.width_px; ++x) image.set(x, y, marcher.pixel(camera.pixel_ray(x, y)));
+        for (int x = 0; x < camera.width_px; ++x) result.set(x, y, marcher.pixel(camera.pixel_ray(x, y), view.max_distance(x, y)));
       }
       progress.advance();
     }
   });
   progress.throw_if_cancelled();
-  return image;
+  return result;
 }
 
 }  // namespace haze::grids

@@ -36,11 +36,11 @@ class PropagationSolution final : public GridSolution {
 
   RenderResult render(const View& view, const RenderOptions& options) const override {
     const Stopwatch watch;
-    const Scene seen = view_scene(scene_, view.camera);
-    RenderResult result{march_image(seen, volume_, depths_, march_, options, &visibility_), std::nullopt, {}};
+    RenderResult result = march_view(view_scene(scene_, view.camera), volume_, depths_, march_, options, view, &visibility_);
     result.stats["march_seconds"] = watch.seconds();
     return result;
   }
+  bool renders_layers() const override { return true; }
 
   // A new density (re-injected by region where it can: replace_volume) redoes every light's depth,
   // new lights only the lights that differ.

@@ -83,6 +83,10 @@ struct MarchSettings {
 // rendering many frames keeps, else computed here). depths[i] belongs to scene.lights[i].
 Image march_image(const Scene& scene, const ExtinctionVolume& volume, const std::vector<DenseGrid>& depths,
                   const MarchSettings& settings, const RenderOptions& options, const std::vector<DenseGrid>* visibility = nullptr);
+// The same for `view` (its camera in place of the scene's): rays end at its depth where no surface
+// is nearer, and with view.layers the result holds L_in, T and C per pixel (PixelLayers).
+RenderResult march_view(const Scene& scene, const ExtinctionVolume& volume, const std::vector<DenseGrid>& depths, const MarchSettings& settings,
+                        const RenderOptions& options, const View& view, const std::vector<DenseGrid>* visibility = nullptr);
 
 // Everything method "propagation" computes before it marches, from the scene and the method's
 // settings in options.settings (resolution, optical_depth, sweep_layers, step, cutoff; unknown

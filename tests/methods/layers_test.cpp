@@ -1,7 +1,8 @@
 // A host's view (DESIGN.md, "Callers"): the layers L_in, T and C per pixel, and a depth buffer
-// that ends the rays, for the methods that render them (analytic, quadrature).
+// that ends the rays, for the methods that render them (analytic, quadrature, propagation).
 #include <haze/core/error.h>
 #include <haze/core/method.h>
+#include <haze/grids/methods.h>
 
 #include <gtest/gtest.h>
 
@@ -28,7 +29,7 @@ Scene fog_scene(bool floor, bool black_floor, bool sphere) {
   const Rgb kd = black_floor ? Rgb(0.0) : Rgb(0.5), ks = black_floor ? Rgb(0.0) : Rgb(0.2);
   if (floor) scene.surfaces.push_back({Plane{Vec3(0.0, -1.0, 0.0), Vec3(0.0, 1.0, 0.0)}, kd, ks, 20.0});
   if (sphere) scene.surfaces.push_back({Sphere{Vec3(0.3, -0.4, 0.0), 0.5}, Rgb(0.6, 0.3, 0.2), Rgb(0.0), 1.0});
-  scene.method = {{"name", "quadrature"}, {"steps", 64}};
+  scene.method = {{"name", "quadrature"}, {"steps", 64}};  // when quadrature renders it
   return scene;
 }
 
@@ -41,9 +42,12 @@ double relative(const Rgb& a, const Rgb& b, double floor = 1e-6) {
 
 // With Haze's own surfaces, T C + L_in is Haze's own image (to float rounding), the image is the
 // one rendered without layers, T lies in (0, 1], and a pixel that sees the background has it as C.
+constexpr const char* kLayered[] = {"analytic", "quadrature", "propagation"};
+
 TEST(Layers, CompositeIsTheImage) {
+  grids::register_methods();
   const Scene scene = fog_scene(true, false, true);
-  for (const char* method : {"analytic", "quadrature"}) {
+  for (const char* method : kLayered) {
     const RenderResult plain = render(scene, method);
     const RenderResult layered = render(scene, method, {}, View{scene.camera, {}, true});
     ASSERT_TRUE(layered.inscatter && layered.transmittance && layered.surface) << method;
@@ -71,6 +75,7 @@ TEST(Layers, CompositeIsTheImage) {
 // view rays: the light is above it), C is 0 where the depth ends a ray, and the background
 // elsewhere.
 TEST(Layers, DepthBufferEndsTheRaysAsASurfaceWould) {
+  grids::register_methods();
   const Scene black = fog_scene(true, true, false), open = fog_scene(false, false, false);
   const Camera& camera = black.camera;
   std::vector<float> depth;
@@ -85,7 +90,7 @@ TEST(Layers, DepthBufferEndsTheRaysAsASurfaceWould) {
     }
   ASSERT_GT(cut, 50);
   ASSERT_LT(cut, camera.width_px * camera.height_px);
-  for (const char* method : {"analytic", "quadrature"}) {
+  for (const char* method : kLayered) {
     const RenderResult a = render(black, method, {}, View{camera, {}, true}), b = render(open, method, {}, View{camera, depth, true});
     // The depth is a float: where a ray's segment in the fog is short, its rounding (about 1e-7 of
     // the distance) is a larger share of the in-scatter, which is small there.
@@ -102,10 +107,13 @@ TEST(Layers, DepthBufferEndsTheRaysAsASurfaceWould) {
 }
 
 TEST(Layers, BadViewsAreClearErrors) {
+  grids::register_methods();
   const Scene scene = fog_scene(true, false, false);
   auto field_of = [&](const std::string& method, const View& view) {
+    RenderOptions options;
+    if (method == "dom") options.settings = {{"resolution", 8}, {"directions", 16}, {"terms", 4}};  // quick: it is refused after solving
     try {
-      render(scene, method, {}, view);
+      render(scene, method, options, view);
     } catch (const Error& e) {
       return e.field();
     }
@@ -116,7 +124,7 @@ TEST(Layers, BadViewsAreClearErrors) {
   negative[3] = -0.5f;
   EXPECT_EQ(field_of("quadrature", View{scene.camera, short_depth, false}), "view.depth");
   EXPECT_EQ(field_of("quadrature", View{scene.camera, negative, false}), "view.depth[3]");
-  EXPECT_EQ(field_of("reference", View{scene.camera, {}, true}), "view");  // not yet
+  EXPECT_EQ(field_of("dom", View{scene.camera, {}, true}), "view");  // not yet
 }
 
 }  // namespace
