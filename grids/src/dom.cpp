@@ -136,13 +136,16 @@ SurfaceSolve solve_with_surfaces(const Scene& scene, const ExtinctionVolume& vol
 // through the medium, reflected toward the eye and seen through T' (Gather::around through the
 // BRDF: the first bounce, medium to surface), with what other surfaces reflect onto it when the
 // solution carries its surfaces' texels (which hold the bounces between surfaces so far).
-Image gather_scattered(const Scene& delta, const ExtinctionVolume& volume, const std::vector<DenseGrid>& depths,
-                       const DomSolution& solution, double step_cells, const Rgb& sky, const RenderOptions& options) {
+// Per pixel of `view`: the gathered in-scatter, its transmittance and the scattered light leaving
+// the surface (not yet seen through it).
+std::vector<PixelLayers> gather_scattered(const Scene& delta, const ExtinctionVolume& volume, const std::vector<DenseGrid>& depths,
+                                          const DomSolution& solution, double step_cells, const Rgb& sky, const View& view,
+                                          const RenderOptions& options) {
   std::optional<dom::SurfaceLight> light;
   if (solution.surfaces) light.emplace(delta, volume, depths, *solution.surfaces, sky, solution.delta_m_fraction);
   const dom::Gather gather(delta, volume, depths, solution, step_cells, options.threads, light ? &*light : nullptr);
-  const Camera& camera = delta.camera;
-  Image image(camera.width_px, camera.height_px);
+  const Camera& camera = view.camera;
+  std::vector<PixelLayers> out(static_cast<size_t>(camera.width_px) * static_cast<size_t>(camera.height_px));
   ProgressTracker progress(options.progress, camera.height_px);
   parallel_for(camera.height_px, options.threads, 4, [&](long long y0, long long y1) {
     for (auto y = static_cast<int>(y0); y < y1 && !progress.cancelled(); ++y) {
@@ -150,32 +153,36 @@ Image gather_scattered(const Scene& delta, const ExtinctionVolume& volume, const
         const Ray ray = camera.pixel_ray(x, y);
         double t_hit = kInfinity;
         Vec3 normal;
-        const Surface* surface = nearest_surface(delta.surfaces, ray, kInfinity, t_hit, normal);
-        Rgb transmittance(1.0), radiance(0.0);
+        const Surface* surface = nearest_surface(delta.surfaces, ray, view.max_distance(x, y), t_hit, normal);
+        PixelLayers& p = out[static_cast<size_t>(y) * static_cast<size_t>(camera.width_px) + static_cast<size_t>(x)];
         double t0 = 0.0, t1 = t_hit;
         if (volume.density.bounds().clip(ray, t0, t1) && t1 > t0)
-          radiance = gather.along(ray, t_hit, inscatter_weights(solution, -ray.direction), transmittance);
+          p.inscatter = gather.along(ray, t_hit, inscatter_weights(solution, -ray.direction), p.transmittance);
         if (surface) {
           const Vec3 wo = -ray.direction;
           if (solution.texel_surfaces && light)
-            radiance += transmittance * (surface->kd + surface->ks) / kPi * light->irradiance(*surface, ray.at(t_hit));
+            p.surface = (surface->kd + surface->ks) / kPi * light->irradiance(*surface, ray.at(t_hit));
           else
-            radiance += transmittance * (gather.around(ray.at(t_hit), normal, sky, [&](const Vec3&) { return surface->kd / kPi; }) +
-                                         gather.glossy(ray.at(t_hit), normal, wo, *surface, sky));
+            p.surface = gather.around(ray.at(t_hit), normal, sky, [&](const Vec3&) { return surface->kd / kPi; }) +
+                        gather.glossy(ray.at(t_hit), normal, wo, *surface, sky);
         }
-        image.set(x, y, radiance);
       }
       progress.advance();
     }
   });
   progress.throw_if_cancelled();
-  return image;
+  return out;
 }
 
 }  // namespace
 
 Image render_dom(const Scene& scene, const ExtinctionVolume& volume, const std::vector<DenseGrid>& delta_depths,
                  const DomSolution& solution, double step_cells, const RenderOptions& options) {
+  return render_dom(scene, volume, delta_depths, solution, step_cells, options, View{scene.camera}).radiance;
+}
+
+RenderResult render_dom(const Scene& scene, const ExtinctionVolume& volume, const std::vector<DenseGrid>& delta_depths,
+                        const DomSolution& solution, double step_cells, const RenderOptions& options, const View& view) {
   Rgb sky;
   Scene delta = without_sky(scene, sky);
   delta.background += sky;
@@ -189,12 +196,18 @@ Image render_dom(const Scene& scene, const ExtinctionVolume& volume, const std::
   const ProgressCallback& progress = options.progress;
   RenderOptions march_options = options;
   march_options.progress = progress ? [&](double f) { return progress(0.3 * f); } : ProgressCallback();
-  Image image = march_image(delta, dark, delta_depths, MarchSettings{step_cells}, march_options);
+  const RenderResult direct = march_view(delta, dark, delta_depths, MarchSettings{step_cells}, march_options, View{view.camera, view.depth, true});
   march_options.progress = progress ? [&](double f) { return progress(0.3 + 0.7 * f); } : ProgressCallback();
-  const Image scattered = gather_scattered(delta, volume, delta_depths, solution, step_cells, sky, march_options);
-  for (int y = 0; y < image.height(); ++y)
-    for (int x = 0; x < image.width(); ++x) image.set(x, y, image.at(x, y) + scattered.at(x, y));
-  return image;
+  const std::vector<PixelLayers> scattered = gather_scattered(delta, volume, delta_depths, solution, step_cells, sky, view, march_options);
+  // One transmittance for both, the march's: the gather's own differs from it only by float
+  // rounding (the same steps and extinction, in double).
+  RenderResult result = RenderResult::for_view(view);
+  for (int y = 0; y < view.camera.height_px; ++y)
+    for (int x = 0; x < view.camera.width_px; ++x) {
+      const PixelLayers& s = scattered[static_cast<size_t>(y) * static_cast<size_t>(view.camera.width_px) + static_cast<size_t>(x)];
+      result.set(x, y, {direct.inscatter->at(x, y) + s.inscatter, direct.transmittance->at(x, y), direct.surface->at(x, y) + s.surface});
+    }
+  return result;
 }
 
 namespace {
@@ -218,10 +231,11 @@ class DomMethodSolution final : public GridSolution {
   RenderResult render(const View& view, const RenderOptions& options) const override {
     const Stopwatch watch;
     const Scene seen = view_scene(scene_, view.camera);
-    RenderResult result{render_dom(seen, volume_, depths_, solution_, step_cells_, options), std::nullopt, {}};
+    RenderResult result = render_dom(seen, volume_, depths_, solution_, step_cells_, options, view);
     result.stats["render_seconds"] = watch.seconds();
     return result;
   }
+  bool renders_layers() const override { return true; }
 
   // A new density (re-injected by region where it can: replace_volume) redoes every light's depth,
   // new lights only those that differ; the moments then iterate from the previous ones

@@ -178,6 +178,10 @@ Eigen::VectorXd inscatter_weights(const DomSolution& solution, const Vec3& w);
 // it is the propagation marcher's estimator plus the gather). One solution serves any camera.
 Image render_dom(const Scene& scene, const ExtinctionVolume& volume, const std::vector<DenseGrid>& delta_depths,
                  const DomSolution& solution, double step_cells = 0.5, const RenderOptions& options = {});
+// The same for `view` (its camera and depth; with view.layers, L_in, T and C per pixel: the
+// gathered and unscattered light summed, seen through the unscattered march's transmittance).
+RenderResult render_dom(const Scene& scene, const ExtinctionVolume& volume, const std::vector<DenseGrid>& delta_depths,
+                        const DomSolution& solution, double step_cells, const RenderOptions& options, const View& view);
 
 // Everything method "dom" computes before it renders, from the scene and the method's settings in
 // options.settings (resolution, directions, terms, scheme, accelerator, iterations, tolerance,
