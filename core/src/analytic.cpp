@@ -51,7 +51,10 @@ struct SurfaceShading {
       if (cos_i <= 0.0 || occluded(surfaces, p, a.to_light, a.distance)) continue;
       radiance += surface.brdf(a.to_light, -view_dir, normal) * a.irradiance * cos_i * medium.transmittance(p, light.position);
     }
-    if (!surface_airlight || !medium.bounds().contains(p)) return radiance;
+    // In the medium on the side the normal faces (toward the viewer): a floor on the medium's
+    // bottom face has it above, where the point itself sits on the boundary, in or out of the
+    // box by rounding (pixels of one floor came out 43% apart).
+    if (!surface_airlight || !medium.bounds().contains(p + 1e-9 * (1.0 + glm::length(p)) * normal)) return radiance;
     const Vec3 mirrored = glm::reflect(view_dir, normal);
     const double cos_r = std::max(0.0, glm::dot(normal, mirrored));
     for (const auto& light : lights) {

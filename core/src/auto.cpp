@@ -55,6 +55,7 @@ class AutoSolution final : public MethodSolution {
     o.progress = options.progress;
     return chosen_.update(change, o);
   }
+  bool renders_layers() const override { return chosen_.method_solution().renders_layers(); }
   Rgb transmittance(size_t light, const Vec3& x) const override { return chosen_.transmittance(light, x); }
   Rgb fluence(const Vec3& x) const override { return chosen_.fluence(x); }
   Rgb inscattered(const Vec3& x, const Vec3& w) const override { return chosen_.inscattered(x, w); }

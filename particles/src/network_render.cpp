@@ -24,8 +24,13 @@ struct Projection {
   double aspect = static_cast<double>(cam.width_px) / cam.height_px;
   double tan_half = std::tan(0.5 * cam.fov_y_deg * kPi / 180.0);
 
-  // False when the sphere of radius `extent` around x lies wholly behind a pinhole camera.
+  // False when the sphere of radius `extent` around x lies wholly behind a pinhole camera. A
+  // host's camera (matrices) is not binned: every particle covers the whole image.
   bool operator()(const Vec3& x, double extent, double& px, double& py, double& radius) const {
+    if (cam.type == Camera::Type::matrices) {
+      px = 0.5 * cam.width_px, py = 0.5 * cam.height_px, radius = 2.0 * (cam.width_px + cam.height_px);
+      return true;
+    }
     const Vec3 d = x - cam.position;
     double scale;  // film units per world unit at x
     if (cam.type == Camera::Type::orthographic) {
@@ -108,7 +113,19 @@ Rgb march(std::vector<Along>& along, const Rgb& sigma_t, const std::vector<Rgb>&
 }  // namespace
 
 Image render_network(const Scene& scene, const ParticleField& field, const NetworkSolution& solution, const RenderOptions& options) {
-  const Camera& cam = scene.camera;
+  return render_network(scene, field, solution, options, View{scene.camera}).radiance;
+}
+
+RenderResult render_network(const Scene& scene, const ParticleField& field, const NetworkSolution& solution, const RenderOptions& options,
+                            const View& view) {
+  const Camera& cam = view.camera;
+  if (cam.type == Camera::Type::rays)
+    throw Error("view.camera", "per-pixel rays", "a camera with one eye (pinhole, orthographic or matrices) for method network, whose "
+                "particles scatter toward the eye");
+  // Toward the eye from x: an orthographic camera's is one direction.
+  const bool parallel = cam.type == Camera::Type::orthographic || (cam.type == Camera::Type::matrices && cam.projection[2][3] == 0.0);
+  const Vec3 backward = cam.type == Camera::Type::matrices ? glm::normalize(Vec3(cam.view_inverse * glm::dvec4(0.0, 0.0, 1.0, 0.0)))
+                                                           : glm::normalize(cam.position - cam.look_at);
   const MaterialDesc& material = field.particles().material;
   Rgb background = scene.background;
   size_t delta = 0;  // point, spot and directional lights
@@ -127,7 +144,7 @@ Image render_network(const Scene& scene, const ParticleField& field, const Netwo
   parallel_for(static_cast<long long>(n), options.threads, 64, [&](long long p0, long long p1) {
     for (auto p = static_cast<size_t>(p0); p < static_cast<size_t>(p1); ++p) {
       const Vec3 x = field.position(p);
-      const Vec3 w = cam.type == Camera::Type::orthographic ? glm::normalize(cam.position - cam.look_at) : glm::normalize(cam.position - x);
+      const Vec3 w = parallel ? backward : glm::normalize(cam.position - x);
       const Eigen::VectorXd row = solution.matrix->row(w);
       Rgb j(0.0);
       for (int c = 0; c < 3; ++c)
@@ -224,7 +241,7 @@ Image render_network(const Scene& scene, const ParticleField& field, const Netwo
     for (int ty = y0; ty <= y1; ++ty)
       for (int tx = x0; tx <= x1; ++tx) tiles[static_cast<size_t>(ty * tiles_x + tx)].push_back(static_cast<int>(p));
   }
-  Image image(cam.width_px, cam.height_px);
+  RenderResult result = RenderResult::for_view(view);
   ProgressTracker progress(options.progress, static_cast<long long>(tiles.size()));
   parallel_for(static_cast<long long>(tiles.size()), options.threads, 1, [&](long long t0, long long t1) {
     for (auto t = t0; t < t1 && !progress.cancelled(); ++t) {
@@ -236,7 +253,7 @@ Image render_network(const Scene& scene, const ParticleField& field, const Netwo
           const Ray ray = cam.pixel_ray(x, y);
           double t_hit = kInfinity;
           Vec3 normal;
-          const Surface* surface = nearest_surface(scene.surfaces, ray, kInfinity, t_hit, normal);
+          const Surface* surface = nearest_surface(scene.surfaces, ray, view.max_distance(x, y), t_hit, normal);
           along.clear();
           for (const int index : list) {
             const auto p = static_cast<size_t>(index);
@@ -249,13 +266,15 @@ Image render_network(const Scene& scene, const ParticleField& field, const Netwo
           const Rgb radiance = march(
               along, material.sigma_t, scattered, [&](double t) { return direct(ray.origin + t * ray.direction, -ray.direction); }, transmittance,
               t_hit);
-          image.set(x, y, radiance + transmittance * (surface ? surface_light(*surface, ray.at(t_hit), normal, -ray.direction, gathered) : background));
+          const Rgb leaving = surface ? surface_light(*surface, ray.at(t_hit), normal, -ray.direction, gathered)
+                              : std::isinf(t_hit) ? background : Rgb(0.0);  // none behind a host's depth
+          result.set(x, y, {radiance, transmittance, leaving});
         }
       progress.advance();
     }
   });
   progress.throw_if_cancelled();
-  return image;
+  return result;
 }
 
 namespace {
@@ -275,10 +294,11 @@ class NetworkMethodSolution final : public MethodSolution {
   RenderResult render(const View& view, const RenderOptions& options) const override {
     const Stopwatch watch;
     const Scene seen = view_scene(scene_, view.camera);
-    RenderResult result{render_network(seen, *field_, solution_, options), std::nullopt, {}};
+    RenderResult result = render_network(seen, *field_, solution_, options, view);
     result.stats["render_seconds"] = watch.seconds();
     return result;
   }
+  bool renders_layers() const override { return true; }
 
   // Moved particles (a new particle medium of the same count) and new lights: update_network,
   // which redoes only what the moved particles and lights reach, then iterates from the previous

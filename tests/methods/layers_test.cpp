@@ -1,11 +1,18 @@
 // A host's view (DESIGN.md, "Callers"): the layers L_in, T and C per pixel, and a depth buffer
-// that ends the rays, for the methods that render them (analytic, quadrature, propagation, dom).
+// that ends the rays, for the methods that render them (analytic, quadrature, propagation, dom,
+// network).
+#include <haze/core/auto.h>
 #include <haze/core/error.h>
 #include <haze/core/method.h>
 #include <haze/grids/methods.h>
+#include <haze/particles/methods.h>
 
+#include <glm/ext/matrix_clip_space.hpp>
+#include <glm/ext/matrix_transform.hpp>
+#include <glm/trigonometric.hpp>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -42,6 +49,16 @@ double relative(const Rgb& a, const Rgb& b, double floor = 1e-6) {
 
 // With Haze's own surfaces, T C + L_in is Haze's own image (to float rounding), the image is the
 // one rendered without layers, T lies in (0, 1], and a pixel that sees the background has it as C.
+// examples/particle_cloud.json at 24 x 18 pixels over a floor at y = -1.4, below every particle's
+// Gaussian (the lowest centre is at -0.8; the light is above it).
+Scene particle_scene(bool black_floor) {
+  Scene scene = Scene::load(std::string(HAZE_SOURCE_DIR) + "/examples/particle_cloud.json");
+  scene.camera.width_px = 24, scene.camera.height_px = 18;
+  const Rgb kd = black_floor ? Rgb(0.0) : Rgb(0.5);
+  scene.surfaces.push_back({Plane{Vec3(0.0, -1.4, 0.0), Vec3(0.0, 1.0, 0.0)}, kd, Rgb(0.0), 1.0});
+  return scene;
+}
+
 constexpr const char* kLayered[] = {"analytic", "quadrature", "propagation", "dom"};
 
 // Quick settings for the grid methods (the layers do not depend on them).
@@ -113,6 +130,69 @@ TEST(Layers, DepthBufferEndsTheRaysAsASurfaceWould) {
         EXPECT_LT(relative(b.inscatter->at(x, y) + b.transmittance->at(x, y) * b.surface->at(x, y), b.radiance.at(x, y)), 1e-6);
       }
   }
+}
+
+// The network on a particle cloud over a floor: the composite is the image, and a depth buffer in
+// place of a black floor gives that floor's layers.
+TEST(Layers, NetworkCompositeAndDepth) {
+  particles::register_methods();
+  const Scene scene = particle_scene(false), black = particle_scene(true);
+  Scene open = black;
+  open.surfaces.clear();
+  const Camera& camera = scene.camera;
+  const RenderResult plain = render(scene, "network"), layered = render(scene, "network", {}, View{camera, {}, true});
+  EXPECT_EQ(layered.radiance.data(), plain.radiance.data());
+  std::vector<float> depth;
+  for (int y = 0; y < camera.height_px; ++y)
+    for (int x = 0; x < camera.width_px; ++x) {
+      const Rgb l = layered.inscatter->at(x, y), t = layered.transmittance->at(x, y), c = layered.surface->at(x, y);
+      ASSERT_LT(relative(l + t * c, plain.radiance.at(x, y)), 1e-6) << x << ", " << y;
+      double t_hit;
+      Vec3 n;
+      const bool hit = nearest_surface(black.surfaces, camera.pixel_ray(x, y), kInfinity, t_hit, n);
+      depth.push_back(hit ? static_cast<float>(t_hit) : std::numeric_limits<float>::infinity());
+    }
+  ASSERT_GT(std::count_if(depth.begin(), depth.end(), [](float d) { return std::isfinite(d); }), 20);
+  const RenderResult a = render(black, "network", {}, View{camera, {}, true}), b = render(open, "network", {}, View{camera, depth, true});
+  const double floor = 0.01 * a.inscatter->mean().r;
+  for (int y = 0; y < camera.height_px; ++y)
+    for (int x = 0; x < camera.width_px; ++x) {
+      EXPECT_LT(relative(b.inscatter->at(x, y), a.inscatter->at(x, y), floor), 1e-5) << x << ", " << y;
+      EXPECT_LT(relative(b.transmittance->at(x, y), a.transmittance->at(x, y)), 1e-5) << x << ", " << y;
+      EXPECT_EQ(b.surface->at(x, y), std::isinf(depth[static_cast<size_t>(y * camera.width_px + x)]) ? a.surface->at(x, y) : Rgb(0.0));
+    }
+}
+
+// A host's matrices for the scene's own pinhole camera render its image, with every method that
+// takes views (a solution prepared once, rendered from both).
+TEST(Layers, HostMatricesRenderAsTheCameraTheyDescribe) {
+  grids::register_methods();
+  particles::register_methods();
+  for (const std::string method : {"analytic", "quadrature", "propagation", "dom", "network"}) {
+    const Scene scene = method == "network" ? particle_scene(false) : fog_scene(true, false, true);
+    const Camera& c = scene.camera;
+    const Camera host = Camera::from_matrices(glm::lookAt(c.position, c.look_at, c.up),
+                                              glm::perspective(glm::radians(c.fov_y_deg), double(c.width_px) / c.height_px, 0.1, 100.0),
+                                              c.width_px, c.height_px);
+    const Solution solution = prepare(scene, method, quick(method));
+    const Image own = solution.render(View{c}).radiance, matrices = solution.render(View{host}).radiance;
+    for (int y = 0; y < c.height_px; ++y)
+      for (int x = 0; x < c.width_px; ++x) ASSERT_LT(relative(matrices.at(x, y), own.at(x, y), 1e-3 * own.mean().r), 1e-4) << method << " at " << x << ", " << y << ": " << matrices.at(x, y).r << " " << own.at(x, y).r;
+  }
+}
+
+// Method auto renders the layers of the method it chose.
+TEST(Layers, AutoPassesTheChosenMethodsLayers) {
+  grids::register_methods();
+  Scene scene = fog_scene(true, false, true);
+  scene.method = {{"name", "auto"}, {"tolerance", 0.1}};
+  const AutoChoice choice = choose_method(scene, 0.1);
+  ASSERT_NE(std::find(std::begin(kLayered), std::end(kLayered), choice.method), std::end(kLayered)) << choice.method;
+  const RenderResult plain = render(scene, "auto"), layered = render(scene, "auto", {}, View{scene.camera, {}, true});
+  ASSERT_TRUE(layered.inscatter.has_value());
+  for (int y = 0; y < scene.camera.height_px; ++y)
+    for (int x = 0; x < scene.camera.width_px; ++x)
+      ASSERT_LT(relative(layered.inscatter->at(x, y) + layered.transmittance->at(x, y) * layered.surface->at(x, y), plain.radiance.at(x, y)), 1e-6);
 }
 
 TEST(Layers, BadViewsAreClearErrors) {

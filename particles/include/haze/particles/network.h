@@ -145,6 +145,10 @@ NetworkSolution update_network(NetworkSolution previous, const ParticleField& fi
 // with the exact phase function; then the background (plus any sky) through what is left.
 // Surfaces are not drawn.
 Image render_network(const Scene& scene, const ParticleField& field, const NetworkSolution& solution, const RenderOptions& options = {});
+// The same for `view`: its camera (one eye: per-pixel rays are refused), its depth ending the
+// rays, and with view.layers L_in, T and C per pixel.
+RenderResult render_network(const Scene& scene, const ParticleField& field, const NetworkSolution& solution, const RenderOptions& options,
+                            const View& view);
 
 // Method "network": its settings, what it handles and its auto rule.
 MethodInfo network_info();
