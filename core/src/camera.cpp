@@ -8,16 +8,25 @@
 
 namespace haze {
 
-Camera Camera::from_matrices(const glm::dmat4& view, const glm::dmat4& projection, int width_px, int height_px) {
+namespace {
+
+void check_size(int width_px, int height_px) {
   if (width_px < 1 || height_px < 1)
     throw Error("camera.width_px", to_text(width_px) + " x " + to_text(height_px), "an image size of at least 1 x 1");
+}
+
+}  // namespace
+
+Camera Camera::from_matrices(const glm::dmat4& view, const glm::dmat4& projection, int width_px, int height_px) {
+  check_size(width_px, height_px);
   auto finite = [](const glm::dmat4& m) {
     for (int c = 0; c < 4; ++c)
       for (int r = 0; r < 4; ++r)
         if (!std::isfinite(m[c][r])) return false;
     return true;
   };
-  if (!finite(view) || std::abs(glm::determinant(view)) < 1e-300) throw Error("camera.view", "a matrix that cannot be inverted", "an invertible world-to-eye matrix");
+  if (!finite(view) || std::abs(glm::determinant(view)) < 1e-300)
+    throw Error("camera.view", "a matrix that cannot be inverted", "an invertible world-to-eye matrix");
   if (!finite(projection) || std::abs(glm::determinant(projection)) < 1e-300)
     throw Error("camera.projection", "a matrix that cannot be inverted", "an invertible eye-to-clip matrix (glm::perspective, glm::ortho)");
   Camera c;
@@ -30,8 +39,7 @@ Camera Camera::from_matrices(const glm::dmat4& view, const glm::dmat4& projectio
 }
 
 Camera Camera::from_rays(std::shared_ptr<const std::vector<Ray>> rays, int width_px, int height_px) {
-  if (width_px < 1 || height_px < 1)
-    throw Error("camera.width_px", to_text(width_px) + " x " + to_text(height_px), "an image size of at least 1 x 1");
+  check_size(width_px, height_px);
   const size_t count = static_cast<size_t>(width_px) * static_cast<size_t>(height_px);
   if (!rays || rays->size() != count)
     throw Error("camera.rays", to_text(rays ? rays->size() : 0) + " rays", to_text(count) + " (width_px x height_px), one per pixel");

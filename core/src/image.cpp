@@ -63,8 +63,9 @@ std::vector<float> read_channel(Imf::InputFile& file, const char* channel, int& 
 }  // namespace
 
 void write_exr(const std::filesystem::path& path, const Image& image, const Image* std_error) {
-  write_exr(path, image, std_error ? std::vector<std::pair<std::string, const Image*>>{{"stderr", std_error}}
-                                   : std::vector<std::pair<std::string, const Image*>>{});
+  std::vector<std::pair<std::string, const Image*>> layers;
+  if (std_error) layers.emplace_back("stderr", std_error);
+  write_exr(path, image, layers);
 }
 
 void write_exr(const std::filesystem::path& path, const Image& image, const std::vector<std::pair<std::string, const Image*>>& layers) {
@@ -115,7 +116,8 @@ std::vector<float> read_exr_depth(const std::filesystem::path& path, int& width,
   try {
     Imf::InputFile file(path.string().c_str());
     const char* channel = file.header().channels().findChannel("Z") ? "Z" : file.header().channels().findChannel("depth") ? "depth" : nullptr;
-    if (!channel) throw Error("depth " + path.string(), "no channel Z or depth", "an EXR with a float channel Z (or depth): distances along each pixel's ray");
+    if (!channel)
+      throw Error("depth " + path.string(), "no channel Z or depth", "an EXR with a float channel Z (or depth): distances along each pixel's ray");
     return read_channel(file, channel, width, height);
   } catch (const Error&) {
     throw;

@@ -464,6 +464,9 @@ void VolumeDisplay::update_depths(const std::vector<DenseGrid>& depths, std::spa
 void VolumeDisplay::draw(const Camera& camera) { impl_->draw(camera); }
 
 Image VolumeDisplay::render(const Camera& camera) {
+  if (camera.type != Camera::Type::pinhole && camera.type != Camera::Type::orthographic)
+    throw Error("camera.type", camera.type == Camera::Type::matrices ? "matrices" : "rays",
+                "pinhole or orthographic for the GL display (a host's matrices and rays render through the CPU methods)");
   Impl& d = *impl_;
   d.draw(camera);
   const int w = camera.width_px, h = camera.height_px;
