@@ -54,7 +54,7 @@ struct SurfaceShading {
     // In the medium on the side the normal faces (toward the viewer): a floor on the medium's
     // bottom face has it above, where the point itself sits on the boundary, in or out of the
     // box by rounding (pixels of one floor came out 43% apart).
-    if (!surface_airlight || !medium.bounds().contains(p + 1e-9 * (1.0 + glm::length(p)) * normal)) return radiance;
+    if (!surface_airlight || !medium.bounds().contains(off_surface(p, normal))) return radiance;
     const Vec3 mirrored = glm::reflect(view_dir, normal);
     const double cos_r = std::max(0.0, glm::dot(normal, mirrored));
     for (const auto& light : lights) {

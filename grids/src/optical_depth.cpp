@@ -376,8 +376,7 @@ Rgb surface_direct(const std::vector<Light>& lights, const std::vector<Surface>&
     // The depth volume only strictly inside the grid, the exact walk on its faces: a floor on the
     // grid's bottom face was in or out by rounding (and in, read at the face; out, as 0 when the
     // volume's own bounds refused it), pixel by pixel, up to 2x apart.
-    const Vec3 off = 1e-9 * (1.0 + glm::length(p)) * n;
-    const bool inside = density.bounds().contains(p - off) && density.bounds().contains(p + off);
+    const bool inside = density.bounds().contains(off_surface(p, -n)) && density.bounds().contains(off_surface(p, n));
     const double depth = inside ? static_cast<double>(sample_trilinear(depths[l], p)) : density_integral_dda(density, p, p + a.to_light * reach);
     sum += surface.brdf(a.to_light, wo, n) * a.irradiance * cos_i * glm::exp(-sigma_t * depth);
   }

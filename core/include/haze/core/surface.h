@@ -41,6 +41,9 @@ const Surface* nearest_surface(const std::vector<Surface>& surfaces, const Ray& 
 // Whether a surface blocks the segment from x along the unit dir over distance (infinite for the
 // sun and the sky), short of its end by 1e-9 of it: a light on a surface is not hidden by it.
 bool occluded(const std::vector<Surface>& surfaces, const Vec3& x, const Vec3& dir, double distance);
+// Surface point p stepped off along `normal` by 1e-9 of its size: enough to leave a face of the
+// medium's box the surface lies on, which rounding alone puts in or out point by point.
+inline Vec3 off_surface(const Vec3& p, const Vec3& normal) { return p + 1e-9 * (1.0 + glm::length(p)) * normal; }
 
 // The stretches [a, b] of ray.at(t), t in [t0, t1] (t1 may be infinite), from which a light at
 // `light` is not hidden by a surface, in order; appended to `out`. Exact for planes and spheres:
