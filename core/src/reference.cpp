@@ -161,13 +161,21 @@ struct Tracer {
     return sum;
   }
 
-  Rgb trace(Ray ray, Rng& rng, long long& events) const {
+  // One path's radiance along the camera ray, which ends at t_end (a host's depth) if nothing
+  // nearer does. With `surface_part`, also the share of it whose first event is the ray's end (a
+  // surface or the background): T C of the layers; the rest is L_in.
+  Rgb trace(Ray ray, Rng& rng, long long& events, double t_end = kInfinity, Rgb* surface_part = nullptr) const {
     Rgb L(0.0), beta(1.0);
+    Rgb inscatter(-1.0);  // once the first event is the ray's end: L up to then
+    auto done = [&] {
+      if (surface_part) *surface_part = inscatter.r < 0.0 ? Rgb(0.0) : L - inscatter;
+      return L;
+    };
     int volume_events = 0, bounces = 0;  // medium scattering events and surface reflections so far
     for (int depth = 0;; ++depth) {
       Vec3 normal;
       double t_surface;
-      const Surface* surface = nearest_surface(scene.surfaces, ray, kInfinity, t_surface, normal);
+      const Surface* surface = nearest_surface(scene.surfaces, ray, depth == 0 ? t_end : kInfinity, t_surface, normal);
 
       // Spectral delta tracking (Kutz et al. 2017, history-aware): tentative collisions at rate
       // sigma_bar = density majorant times the largest channel; scatter, null or absorb with
@@ -206,67 +214,72 @@ struct Tracer {
               beta *= sigma_n / (sigma_bar * p_n);
               continue;
             }
-            return L;  // absorbed
+            return done();  // absorbed
           }
         }
       }
 
+      if (depth == 0 && !scattered) inscatter = L;
       if (!scattered && !surface) {
-        if (depth == 0) L += beta * (scene.background + sky);
-        return L;
+        if (depth == 0 && !std::isfinite(t_end)) L += beta * (scene.background + sky);
+        return done();
       }
       // A real event: paths with more medium scatterings or surface reflections than allowed end
       // here; their light is not part of the requested orders.
       if (scattered) {
-        if (max_scattering >= 0 && volume_events + 1 > max_scattering) return L;
+        if (max_scattering >= 0 && volume_events + 1 > max_scattering) return done();
         ++volume_events, ++events;
         L += beta * volume_nee(x, ray.direction, rng);
-        if (volume_events == max_scattering && bounces == max_bounces) return L;
+        if (volume_events == max_scattering && bounces == max_bounces) return done();
         ray = {x, medium->phase().sample(ray.direction, rng).wo};
       } else {
-        if (max_bounces >= 0 && bounces + 1 > max_bounces) return L;
+        if (max_bounces >= 0 && bounces + 1 > max_bounces) return done();
         ++bounces;
         Vec3 p = ray.at(t_surface) + normal * kEpsilon, wo = -ray.direction;
         L += beta * surface_nee(*surface, p, normal, wo, rng);
-        if (volume_events == max_scattering && bounces == max_bounces) return L;
+        if (volume_events == max_scattering && bounces == max_bounces) return done();
         Vec3 w = sample_cosine(normal, rng);
         beta *= kPi * surface->brdf(w, wo, normal);
         ray = {p, w};
       }
       if (depth + 1 >= kRouletteDepth) {
         double q = std::min(0.95, max3(beta));
-        if (!(q > 0.0) || rng.uniform() >= q) return L;
+        if (!(q > 0.0) || rng.uniform() >= q) return done();
         beta /= q;
       }
     }
   }
 };
 
-// Per pixel: the sum and the sum of squares of its samples.
-using Sums = std::vector<std::array<Rgb, 2>>;
+// Per pixel: the sum and the sum of squares of its samples, and the sum of their surface parts
+// (Tracer::trace) when the view asks for layers.
+using Sums = std::vector<std::array<Rgb, 3>>;
 
 // Adds `spp` samples per pixel drawn with `seed` to `sums`; returns the scattering events. Work
 // items (pixel, block of kSamplesPerBlock) are reduced in block order, so the sums do not depend
 // on the thread count.
-long long accumulate(const Tracer& tracer, const Camera& camera, long long spp, std::uint64_t seed, int threads,
+long long accumulate(const Tracer& tracer, const View& view, long long spp, std::uint64_t seed, int threads,
                      const ProgressCallback& callback, Sums& sums) {
   const long long pixels = static_cast<long long>(sums.size());
   const long long blocks = (spp + kSamplesPerBlock - 1) / kSamplesPerBlock;
-  std::vector<std::array<Rgb, 2>> partial(static_cast<size_t>(pixels * blocks));
+  const Camera& camera = view.camera;
+  Sums partial(static_cast<size_t>(pixels * blocks));
   std::vector<long long> events(static_cast<size_t>(pixels * blocks), 0);
   ProgressTracker progress(callback, pixels * blocks);
   parallel_for(pixels * blocks, threads, 1, [&](long long begin, long long end) {
     for (long long item = begin; item < end && !progress.cancelled(); ++item) {
       long long pixel = item / blocks, block = item % blocks;
       Rng rng(seed, static_cast<std::uint64_t>(item));
-      Ray ray = camera.pixel_ray(static_cast<int>(pixel % camera.width_px), static_cast<int>(pixel / camera.width_px));
-      Rgb sum(0.0), sum2(0.0);
+      const int x = static_cast<int>(pixel % camera.width_px), y = static_cast<int>(pixel / camera.width_px);
+      const Ray ray = camera.pixel_ray(x, y);
+      Rgb sum(0.0), sum2(0.0), surface_sum(0.0), surface_part;
       long long count = std::min(kSamplesPerBlock, spp - block * kSamplesPerBlock);
       for (long long s = 0; s < count; ++s) {
-        Rgb v = tracer.trace(ray, rng, events[static_cast<size_t>(item)]);
+        Rgb v = tracer.trace(ray, rng, events[static_cast<size_t>(item)], view.max_distance(x, y), view.layers ? &surface_part : nullptr);
         sum += v, sum2 += v * v;
+        if (view.layers) surface_sum += surface_part;
       }
-      partial[static_cast<size_t>(item)] = {sum, sum2};
+      partial[static_cast<size_t>(item)] = {sum, sum2, surface_sum};
       progress.advance();
     }
   });
@@ -275,14 +288,16 @@ long long accumulate(const Tracer& tracer, const Camera& camera, long long spp, 
   for (long long pixel = 0; pixel < pixels; ++pixel)
     for (long long b = 0; b < blocks; ++b) {
       const auto& p = partial[static_cast<size_t>(pixel * blocks + b)];
-      sums[static_cast<size_t>(pixel)][0] += p[0], sums[static_cast<size_t>(pixel)][1] += p[1];
+      for (int k = 0; k < 3; ++k) sums[static_cast<size_t>(pixel)][k] += p[k];
       total_events += events[static_cast<size_t>(pixel * blocks + b)];
     }
   return total_events;
 }
 
-// The mean of n samples per pixel and its standard error, sqrt(sample variance / n).
-void finish(const Sums& sums, long long spp, RenderResult& result) {
+// The mean of n samples per pixel and its standard error, sqrt(sample variance / n); with layers,
+// L_in and C from the mean surface part S and the exact transmittance T to the ray's end: C = S / T
+// (0 where T is), L_in = mean - S, so that L_in + T C is the image.
+void finish(const Sums& sums, long long spp, const std::vector<Rgb>& ends, RenderResult& result) {
   const int width = result.radiance.width();
   const double n = static_cast<double>(spp);
   for (size_t pixel = 0; pixel < sums.size(); ++pixel) {
@@ -291,6 +306,11 @@ void finish(const Sums& sums, long long spp, RenderResult& result) {
     const int px = static_cast<int>(pixel) % width, py = static_cast<int>(pixel) / width;
     result.radiance.set(px, py, mean);
     result.std_error->set(px, py, glm::sqrt(variance / n));
+    if (!result.inscatter) continue;
+    const Rgb S = sums[pixel][2] / n, T = ends[pixel];
+    Rgb C(0.0);
+    for (int k = 0; k < 3; ++k) C[k] = T[k] > 0.0 ? S[k] / T[k] : 0.0;
+    result.inscatter->set(px, py, mean - S), result.transmittance->set(px, py, T), result.surface->set(px, py, C);
   }
 }
 
@@ -330,8 +350,23 @@ class ReferenceSolution final : public MethodSolution {
     const Stopwatch watch;
     const ReferenceSettings& s = settings_;
     const Camera& camera = view.camera;
-    RenderResult result{Image(camera.width_px, camera.height_px), Image(camera.width_px, camera.height_px), {}};
-    Sums sums(static_cast<size_t>(camera.width_px) * camera.height_px, {Rgb(0.0), Rgb(0.0)});
+    RenderResult result = RenderResult::for_view(view);
+    result.std_error = Image(camera.width_px, camera.height_px);
+    std::vector<Rgb> ends;  // with layers: each pixel ray's transmittance to its end
+    if (view.layers) {
+      ends.assign(static_cast<size_t>(camera.width_px) * camera.height_px, Rgb(1.0));
+      parallel_for(static_cast<long long>(ends.size()), options.threads, 64, [&](long long begin, long long end) {
+        for (long long pixel = begin; pixel < end; ++pixel) {
+          const int x = static_cast<int>(pixel % camera.width_px), y = static_cast<int>(pixel / camera.width_px);
+          const Ray ray = camera.pixel_ray(x, y);
+          double t;
+          Vec3 n;
+          nearest_surface(scene_.surfaces, ray, view.max_distance(x, y), t, n);
+          if (medium_) ends[static_cast<size_t>(pixel)] = medium_->transmittance_along(ray.origin, ray.direction, t);
+        }
+      });
+    }
+    Sums sums(static_cast<size_t>(camera.width_px) * camera.height_px, {Rgb(0.0), Rgb(0.0), Rgb(0.0)});
     long long done = 0, planned = s.target_noise > 0.0 ? std::min(s.spp, kFirstRound) : s.spp, total_events = 0;
     double noise = 0.0;
     for (int round = 0;; ++round) {
@@ -340,9 +375,9 @@ class ReferenceSolution final : public MethodSolution {
       ProgressCallback callback;
       if (options.progress)
         callback = [&, from = done, to = planned](double f) { return options.progress((from + f * (to - from)) / to); };
-      total_events += accumulate(tracer_, camera, planned - done, round_seed, options.threads, callback, sums);
+      total_events += accumulate(tracer_, view, planned - done, round_seed, options.threads, callback, sums);
       done = planned;
-      finish(sums, done, result);
+      finish(sums, done, ends, result);
       if (!(s.target_noise > 0.0)) break;
       noise = lit_pixel_error(result.radiance, result.radiance, &*result.std_error).noise_rms;
       if (noise <= s.target_noise || done >= s.spp) break;
@@ -364,6 +399,7 @@ class ReferenceSolution final : public MethodSolution {
     if (s.target_noise > 0.0) result.stats["target_noise"] = {{"target", s.target_noise}, {"noise", noise}, {"met", noise <= s.target_noise}};
     return result;
   }
+  bool renders_layers() const override { return true; }
 
  private:
   const Scene scene_;

@@ -139,8 +139,7 @@ RenderResult Solution::render(const View& view, const RenderOptions& options) co
   check_depth(view);
   if ((view.layers || !view.depth.empty()) && !s.solution->renders_layers())
     throw Error("view", view.layers ? "layers" : "a depth buffer",
-                "a method that renders layers and takes a depth buffer: analytic, quadrature, propagation, dom or network (the "
-                "reference is to come, tracker issue 24)");
+                "a method that renders layers and takes a depth buffer (every built-in method does; " + s.info.name + " does not)");
   if (!options.settings.is_null() && (!options.settings.is_object() || !options.settings.empty()))
     throw Error("settings", options.settings.dump(), "none when rendering a solution (settings are given to haze::prepare)");
   if (s.options.single_view && !(view.camera == s.scene.camera))

@@ -97,5 +97,22 @@ TEST(ToyMethod, RegistrySettingsHelpAndAutoSeeIt) {
   EXPECT_NE(choose_method(fog(), 0.05).method, "toy");
 }
 
+// A method that does not render a host's layers (MethodSolution::renders_layers) is refused a view
+// that asks for them, or for a depth buffer, rather than ignoring it.
+TEST(ToyMethod, ViewsItCannotRenderAreRefused) {
+  register_method(toy_info());
+  const Scene scene = fog();
+  const std::vector<float> depth(16, 1.0f);
+  for (const View& view : {View{scene.camera, {}, true}, View{scene.camera, depth, false}}) {
+    try {
+      render(scene, "toy", {}, view);
+      FAIL();
+    } catch (const Error& e) {
+      EXPECT_EQ(e.field(), "view");
+    }
+  }
+  EXPECT_FLOAT_EQ(render(scene, "toy", {}, View{scene.camera}).radiance.at(0, 0).r, 0.25f);
+}
+
 }  // namespace
 }  // namespace haze
