@@ -13,9 +13,10 @@ HWY_BEFORE_NAMESPACE();
 namespace haze::simd::HWY_NAMESPACE {
 namespace hn = hwy::HWY_NAMESPACE;
 
-// K(u, eta) from the table T = K (1 + w)(1 + a) / 2 (airlight.h), bilinear.
+// log T(u, eta) for T = K (1 + w)(1 + a) / 2, bilinear in the fine log table
+// (AirlightTable::log_fine_values); `scale` = 2 / ((1 + w)(1 + a)), so that K = scale e^(log T).
 template <class D, class V>
-HWY_INLINE V Tail(D d, const float* HWY_RESTRICT table, int na, int ne, float eta_max, V u, V eta, V w) {
+HWY_INLINE V LogTail(D d, const float* HWY_RESTRICT table, int na, int ne, float eta_max, V u, V eta, V w, V& scale) {
   const hn::RebindToSigned<D> di;
   const V one = hn::Set(d, 1.0f);
   V a = hn::Min(hn::Mul(u, hn::Add(one, w)), hn::Set(d, 1e30f));
@@ -30,8 +31,8 @@ HWY_INLINE V Tail(D d, const float* HWY_RESTRICT table, int na, int ne, float et
   V t00 = hn::GatherIndex(d, table, index), t10 = hn::GatherIndex(d, table + 1, index);
   V t01 = hn::GatherIndex(d, table + na, index), t11 = hn::GatherIndex(d, table + na + 1, index);
   V t0 = hn::MulAdd(x, hn::Sub(t10, t00), t00), t1 = hn::MulAdd(x, hn::Sub(t11, t01), t01);
-  V t = hn::MulAdd(y, hn::Sub(t1, t0), t0);
-  return hn::Div(hn::Add(t, t), hn::Mul(hn::Add(one, w), hn::Add(one, a)));
+  scale = hn::Div(hn::Set(d, 2.0f), hn::Mul(hn::Add(one, w), hn::Add(one, a)));
+  return hn::MulAdd(y, hn::Sub(t1, t0), t0);
 }
 
 // Processes whole vectors of segments; returns how many. result[i] is the airlight, fallback[i] is
@@ -60,14 +61,17 @@ HWY_NOINLINE size_t AirlightBatch(const float* HWY_RESTRICT table, int na, int n
     V u = hn::Mul(sigma_t, h);
     // w = (xi + r) / h without cancellation (xi = -t at the start).
     V w0 = hn::IfThenElse(hn::Le(t, zero), hn::Div(hn::Sub(d_sv, t), h), hn::Div(h, hn::Add(d_sv, t)));
-    V near = hn::Mul(hn::Exp(d, hn::Neg(hn::Mul(sigma_t, d_sv))), Tail(d, table, na, ne, eta_max, u, hn::Log(d, w0), w0));
+    V scale_near, scale_far;
+    V log_near = LogTail(d, table, na, ne, eta_max, u, hn::Log(d, w0), w0, scale_near);
+    V near = hn::Mul(hn::Exp(d, hn::NegMulAdd(sigma_t, d_sv, log_near)), scale_near);
     V len = hn::LoadU(d, length + i);
     auto finite = hn::Lt(len, hn::Set(d, 3e38f));
     V len_f = hn::IfThenElseZero(finite, len);
     V xi = hn::Sub(len_f, t);
     V d_sp = hn::Sqrt(hn::MulAdd(xi, xi, h2));
     V wd = hn::IfThenElse(hn::Ge(xi, zero), hn::Div(hn::Add(xi, d_sp), h), hn::Div(h, hn::Sub(d_sp, xi)));
-    V far = hn::Mul(hn::Exp(d, hn::Neg(hn::Mul(sigma_t, hn::Add(len_f, d_sp)))), Tail(d, table, na, ne, eta_max, u, hn::Log(d, wd), wd));
+    V log_far = LogTail(d, table, na, ne, eta_max, u, hn::Log(d, wd), wd, scale_far);
+    V far = hn::Mul(hn::Exp(d, hn::NegMulAdd(sigma_t, hn::Add(len_f, d_sp), log_far)), scale_far);
     far = hn::IfThenElseZero(finite, far);
     hn::StoreU(hn::Div(hn::Mul(scale, hn::Sub(near, far)), h), d, result + i);
     auto redo = hn::Or(hn::Ge(far, hn::Mul(half, near)), hn::Lt(h, hn::Mul(hn::Set(d, 1e-3f), d_sv)));

@@ -20,8 +20,9 @@ HWY_EXPORT(AirlightBatch);
 
 namespace {
 
-float tail_scalar(const AirlightTable& table, float u, float eta, float w) {
-  const int na = table.a_samples(), ne = table.eta_samples();
+// log T and scale = 2 / ((1 + w)(1 + a)), the kernel's LogTail.
+float log_tail_scalar(const AirlightTable& table, float u, float eta, float w, float& scale) {
+  const int na = table.a_samples(), ne = table.fine_eta_samples();
   const float eta_max = static_cast<float>(AirlightTable::kEtaMax);
   float a = std::min(u * (1.0f + w), 1e30f);
   float m = std::sqrt(a / (1.0f + a));
@@ -29,9 +30,10 @@ float tail_scalar(const AirlightTable& table, float u, float eta, float w) {
   float fe = (std::clamp(eta, -eta_max, eta_max) + eta_max) * (static_cast<float>(ne - 1) / (2.0f * eta_max));
   float fi = std::min(std::floor(fa), static_cast<float>(na - 2)), fj = std::min(std::floor(fe), static_cast<float>(ne - 2));
   float x = fa - fi, y = fe - fj;
-  const float* t = table.values().data() + static_cast<size_t>(fj * static_cast<float>(na) + fi);
+  const float* t = table.log_fine_values().data() + static_cast<size_t>(fj * static_cast<float>(na) + fi);
   float t0 = t[0] + x * (t[1] - t[0]), t1 = t[na] + x * (t[na + 1] - t[na]);
-  return 2.0f * (t0 + y * (t1 - t0)) / ((1.0f + w) * (1.0f + a));
+  scale = 2.0f / ((1.0f + w) * (1.0f + a));
+  return t0 + y * (t1 - t0);
 }
 
 // One segment in float32, the formulas of the SIMD kernel; false where float64 must redo it.
@@ -43,12 +45,13 @@ bool airlight_scalar(const AirlightTable& table, const AirlightChannel& l, const
   float h2 = std::max(d2 - t * t, floor_h * floor_h), h = std::sqrt(h2);
   float u = l.sigma_t * h;
   float w0 = t <= 0.0f ? (d_sv - t) / h : h / (d_sv + t);
-  float near = std::exp(-l.sigma_t * d_sv) * tail_scalar(table, u, std::log(w0), w0);
+  float scale_near, scale_far;
+  float near = std::exp(log_tail_scalar(table, u, std::log(w0), w0, scale_near) - l.sigma_t * d_sv) * scale_near;
   float far = 0.0f;
   if (b.length[i] < 3e38f) {
     float xi = b.length[i] - t, d_sp = std::sqrt(xi * xi + h2);
     float wd = xi >= 0.0f ? (xi + d_sp) / h : h / (d_sp - xi);
-    far = std::exp(-l.sigma_t * (b.length[i] + d_sp)) * tail_scalar(table, u, std::log(wd), wd);
+    far = std::exp(log_tail_scalar(table, u, std::log(wd), wd, scale_far) - l.sigma_t * (b.length[i] + d_sp)) * scale_far;
   }
   value = l.sigma_s * l.intensity * (near - far) / h;
   return !(far >= 0.5f * near || h < 1e-3f * d_sv);
@@ -73,7 +76,7 @@ void add_airlight_reference(const AirlightTable& table, const AirlightChannel& l
 void add_airlight(const AirlightTable& table, const AirlightChannel& light, const SegmentBatch& batch, float* out) {
   std::vector<float> result(batch.count), fallback(batch.count);
   const float params[6] = {light.x, light.y, light.z, light.sigma_t, light.sigma_s, light.intensity};
-  size_t done = HWY_DYNAMIC_DISPATCH(AirlightBatch)(table.values().data(), table.a_samples(), table.eta_samples(),
+  size_t done = HWY_DYNAMIC_DISPATCH(AirlightBatch)(table.log_fine_values().data(), table.a_samples(), table.fine_eta_samples(),
                                                     static_cast<float>(AirlightTable::kEtaMax), params, batch.ox, batch.oy,
                                                     batch.oz, batch.dx, batch.dy, batch.dz, batch.length, batch.count,
                                                     result.data(), fallback.data());
