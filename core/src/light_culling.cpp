@@ -101,6 +101,10 @@ std::vector<CulledLight> culled_lights(const Scene& scene, bool single_scatterin
       }
       const bool lights_a_surface = std::any_of(scene.surfaces.begin(), scene.surfaces.end(), [&](const Surface& s) {
         if (const auto* ball = std::get_if<Sphere>(&s.shape)) return cone_meets_ball(spot->position, axis, theta, ball->center, ball->radius);
+        if (const auto* mesh = std::get_if<Mesh>(&s.shape)) {
+          const Aabb& box = mesh->triangles->bounds();
+          return cone_meets_ball(spot->position, axis, theta, 0.5 * (box.lo + box.hi), 0.5 * glm::length(box.extent()));
+        }
         const auto& plane = std::get<Plane>(s.shape);
         return cone_meets_plane(spot->position, axis, theta, plane.point, plane.normal);
       });

@@ -254,6 +254,20 @@ void check_grid_values(const GridDensity& grid, const std::string& path, const f
   }
 }
 
+// The existing file o.file names, relative to the scene's folder, as an absolute path (so that
+// messages say exactly where Haze looked).
+fs::path existing_file(const Object& o, const fs::path& base_dir, const char* expected) {
+  fs::path file = read_string(o.need("file", expected), o.at("file"), expected);
+  if (file.is_relative()) file = base_dir / file;
+  std::error_code ec;
+  if (fs::path absolute = fs::absolute(file, ec); !ec) file = absolute;
+  file = file.lexically_normal();
+  if (!fs::is_regular_file(file, ec))
+    throw Error(o.at("file"), text(o.need("file", expected)) + " (resolved to " + file.string() + ")",
+                "an existing file, but there is none at that path");
+  return file;
+}
+
 GridDensity read_grid(const Object& o, const fs::path& base_dir) {
   GridDensity grid;
   const std::string res_path = o.at("resolution");
@@ -270,16 +284,8 @@ GridDensity read_grid(const Object& o, const fs::path& base_dir) {
 
   const std::string file_path = o.at("file");
   const char* file_expected = "a float32 little-endian file name (relative to the scene file's folder)";
-  fs::path file = read_string(o.need("file", file_expected), file_path, file_expected);
-  if (file.is_relative()) file = base_dir / file;
+  const fs::path file = existing_file(o, base_dir, file_expected);
   std::error_code ec;
-  // Absolute, so that the messages below say exactly where Haze looked.
-  if (fs::path absolute = fs::absolute(file, ec); !ec) file = absolute;
-  file = file.lexically_normal();
-
-  if (!fs::is_regular_file(file, ec))
-    throw Error(file_path, text(o.need("file", file_expected)) + " (resolved to " + file.string() + ")",
-                "an existing file, but there is none at that path");
   const std::uint64_t expected_bytes = cells * 4;
   const std::uint64_t actual_bytes = fs::file_size(file, ec);
   if (ec) throw Error(file_path, file.string(), "a readable file (" + ec.message() + ")");
@@ -414,15 +420,54 @@ Light read_light(const Object& o) {
   return SkyLight{o.color("radiance", kNonNegative)};
 }
 
-Surface read_surface(const Object& o) {
-  std::string type = o.type({"plane", "sphere"});
+// A mesh's placement: {"translate": [x, y, z], "rotate_deg": [x, y, z], "scale": s or [x, y, z]}
+// (scale, then rotations about x, y and z, then translation), or {"matrix": 16 numbers, row-major,
+// the last row 0 0 0 1}.
+glm::dmat4 read_transform(const Object& o) {
+  if (const json* m = o.find("matrix")) {
+    o.allow({"matrix"});
+    const char* expected = "16 finite numbers, a 4 x 4 affine matrix row by row (last row 0, 0, 0, 1)";
+    if (!m->is_array() || m->size() != 16) throw Error(o.at("matrix"), text(*m), expected);
+    glm::dmat4 out(1.0);
+    for (int r = 0; r < 4; ++r)
+      for (int c = 0; c < 4; ++c) out[c][r] = read_number((*m)[static_cast<size_t>(4 * r + c)], index_path(o.at("matrix"), static_cast<size_t>(4 * r + c)), kFinite);
+    if (out[0][3] != 0.0 || out[1][3] != 0.0 || out[2][3] != 0.0 || out[3][3] != 1.0) throw Error(o.at("matrix"), text(*m), expected);
+    return out;
+  }
+  o.allow({"translate", "rotate_deg", "scale"});
+  Vec3 scale(1.0);
+  if (const json* v = o.find("scale")) {
+    const char* expected = "a number > 0, or an [x, y, z] array of such numbers";
+    scale = v->is_array() ? read_vec3(*v, o.at("scale")) : Vec3(read_number(*v, o.at("scale"), {[](double x) { return x > 0.0; }, expected}));
+    if (!(scale.x > 0.0 && scale.y > 0.0 && scale.z > 0.0)) throw Error(o.at("scale"), text(*v), expected);
+  }
+  return placement(o.vec3("translate", Vec3(0.0)), o.vec3("rotate_deg", Vec3(0.0)), scale);
+}
+
+Surface read_surface(const Object& o, const fs::path& base_dir) {
+  std::string type = o.type({"plane", "sphere", "mesh"});
   Surface s;
   if (type == "plane") {
     o.allow({"type", "point", "normal", "kd", "ks", "shininess"});
     s.shape = Plane{o.vec3("point"), o.direction("normal")};
-  } else {
+  } else if (type == "sphere") {
     o.allow({"type", "center", "radius", "kd", "ks", "shininess"});
     s.shape = Sphere{o.vec3("center"), o.number("radius", kPositive)};
+  } else {
+    o.allow({"type", "file", "transform", "kd", "ks", "shininess", "shaded"});
+    const fs::path file = existing_file(o, base_dir, "an OBJ file name (relative to the scene file's folder)");
+    glm::dmat4 transform(1.0);
+    if (const json* t = o.find("transform")) transform = read_transform(Object(*t, o.at("transform")));
+    s.shape = Mesh{TriangleMesh::load_obj(file, transform, o.at("file"))};
+    if (const json* shaded = o.find("shaded")) {
+      if (!shaded->is_boolean()) throw Error(o.at("shaded"), text(*shaded), "true or false");
+      if (!shaded->get<bool>()) {
+        // The host shades it: black to Haze (surface.h).
+        if (o.find("kd") || o.find("ks")) throw Error(o.at(o.find("kd") ? "kd" : "ks"), "given with \"shaded\": false", "no BRDF for a surface the host shades");
+        s.kd = s.ks = Rgb(0.0);
+        return s;
+      }
+    }
   }
   // kd and ks are reflectances (albedos): above 1 a surface would create energy.
   s.kd = o.color("kd", Rgb(0.5), kUnit);
@@ -480,7 +525,7 @@ Scene parse(const json& j, const fs::path& base_dir) {
     scene.medium = reader(*block, type, base_dir);
   }
   scene.lights = read_array<Light>(top, "lights", read_light);
-  scene.surfaces = read_array<Surface>(top, "surfaces", read_surface);
+  scene.surfaces = read_array<Surface>(top, "surfaces", [&](const Object& o) { return read_surface(o, base_dir); });
   scene.background = top.color("background", Rgb(0.0), kNonNegative);
   if (const json* m = top.find("method")) {
     Object method(*m, "method");

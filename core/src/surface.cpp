@@ -15,6 +15,7 @@ bool Surface::intersect(const Ray& ray, double t_min, double t_max, double& t, V
     normal = denom < 0.0 ? plane->normal : -plane->normal;
     return true;
   }
+  if (auto* mesh = std::get_if<Mesh>(&shape)) return mesh->triangles->intersect(ray, t_min, t_max, t, normal);
   const auto& sphere = std::get<Sphere>(shape);
   Vec3 oc = ray.origin - sphere.center;
   double b = glm::dot(oc, ray.direction);
@@ -53,9 +54,15 @@ const Surface* nearest_surface(const std::vector<Surface>& surfaces, const Ray& 
 }
 
 bool occluded(const std::vector<Surface>& surfaces, const Vec3& x, const Vec3& dir, double distance) {
-  double t;
-  Vec3 n;
-  return !surfaces.empty() && nearest_surface(surfaces, {x, dir}, distance * (1.0 - 1e-9), t, n) != nullptr;
+  const Ray ray{x, dir};
+  const double t_max = distance * (1.0 - 1e-9);
+  for (const auto& s : surfaces) {
+    double t;
+    Vec3 n;
+    const auto* mesh = std::get_if<Mesh>(&s.shape);
+    if (mesh ? mesh->triangles->occluded(ray, 1e-7, t_max) : s.intersect(ray, 1e-7, t_max, t, n)) return true;
+  }
+  return false;
 }
 
 namespace {
@@ -73,6 +80,30 @@ void roots(double a, double b, double c, std::vector<double>& out) {
   if (q != 0.0) out.push_back(c / q);
 }
 
+// Where `lit` changes along [t0, t1]: 64 points (u / (1 - u) past t0 for an infinite t1), each
+// change bisected to 1e-6 of the stretch between its two points.
+template <class Lit>
+void mesh_shadow_edges(double t0, double t1, const Lit& lit, std::vector<double>& cuts) {
+  constexpr int kPoints = 64;
+  const bool infinite = !std::isfinite(t1);
+  auto at = [&](double u) { return infinite ? t0 + (1.0 + std::abs(t0)) * u / (1.0 - u) : t0 + u * (t1 - t0); };
+  double u_prev = 0.5 / kPoints;
+  bool prev = lit(at(u_prev));
+  for (int k = 1; k < kPoints; ++k) {
+    const double u = (k + 0.5) / kPoints;
+    const bool now = lit(at(u));
+    if (now != prev) {
+      double lo = u_prev, hi = u;
+      while (hi - lo > 1e-6) {
+        const double mid = 0.5 * (lo + hi);
+        (lit(at(mid)) == prev ? lo : hi) = mid;
+      }
+      cuts.push_back(at(0.5 * (lo + hi)));
+    }
+    u_prev = u, prev = now;
+  }
+}
+
 }  // namespace
 
 void lit_stretches(const std::vector<Surface>& surfaces, const Ray& ray, double t0, double t1, const Vec3& light,
@@ -81,7 +112,17 @@ void lit_stretches(const std::vector<Surface>& surfaces, const Ray& ray, double 
   std::vector<double> cuts;
   const Vec3& o = ray.origin;
   const Vec3& d = ray.direction;
+  auto lit = [&](double t) {
+    const Vec3 x = ray.at(t), to = light - x;
+    const double length = glm::length(to);
+    return length > 0.0 && !occluded(surfaces, x, to / length, length);
+  };
+  bool meshes = false;
   for (const Surface& s : surfaces) {
+    if (std::holds_alternative<Mesh>(s.shape)) {
+      meshes = true;
+      continue;
+    }
     if (const auto* plane = std::get_if<Plane>(&s.shape)) {
       roots(0.0, glm::dot(d, plane->normal), glm::dot(o - plane->point, plane->normal), cuts);
       continue;
@@ -98,6 +139,7 @@ void lit_stretches(const std::vector<Surface>& surfaces, const Ray& ray, double 
     const double cos2 = 1.0 - r2 / dist2, dv = glm::dot(d, v), wv = glm::dot(w, v);
     roots(dv * dv - cos2 * glm::dot(d, d), 2.0 * (wv * dv - cos2 * glm::dot(w, d)), wv * wv - cos2 * glm::dot(w, w), cuts);
   }
+  if (meshes) mesh_shadow_edges(t0, t1, lit, cuts);
   cuts.push_back(t0), cuts.push_back(t1);
   std::sort(cuts.begin(), cuts.end());
   double start = t0;
@@ -106,11 +148,9 @@ void lit_stretches(const std::vector<Surface>& surfaces, const Ray& ray, double 
     const double a = std::max(cuts[i], t0), b = std::min(cuts[i + 1], t1);
     if (!(b > a)) continue;
     const double mid = std::isfinite(b) ? 0.5 * (a + b) : a + 1.0 + std::abs(a);
-    const Vec3 x = ray.at(mid), to = light - x;
-    const double length = glm::length(to);
-    const bool lit = length > 0.0 && !occluded(surfaces, x, to / length, length);
-    if (lit && !open) start = a, open = true;
-    if (!lit && open) out.emplace_back(start, a), open = false;
+    const bool is_lit = lit(mid);
+    if (is_lit && !open) start = a, open = true;
+    if (!is_lit && open) out.emplace_back(start, a), open = false;
   }
   if (open) out.emplace_back(start, t1);
 }

@@ -387,6 +387,10 @@ VolumeDisplay::VolumeDisplay(const Scene& scene, const grids::ExtinctionVolume& 
     throw Error("lights", std::to_string(d.scene.lights.size()) + " point, spot or directional lights", "at most 16 for the GL display");
   if (scene.surfaces.size() > static_cast<size_t>(kMaxSurfaces))
     throw Error("surfaces", std::to_string(scene.surfaces.size()), "at most 16 for the GL display");
+  for (size_t i = 0; i < scene.surfaces.size(); ++i)
+    if (std::holds_alternative<Mesh>(scene.surfaces[i].shape))
+      throw Error("surfaces[" + std::to_string(i) + "].type", "mesh",
+                  "a plane or a sphere: the GL display's ray march draws no triangles (a host rasterizes them: docs/HOST.md)");
   d.cells = volume.density.resolution();
   d.bounds = volume.density.bounds();
   d.sigma_t = volume.sigma_t_scale, d.albedo = volume.albedo, d.phase = volume.phase;

@@ -161,7 +161,7 @@ std::vector<PixelLayers> gather_scattered(const Scene& delta, const ExtinctionVo
         if (surface) {
           const Vec3 wo = -ray.direction;
           if (solution.texel_surfaces && light)
-            p.surface = (surface->kd + surface->ks) / kPi * light->irradiance(*surface, ray.at(t_hit));
+            p.surface = (surface->kd + surface->ks) / kPi * light->irradiance(*surface, ray.at(t_hit), normal);
           else
             p.surface = gather.around(ray.at(t_hit), normal, sky, [&](const Vec3&) { return surface->kd / kPi; }) +
                         gather.glossy(ray.at(t_hit), normal, wo, *surface, sky);

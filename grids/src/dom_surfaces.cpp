@@ -28,13 +28,78 @@ Rgb SurfaceTexels::Globe::lookup(const Vec3& p) const {
   return (1.0 - a) * ((1.0 - b) * at(t, p0) + b * at(t, p1)) + a * ((1.0 - b) * at(t + 1, p0) + b * at(t + 1, p1));
 }
 
+std::int64_t SurfaceTexels::Patches::cell_key(const Vec3& p) const {
+  const Vec3 c = glm::floor(p / size);
+  constexpr std::int64_t k = 1 << 20;  // 2^20 cells a side, wrapping
+  auto wrap = [&](double v) { return ((static_cast<std::int64_t>(v) % k) + k) % k; };
+  return (wrap(c.x) * k + wrap(c.y)) * k + wrap(c.z);
+}
+
+void SurfaceTexels::Patches::index() {
+  cells.clear();
+  for (size_t i = 0; i < points.size(); ++i) cells[cell_key(points[i])].push_back(static_cast<std::uint32_t>(i));
+}
+
+bool SurfaceTexels::Patches::lookup(const Vec3& p, const Vec3& n, Rgb& e) const {
+  Rgb sum(0.0);
+  double weights = 0.0;
+  const double reach = 1.5 * size;
+  for (int dz = -1; dz <= 1; ++dz)
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dx = -1; dx <= 1; ++dx) {
+        const auto it = cells.find(cell_key(p + size * Vec3(dx, dy, dz)));
+        if (it == cells.end()) continue;
+        for (const std::uint32_t i : it->second) {
+          const double facing = glm::dot(normals[i], n);
+          if (std::abs(facing) < 0.9 || std::abs(glm::dot(p - points[i], normals[i])) > 0.25 * size) continue;  // another face
+          const double d = glm::length(p - points[i]);
+          if (d >= reach) continue;
+          const double w = 1.0 - d / reach;
+          sum += w * (facing > 0.0 ? front[i] : back[i]), weights += w;
+        }
+      }
+  if (!(weights > 0.0)) return false;
+  e = sum / weights;
+  return true;
+}
+
 }  // namespace haze::grids
 
 namespace haze::grids::dom {
 
 namespace {
 constexpr int kMostTexels = 48;
+constexpr size_t kMostMeshTexels = 4096;
+
+// Texels on a mesh's triangles, each cut into k^2 similar ones (k from the longest edge over
+// `size`), one texel at each small triangle's centroid; `size` grows until at most
+// kMostMeshTexels fit.
+SurfaceTexels::Patches mesh_patches(const TriangleMesh& mesh, double size) {
+  SurfaceTexels::Patches out;
+  for (;; size *= 1.5) {
+    out.points.clear(), out.normals.clear();
+    for (size_t tri = 0; tri < mesh.triangle_count(); ++tri) {
+      const Vec3 a = mesh.vertex(tri, 0), ab = mesh.vertex(tri, 1) - a, ac = mesh.vertex(tri, 2) - a;
+      const Vec3 c = glm::cross(ab, ac);
+      if (!(glm::length(c) > 0.0)) continue;
+      const Vec3 n = glm::normalize(c);
+      const double longest = std::max({glm::length(ab), glm::length(ac), glm::length(ac - ab)});
+      const int k = std::clamp(static_cast<int>(std::ceil(longest / size)), 1, 64);
+      for (int i = 0; i < k; ++i)
+        for (int j = 0; i + j < k; ++j) {
+          out.points.push_back(a + ((i + 1.0 / 3.0) * ab + (j + 1.0 / 3.0) * ac) / double(k)), out.normals.push_back(n);
+          if (i + j + 1 < k) out.points.push_back(a + ((i + 2.0 / 3.0) * ab + (j + 2.0 / 3.0) * ac) / double(k)), out.normals.push_back(n);
+        }
+      if (out.points.size() > kMostMeshTexels) break;
+    }
+    if (out.points.size() <= kMostMeshTexels) break;
+  }
+  out.size = size;
+  out.index();
+  return out;
 }
+
+}  // namespace
 
 SurfaceTexels surface_texels(const Scene& delta, const ExtinctionVolume& volume, const std::vector<DenseGrid>& depths,
                              const DomSolution& solution, const Rgb& sky, double step_cells, int threads,
@@ -45,7 +110,24 @@ SurfaceTexels surface_texels(const Scene& delta, const ExtinctionVolume& volume,
   SurfaceTexels out;
   out.planes.resize(delta.surfaces.size());
   out.spheres.resize(delta.surfaces.size());
+  out.meshes.resize(delta.surfaces.size());
   for (size_t s = 0; s < delta.surfaces.size(); ++s) {
+    if (const auto* mesh = std::get_if<Mesh>(&delta.surfaces[s].shape)) {
+      // Texels about two cells apart, as on planes; E_s on both sides (a mesh's winding need not
+      // say which side the medium is on).
+      SurfaceTexels::Patches& m = out.meshes[s];
+      m = mesh_patches(*mesh->triangles, 2.0 * std::max({h.x, h.y, h.z}));
+      m.front.resize(m.points.size()), m.back.resize(m.points.size());
+      parallel_for(static_cast<long long>(m.points.size()), threads, 16, [&](long long i0, long long i1) {
+        for (auto i = static_cast<size_t>(i0); i < static_cast<size_t>(i1); ++i)
+          for (const double side : {1.0, -1.0}) {
+            // Off the face by twice the mesh's self-hit skip: the gather's rays then leave it.
+            const Vec3 n = side * m.normals[i], p = m.points[i] + 2.0 * TriangleMesh::kSelfHit * (1.0 + glm::length(m.points[i])) * n;
+            (side > 0.0 ? m.front : m.back)[i] = gather.around(p, n, sky, [](const Vec3&) { return Rgb(1.0); });
+          }
+      });
+      continue;
+    }
     if (const auto* sphere = std::get_if<Sphere>(&delta.surfaces[s].shape)) {
       SurfaceTexels::Globe& g = out.spheres[s];
       // Texels about a cell apart along a meridian, 8 to 16 of them (and twice as many around).
@@ -109,12 +191,13 @@ Rgb SurfaceLight::reflected(const Surface& surface, const Vec3& p, const Vec3& n
   Surface lambert = surface;
   if (!glossy) lambert.ks = Rgb(0.0);
   return surface_direct(delta_.lights, delta_.surfaces, volume_.density, depths_, sigma_t_, lambert, p, n, wo) +
-         surface.kd / kPi * irradiance(surface, p);
+         surface.kd / kPi * irradiance(surface, p, n);
 }
 
-Rgb SurfaceLight::irradiance(const Surface& surface, const Vec3& p) const {
+Rgb SurfaceLight::irradiance(const Surface& surface, const Vec3& p, const Vec3& n) const {
   Rgb e_s = kPi * sky_;
   const auto index = static_cast<size_t>(&surface - delta_.surfaces.data());
+  if (const SurfaceTexels::Patches& patches = texels_.meshes[index]; !patches.points.empty()) patches.lookup(p, n, e_s);
   if (const SurfaceTexels::Rectangle& rectangle = texels_.planes[index]; !rectangle.values.empty()) rectangle.lookup(p, e_s);
   if (const SurfaceTexels::Globe& globe = texels_.spheres[index]; !globe.values.empty()) e_s = globe.lookup(p);
   return e_s;

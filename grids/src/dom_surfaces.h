@@ -28,8 +28,8 @@ class SurfaceLight {
   // and on spheres. With `glossy` false the direct light too goes through the Lambert part only:
   // a gather's few directions would alias a glossy surface's highlight into spikes (a caustic).
   Rgb reflected(const Surface& surface, const Vec3& p, const Vec3& n, const Vec3& wo, bool glossy = true) const;
-  // E_s at a surface point: from the texels, pi sky past them.
-  Rgb irradiance(const Surface& surface, const Vec3& p) const;
+  // E_s at a surface point with unit normal n: from the texels, pi sky past them.
+  Rgb irradiance(const Surface& surface, const Vec3& p, const Vec3& n) const;
 
   // What enters the grid at a face point along w (pointing into the grid): the sky where the ray
   // back along -w meets no surface, else what the surface hit reflects toward w.

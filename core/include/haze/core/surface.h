@@ -1,9 +1,12 @@
-// Opaque surfaces that block and reflect light: planes and spheres with energy-normalized BRDFs
+// Opaque surfaces that block and reflect light: planes, spheres and triangle meshes (mesh.h) with energy-normalized BRDFs
 // (DESIGN.md): Lambert kd / pi plus Phong ks (n + 2) / (2 pi) cos^n(alpha). The thesis (seed 002)
 // writes kd and ks cos^n; its constants are folded in here.
 #pragma once
 
 #include <haze/core/math.h>
+#include <haze/core/mesh.h>
+
+#include <memory>
 
 #include <utility>
 #include <variant>
@@ -23,8 +26,15 @@ struct Sphere {
   double radius = 1.0;
 };
 
+// A triangle mesh, shared between copies of a scene.
+struct Mesh {
+  std::shared_ptr<const TriangleMesh> triangles;
+};
+
+// A surface Haze does not shade (the host does: "shaded": false in a scene file) has kd = ks = 0:
+// it casts shadows, ends view rays as a host's depth would (C = 0) and reflects nothing.
 struct Surface {
-  std::variant<Plane, Sphere> shape;
+  std::variant<Plane, Sphere, Mesh> shape;
   Rgb kd{0.5};
   Rgb ks{0.0};
   double shininess = 1.0;
@@ -48,7 +58,9 @@ inline Vec3 off_surface(const Vec3& p, const Vec3& normal) { return p + 1e-9 * (
 // The stretches [a, b] of ray.at(t), t in [t0, t1] (t1 may be infinite), from which a light at
 // `light` is not hidden by a surface, in order; appended to `out`. Exact for planes and spheres:
 // the line crosses a shadow's edge only where it crosses a plane, a sphere or the cone from the
-// light tangent to a sphere, so between those crossings occluded() at one point decides.
+// light tangent to a sphere, so between those crossings occluded() at one point decides. A mesh's
+// shadow edges are found by bisection between 64 points along the stretch (a shadow shorter than
+// 1/64 of it can be missed).
 void lit_stretches(const std::vector<Surface>& surfaces, const Ray& ray, double t0, double t1, const Vec3& light,
                    std::vector<std::pair<double, double>>& out);
 

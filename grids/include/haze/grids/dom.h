@@ -5,6 +5,9 @@
 // point lights show no ray effects; the solver carries only light scattered at least once.
 #pragma once
 
+#include <cstdint>
+#include <unordered_map>
+
 #include <haze/core/light.h>
 #include <haze/core/method.h>
 #include <haze/core/phase_matrix.h>
@@ -94,7 +97,8 @@ struct DomSettings {
 // first surface pass) other surfaces' reflected light give the surfaces (dom_fields, the surface
 // passes; gathered along 64 directions like a camera pixel's), at texel centres: over a rectangle of each plane, the grid's bounds widened by their extent on
 // every side, texels at least two cells wide, at most 48 a side; over each sphere in latitude
-// and longitude, n x 2n, n about a cell apart along a meridian (8 to 16).
+// and longitude, n x 2n, n about a cell apart along a meridian (8 to 16); on each mesh's triangles
+// about two cells apart (at most 4096 a mesh), on both sides.
 struct SurfaceTexels {
   struct Rectangle {
     Vec3 origin, u, v;
@@ -110,8 +114,21 @@ struct SurfaceTexels {
     std::vector<Rgb> values;  // [t * np + p], t along the polar angle from +y, p the azimuth from +x
     Rgb lookup(const Vec3& p) const;  // bilinear, wrapping in azimuth
   };
-  std::vector<Rectangle> planes;  // per surface; empty for spheres
-  std::vector<Globe> spheres;     // per surface; empty for planes
+  // A mesh's texels: points on its triangles about `size` apart, E_s on both sides of each.
+  struct Patches {
+    double size = 1.0;
+    std::vector<Vec3> points, normals;  // normals by the triangles' winding
+    std::vector<Rgb> front, back;       // E_s on the normal's side and on the other
+    std::unordered_map<std::int64_t, std::vector<std::uint32_t>> cells;  // texels by cell of `size`
+    // Weighted over the texels within 1.5 size on p's face with normal n (either side); false
+    // where there are none.
+    bool lookup(const Vec3& p, const Vec3& n, Rgb& e) const;
+    void index();  // fills `cells`
+    std::int64_t cell_key(const Vec3& p) const;
+  };
+  std::vector<Rectangle> planes;  // per surface; empty but for planes
+  std::vector<Globe> spheres;     // per surface; empty but for spheres
+  std::vector<Patches> meshes;    // per surface; empty but for meshes
 };
 // The converged diffuse radiance in moment form: per solved channel (1 when medium and lights are
 // grey, else 3) and cell, the N moments m_k = sum_d Q[d][k] L_d (seed 000 eq. 10). The in-scattered
