@@ -375,7 +375,7 @@ MethodInfo analytic_info() {
   info.summary = "closed-form single scattering, homogeneous medium, point and spot lights (seed 002; no shadows)";
   info.create = [] { return std::make_unique<AnalyticMethod>(); };
   info.handles = {"constant density (bounded or not)", "point, spot",
-                  "planes and spheres lit by unscattered light and the airlight, with shadows (not of the airlight onto them)", false};
+                  "planes, spheres and meshes lit by unscattered light and the airlight, with shadows (not of the airlight onto them)", false};
   info.settings = {SettingInfo::integer("table_a", 256, 16, 4096, "airlight table samples along A = T_sv sin(gamma)"),
                    SettingInfo::integer("table_eta", 512, 16, 4096, "airlight table samples along the angle eta"),
                    SettingInfo::integer("surface_airlight", 1, 0, 1, "1: surfaces also receive the airlight (tables J1 and J_n)"),

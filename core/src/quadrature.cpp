@@ -186,7 +186,7 @@ MethodInfo quadrature_info() {
   info.summary = "single scattering by deterministic numerical quadrature (any medium; a yardstick, not fast)";
   info.create = [] { return std::make_unique<QuadratureMethod>(); };
   info.handles = {"any: constant, RBF and grid densities, the particles' density", "point, spot, directional, sky",
-                  "planes and spheres lit by unscattered light, with shadows", false};
+                  "planes, spheres and meshes lit by unscattered light, with shadows", false};
   info.settings = {SettingInfo::integer("steps", 512, kNodesPerPanel, 1 << 20, "quadrature nodes along each view ray"),
                    SettingInfo::integer("sky_directions", 256, 1, 1 << 16, "directions the sky's light is integrated over")};
   for (int steps : {32, 64, 128, 256}) info.trade_sweep.push_back({{"steps", steps}, {"sky_directions", 64}});

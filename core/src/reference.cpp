@@ -2,7 +2,7 @@
 // (docs/REFERENCE.md). Free flights by spectral delta tracking against a coarse majorant grid
 // (Kutz et al. 2017; pbrt-v4's DDA majorants), next-event estimation to point, spot and
 // directional lights and the sky with ratio-tracked transmittance (exact for homogeneous media),
-// phase-function importance sampling, Russian roulette; planes and spheres block and reflect.
+// phase-function importance sampling, Russian roulette; planes, spheres and meshes block and reflect.
 #include "builtin_methods.h"
 
 #include <haze/core/error.h>
@@ -434,7 +434,7 @@ MethodInfo reference_info() {
   info.summary = "unbiased volumetric path tracer with a standard-error image (the yardstick for every method)";
   info.create = [] { return std::make_unique<ReferenceMethod>(); };
   info.handles = {"any: constant, RBF and grid densities, the particles' density", "point, spot, directional, sky",
-                  "planes and spheres: every light path", true};
+                  "planes, spheres and meshes: every light path", true};
   info.settings = {
       SettingInfo::number("target_noise", 0.0, 0.0, 0.99, "add samples until the image's own relative noise over the lit pixels is this (0: off)"),
       SettingInfo::integer("spp", nullptr, 1, 1LL << 32, "samples per pixel: 1024, or with target_noise the cap (2^20)"),

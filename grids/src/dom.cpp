@@ -432,7 +432,7 @@ MethodInfo dom_info() {
   info.summary = "multiple scattering on grids: discrete ordinates with a separable phase function (seed 000)";
   info.create = [] { return std::make_unique<DomMethod>(); };
   info.handles = {"RBF, grid and bounded constant densities, the particles' density", "point, spot, directional, sky",
-                  "planes and spheres: shadows, the medium's light onto them and theirs into it (outside the grid or on its faces), and between them", true};
+                  "planes, spheres and meshes: shadows, the medium's light onto them and theirs into it (outside the grid or on its faces), and between them", true};
   const DomSettings d;
   info.settings = {
       SettingInfo::cells("resolution", 64, 2, 1024,

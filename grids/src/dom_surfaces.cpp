@@ -71,26 +71,28 @@ namespace {
 constexpr int kMostTexels = 48;
 constexpr size_t kMostMeshTexels = 4096;
 
-// Texels on a mesh's triangles, each cut into k^2 similar ones (k from the longest edge over
-// `size`), one texel at each small triangle's centroid; `size` grows until at most
-// kMostMeshTexels fit.
-SurfaceTexels::Patches mesh_patches(const TriangleMesh& mesh, double size) {
+// Texels on a mesh's triangles within `region`, each triangle cut into k^2 similar ones (k from
+// its longest edge over `size`, at most 1024), one texel at each small triangle's centroid; `size`
+// grows until at most kMostMeshTexels fit.
+SurfaceTexels::Patches mesh_patches(const TriangleMesh& mesh, const Aabb& region, double size) {
   SurfaceTexels::Patches out;
   for (;; size *= 1.5) {
     out.points.clear(), out.normals.clear();
-    for (size_t tri = 0; tri < mesh.triangle_count(); ++tri) {
+    auto add = [&](const Vec3& p, const Vec3& n) {
+      if (region.contains(p)) out.points.push_back(p), out.normals.push_back(n);
+    };
+    for (size_t tri = 0; tri < mesh.triangle_count() && out.points.size() <= kMostMeshTexels; ++tri) {
       const Vec3 a = mesh.vertex(tri, 0), ab = mesh.vertex(tri, 1) - a, ac = mesh.vertex(tri, 2) - a;
       const Vec3 c = glm::cross(ab, ac);
       if (!(glm::length(c) > 0.0)) continue;
       const Vec3 n = glm::normalize(c);
       const double longest = std::max({glm::length(ab), glm::length(ac), glm::length(ac - ab)});
-      const int k = std::clamp(static_cast<int>(std::ceil(longest / size)), 1, 64);
+      const int k = std::clamp(static_cast<int>(std::ceil(longest / size)), 1, 1024);
       for (int i = 0; i < k; ++i)
         for (int j = 0; i + j < k; ++j) {
-          out.points.push_back(a + ((i + 1.0 / 3.0) * ab + (j + 1.0 / 3.0) * ac) / double(k)), out.normals.push_back(n);
-          if (i + j + 1 < k) out.points.push_back(a + ((i + 2.0 / 3.0) * ab + (j + 2.0 / 3.0) * ac) / double(k)), out.normals.push_back(n);
+          add(a + ((i + 1.0 / 3.0) * ab + (j + 1.0 / 3.0) * ac) / double(k), n);
+          if (i + j + 1 < k) add(a + ((i + 2.0 / 3.0) * ab + (j + 2.0 / 3.0) * ac) / double(k), n);
         }
-      if (out.points.size() > kMostMeshTexels) break;
     }
     if (out.points.size() <= kMostMeshTexels) break;
   }
@@ -113,10 +115,11 @@ SurfaceTexels surface_texels(const Scene& delta, const ExtinctionVolume& volume,
   out.meshes.resize(delta.surfaces.size());
   for (size_t s = 0; s < delta.surfaces.size(); ++s) {
     if (const auto* mesh = std::get_if<Mesh>(&delta.surfaces[s].shape)) {
-      // Texels about two cells apart, as on planes; E_s on both sides (a mesh's winding need not
-      // say which side the medium is on).
+      // Texels about two cells apart over the grid's bounds widened by their extent, as on planes
+      // (past them, pi sky); E_s on both sides (a mesh's winding need not say which side the
+      // medium is on).
       SurfaceTexels::Patches& m = out.meshes[s];
-      m = mesh_patches(*mesh->triangles, 2.0 * std::max({h.x, h.y, h.z}));
+      m = mesh_patches(*mesh->triangles, {bounds.lo - extent, bounds.hi + extent}, 2.0 * std::max({h.x, h.y, h.z}));
       m.front.resize(m.points.size()), m.back.resize(m.points.size());
       parallel_for(static_cast<long long>(m.points.size()), threads, 16, [&](long long i0, long long i1) {
         for (auto i = static_cast<size_t>(i0); i < static_cast<size_t>(i1); ++i)
@@ -184,7 +187,9 @@ SurfaceLight::SurfaceLight(const Scene& delta, const ExtinctionVolume& volume, c
       sky_(sky),
       sigma_t_(delta_m_sigma_t(volume.sigma_t_scale, volume.albedo, delta_m_fraction)) {
   const Vec3 h = volume.density.cell_size();
-  offset_ = std::max(1e-4 * std::min({h.x, h.y, h.z}), 1e-6);  // past nearest_surface's 1e-7
+  // Past nearest_surface's 1e-7, and past a mesh's self-hit skip anywhere in the grid.
+  const double far = std::max(glm::length(volume.density.bounds().lo), glm::length(volume.density.bounds().hi));
+  offset_ = std::max({1e-4 * std::min({h.x, h.y, h.z}), 1e-6, 3.0 * TriangleMesh::kSelfHit * (1.0 + far)});
 }
 
 Rgb SurfaceLight::reflected(const Surface& surface, const Vec3& p, const Vec3& n, const Vec3& wo, bool glossy) const {

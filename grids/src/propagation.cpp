@@ -113,7 +113,7 @@ MethodInfo propagation_info() {
   info.summary = "single scattering in heterogeneous media: RBF injection, optical-depth volumes, ray marching (seed 003)";
   info.create = [] { return std::make_unique<PropagationMethod>(); };
   info.handles = {"RBF, grid and bounded constant densities, the particles' density", "point, spot, directional",
-                  "planes and spheres lit by unscattered light through the depth volumes, with shadows", false};
+                  "planes, spheres and meshes lit by unscattered light through the depth volumes, with shadows", false};
   info.settings = {SettingInfo::integer("resolution", 64, 2, 1024, "cells along the longest side of the medium's bounds (RBF and constant)"),
                    SettingInfo::choice("optical_depth", "sweep", {"exact", "paper", "sweep"}, "how the depth to each light is computed"),
                    SettingInfo::integer("sweep_layers", 4, 1, 64, "sweep: cell layers each short characteristic walks exactly"),

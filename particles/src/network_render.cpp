@@ -386,7 +386,7 @@ MethodInfo network_info() {
   info.name = "network";
   info.summary = "multiple scattering in particle media: visibility and illumination networks (seed 001)";
   info.create = [] { return std::make_unique<NetworkMethod>(); };
-  info.handles = {"particles (a Gaussian each)", "point, spot, directional, sky", "planes and spheres lit through the particles and by their scattered light, with shadows (also in the particles' direct light)", true};
+  info.handles = {"particles (a Gaussian each)", "point, spot, directional, sky", "planes, spheres and meshes lit through the particles and by their scattered light, with shadows (also in the particles' direct light)", true};
   const NetworkSettings n;
   info.settings = {SettingInfo::integer("directions", n.directions, 8, 4096, "D, the network's directions"),
                    SettingInfo::integer("window", 0, 0, 65536, "projection window in texels (0: from the particles' sizes)"),

@@ -98,7 +98,7 @@ struct DomSettings {
 // passes; gathered along 64 directions like a camera pixel's), at texel centres: over a rectangle of each plane, the grid's bounds widened by their extent on
 // every side, texels at least two cells wide, at most 48 a side; over each sphere in latitude
 // and longitude, n x 2n, n about a cell apart along a meridian (8 to 16); on each mesh's triangles
-// about two cells apart (at most 4096 a mesh), on both sides.
+// about two cells apart within the same widened bounds (at most 4096 a mesh), on both sides.
 struct SurfaceTexels {
   struct Rectangle {
     Vec3 origin, u, v;
