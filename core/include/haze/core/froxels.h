@@ -1,0 +1,58 @@
+// Froxels (frustum voxels; Wronski 2014, Hillaire 2015, docs/REFERENCES.md): a camera-aligned
+// volume holding, per froxel, the in-scattered radiance L_in and the transmittance T accumulated
+// from the camera to the froxel's far slice boundary. A host renders it once per frame and looks up
+// every pixel's layers at the pixel's depth (trilinear), instead of Haze rendering every pixel:
+// colour = L_in(d) + T(d) * host colour (docs/HOST.md). Built from any solution whose method
+// renders layers (DESIGN.md, "Callers").
+#pragma once
+
+#include <haze/core/camera.h>
+#include <haze/core/image.h>
+#include <haze/core/method.h>
+
+#include <span>
+#include <vector>
+
+#pragma GCC visibility push(default)  // the public API: exported from shared builds
+
+namespace haze {
+
+// The volume's shape: nx x ny columns over the camera's image, nz slices in distance along each
+// column's ray (not view-space z), exponential between near and far: slice k ends at
+// near (far / near)^((k + 1) / nz). 160 x 90 x 64 suits a 16:9 1080p frame.
+struct FroxelGrid {
+  int nx = 160, ny = 90, nz = 64;
+  double near = 0.1, far = 100.0;
+  // Slice k's far boundary (k = -1: near).
+  double boundary(int k) const;
+  // The continuous slice coordinate of distance d: k at boundary(k), -1 at near and before.
+  double slice(double d) const;
+};
+
+struct Froxels {
+  FroxelGrid grid;
+  // [(k * ny + j) * nx + i]: L_in and T along column (i, j)'s ray from the camera to boundary(k).
+  // Column (i, j) is the camera's ray through film position ((i + 0.5) W / nx, (j + 0.5) H / ny)
+  // of its W x H image, rows top to bottom.
+  std::vector<Vec3f> inscatter, transmittance;
+
+  // The layers at film position (u, v) in [0, 1]^2 of the image (u across, v down) and distance d
+  // along the ray: bilinear between column centres (clamped at the edges), linear in slice(d)
+  // between boundaries; before near L_in = 0, T = 1 are taken at near; past far, far's values.
+  PixelLayers sample(double u, double v, double d) const;
+};
+
+// Builds the froxels of `camera`'s view from `solution` (any method that renders layers): one
+// layered render of the nx x ny columns per slice, each with its boundary as the depth (the
+// method's SIMD and threads do the work). options.progress sees the slices; a camera of type
+// `rays` is sampled at the columns' nearest pixels. Bad grids (a count below 1 or above 4096, near
+// not in (0, far)) are a haze::Error naming `froxels.<field>`.
+Froxels build_froxels(const Solution& solution, const Camera& camera, const FroxelGrid& grid = {}, const RenderOptions& options = {});
+
+// The CPU form of the GLSL composite pass: per pixel of the host's colour, L_in(d) + T(d) * colour
+// at its depth d (distance along the ray, +inf for the background: far's values then).
+Image composite_froxels(const Froxels& froxels, const Image& host_colour, std::span<const float> depth);
+
+}  // namespace haze
+
+#pragma GCC visibility pop
