@@ -126,11 +126,13 @@ class AnalyticSolution final : public MethodSolution {
       std::vector<size_t> owner;
       std::vector<double> offset;
       std::vector<std::pair<double, double>> stretches;
+      std::vector<Ray> rays(static_cast<size_t>(camera.width_px));
       for (auto y = static_cast<int>(y0); y < y1 && !progress.cancelled(); ++y) {
         for (auto* v : {&ox, &oy, &oz, &dx, &dy, &dz, &seg}) v->clear();
+        camera.row_rays(y, rays.data());
         for (int x = 0; x < camera.width_px; ++x) {
           PixelHit& px = row[static_cast<size_t>(x)];
-          px.ray = camera.pixel_ray(x, y);
+          px.ray = rays[static_cast<size_t>(x)];
           px.normal = Vec3(0.0);
           px.hit = nearest_surface(scene_.surfaces, px.ray, view.max_distance(x, y), px.t_hit, px.normal);
           const Ray& ray = px.ray;

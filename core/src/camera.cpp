@@ -73,19 +73,36 @@ Ray Camera::generate_ray(double px, double py) const {
     const Vec3 origin = perspective ? Vec3(0.0) : Vec3(p.x, p.y, 0.0), direction = perspective ? p : Vec3(0.0, 0.0, -1.0);
     return {Vec3(view_inverse * glm::dvec4(origin, 1.0)), glm::normalize(Vec3(view_inverse * glm::dvec4(direction, 0.0)))};
   }
-  Vec3 forward = glm::normalize(look_at - position);
-  Vec3 right = glm::normalize(glm::cross(forward, up));
-  Vec3 true_up = glm::cross(right, forward);
-  // Film coordinates in [-1, 1] vertically, aspect-scaled horizontally; row 0 at the top.
-  double aspect = static_cast<double>(width_px) / height_px;
-  double sx = (2.0 * px / width_px - 1.0) * aspect;
-  double sy = 1.0 - 2.0 * py / height_px;
-  if (type == Type::orthographic) {
-    double half = 0.5 * height;
-    return {position + right * (sx * half) + true_up * (sy * half), forward};
+  Ray ray;
+  row_rays_at(py, &px, 1, &ray);
+  return ray;
+}
+
+void Camera::row_rays_at(double py, const double* px, int count, Ray* out) const {
+  if (type == Type::rays || type == Type::matrices) {
+    for (int i = 0; i < count; ++i) out[i] = generate_ray(px[i], py);
+    return;
   }
-  double tan_half = std::tan(0.5 * fov_y_deg * kPi / 180.0);
-  return {position, glm::normalize(forward + right * (sx * tan_half) + true_up * (sy * tan_half))};
+  const Vec3 forward = glm::normalize(look_at - position);
+  const Vec3 right = glm::normalize(glm::cross(forward, up));
+  const Vec3 true_up = glm::cross(right, forward);
+  // Film coordinates in [-1, 1] vertically, aspect-scaled horizontally; row 0 at the top.
+  const double aspect = static_cast<double>(width_px) / height_px;
+  const double sy = 1.0 - 2.0 * py / height_px;
+  if (type == Type::orthographic) {
+    const double half = 0.5 * height;
+    for (int i = 0; i < count; ++i) out[i] = {position + right * ((2.0 * px[i] / width_px - 1.0) * aspect * half) + true_up * (sy * half), forward};
+    return;
+  }
+  const double tan_half = std::tan(0.5 * fov_y_deg * kPi / 180.0);
+  const Vec3 centre = forward + true_up * (sy * tan_half);
+  for (int i = 0; i < count; ++i) out[i] = {position, glm::normalize(centre + right * ((2.0 * px[i] / width_px - 1.0) * aspect * tan_half))};
+}
+
+void Camera::row_rays(int y, Ray* out) const {
+  std::vector<double> px(static_cast<size_t>(width_px));
+  for (int x = 0; x < width_px; ++x) px[static_cast<size_t>(x)] = x + 0.5;
+  row_rays_at(y + 0.5, px.data(), width_px, out);
 }
 
 }  // namespace haze

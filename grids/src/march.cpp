@@ -193,8 +193,8 @@ void march_row(const Marcher& m, const simd::MarchVolume& v, const View& view, i
   std::vector<float> in(9 * width), out(6 * width, 0.0f);
   std::vector<Ray> rays(width);
   std::vector<Hit> hits(width);
+  camera.row_rays(y, rays.data());
   for (size_t x = 0; x < width; ++x) {
-    rays[x] = camera.pixel_ray(static_cast<int>(x), y);
     hits[x] = m.hit(rays[x], view.max_distance(static_cast<int>(x), y));
     const Steps s = m.steps(rays[x], hits[x].t);
     const double values[9] = {rays[x].origin.x, rays[x].origin.y, rays[x].origin.z, rays[x].direction.x, rays[x].direction.y,

@@ -46,7 +46,13 @@ struct Camera {
   // Ray through film position (px, py) in pixels, (0, 0) the top-left corner.
   Ray generate_ray(double px, double py) const;
   Ray pixel_ray(int x, int y) const { return generate_ray(x + 0.5, y + 0.5); }
+  // The rays of row y's pixels, out[x] = pixel_ray(x, y) (the camera's frame made once per row).
+  void row_rays(int y, Ray* out) const;
   bool operator==(const Camera&) const = default;
+
+ private:
+  // Film positions (px[i], py) of one row; pinhole and orthographic make their frame once.
+  void row_rays_at(double py, const double* px, int count, Ray* out) const;
 };
 
 }  // namespace haze
