@@ -60,6 +60,7 @@ namespace haze::gl::internal {
   X(PFNGLUNIFORM1FVPROC, Uniform1fv)                                                                                     \
   X(PFNGLUNIFORM3FVPROC, Uniform3fv)                                                                                     \
   X(PFNGLUNIFORM4FVPROC, Uniform4fv)                                                                                     \
+  X(PFNGLUNIFORMMATRIX4FVPROC, UniformMatrix4fv)                                                                         \
   X(PFNGLGENVERTEXARRAYSPROC, GenVertexArrays)                                                                           \
   X(PFNGLBINDVERTEXARRAYPROC, BindVertexArray)                                                                           \
   X(PFNGLDELETEVERTEXARRAYSPROC, DeleteVertexArrays)                                                                     \
