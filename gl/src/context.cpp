@@ -99,6 +99,11 @@ HeadlessContext::~HeadlessContext() {
 
 void HeadlessContext::finish() const { internal::finish(*impl_->api); }
 
+HeadlessContext::ProcAddress HeadlessContext::proc_address(const char* name) const {
+  return info_.backend == "osmesa" ? reinterpret_cast<ProcAddress>(OSMesaGetProcAddress(name))
+                                   : reinterpret_cast<ProcAddress>(eglGetProcAddress(name));
+}
+
 GlInfo probe() {
   try {
     HeadlessContext context;

@@ -26,6 +26,11 @@ class HeadlessContext {
   const GlInfo& info() const { return info_; }
   // Waits until GL has executed every command issued so far (benchmarks time uploads with it).
   void finish() const;
+  // A GL entry point of this context's driver ("glDrawArrays"), or nullptr: for a host that draws
+  // through Haze's headless context (examples/host). Link to neither libGL nor OSMesa yourself:
+  // both export gl* symbols, and the wrong one would be called.
+  using ProcAddress = void (*)();
+  ProcAddress proc_address(const char* name) const;
 
  private:
   struct Impl;
