@@ -56,6 +56,9 @@ class AutoSolution final : public MethodSolution {
     return chosen_.update(change, o);
   }
   bool renders_layers() const override { return chosen_.method_solution().renders_layers(); }
+  std::optional<std::vector<PixelLayers>> render_distances(const View& view, std::span<const double> distances, const RenderOptions& options) const override {
+    return chosen_.method_solution().render_distances(view, distances, options);
+  }
   Rgb transmittance(size_t light, const Vec3& x) const override { return chosen_.transmittance(light, x); }
   Rgb fluence(const Vec3& x) const override { return chosen_.fluence(x); }
   Rgb inscattered(const Vec3& x, const Vec3& w) const override { return chosen_.inscattered(x, w); }

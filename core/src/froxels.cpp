@@ -92,21 +92,15 @@ Froxels build_froxels(const Solution& solution, const Camera& camera, const Frox
   const size_t columns = static_cast<size_t>(grid.nx) * static_cast<size_t>(grid.ny);
   out.inscatter.resize(columns * static_cast<size_t>(grid.nz));
   out.transmittance.resize(out.inscatter.size());
-  View view{column_camera(camera, grid.nx, grid.ny), {}, true};
-  std::vector<float> depth(columns);
-  view.depth = depth;
-  RenderOptions slice_options = options;
-  for (int k = 0; k < grid.nz; ++k) {
-    if (options.progress)
-      slice_options.progress = [&, k](double f) { return options.progress((k + f) / grid.nz); };
-    std::fill(depth.begin(), depth.end(), static_cast<float>(grid.boundary(k)));
-    const RenderResult r = solution.render(view, slice_options);
-    for (int j = 0; j < grid.ny; ++j)
-      for (int i = 0; i < grid.nx; ++i) {
-        const size_t at = (static_cast<size_t>(k) * static_cast<size_t>(grid.ny) + static_cast<size_t>(j)) * static_cast<size_t>(grid.nx) + static_cast<size_t>(i);
-        out.inscatter[at] = Vec3f(r.inscatter->at(i, j)), out.transmittance[at] = Vec3f(r.transmittance->at(i, j));
-      }
-  }
+  std::vector<double> boundaries;
+  for (int k = 0; k < grid.nz; ++k) boundaries.push_back(grid.boundary(k));
+  const std::vector<PixelLayers> layers = solution.render_distances(View{column_camera(camera, grid.nx, grid.ny)}, boundaries, options);
+  const auto nz = static_cast<size_t>(grid.nz);
+  for (size_t column = 0; column < columns; ++column)
+    for (size_t k = 0; k < nz; ++k) {
+      const PixelLayers& p = layers[column * nz + k];
+      out.inscatter[k * columns + column] = Vec3f(p.inscatter), out.transmittance[k * columns + column] = Vec3f(p.transmittance);
+    }
   return out;
 }
 

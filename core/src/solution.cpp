@@ -154,6 +154,33 @@ RenderResult Solution::render(const View& view, const RenderOptions& options) co
   return result;
 }
 
+std::vector<PixelLayers> Solution::render_distances(const View& view, std::span<const double> distances, const RenderOptions& options) const {
+  for (size_t k = 0; k < distances.size(); ++k)
+    if (!(distances[k] > 0.0) || (k > 0 && !(distances[k] >= distances[k - 1])))
+      throw Error("distances[" + std::to_string(k) + "]", to_text(distances[k]), "ascending distances > 0");
+  const State& s = *state_;
+  const View at{view.camera, {}, true};
+  if (s.options.single_view && !(view.camera == s.scene.camera))
+    throw Error("view.camera", "another camera than the scene's", "the scene's camera for a solution prepared with single_view");
+  RenderOptions o = s.options;
+  o.threads = options.threads;
+  if (auto fast = s.naming_lights([&] { return s.solution->render_distances(at, distances, o); })) return std::move(*fast);
+  const size_t rays = static_cast<size_t>(view.camera.width_px) * static_cast<size_t>(view.camera.height_px), n = distances.size();
+  std::vector<PixelLayers> out(rays * n);
+  std::vector<float> depth(rays);
+  RenderOptions slice = options;
+  for (size_t k = 0; k < n; ++k) {
+    if (options.progress) slice.progress = [&, k](double f) { return options.progress((static_cast<double>(k) + f) / static_cast<double>(n)); };
+    std::fill(depth.begin(), depth.end(), static_cast<float>(distances[k]));
+    const RenderResult r = render(View{view.camera, depth, true}, slice);
+    for (size_t i = 0; i < rays; ++i) {
+      const int x = static_cast<int>(i % static_cast<size_t>(view.camera.width_px)), y = static_cast<int>(i / static_cast<size_t>(view.camera.width_px));
+      out[i * n + k] = {r.inscatter->at(x, y), r.transmittance->at(x, y), r.surface->at(x, y)};
+    }
+  }
+  return out;
+}
+
 UpdateReport Solution::update(const SceneChange& change, const RenderOptions& options) {
   State& s = *state_;
   const Stopwatch watch;
