@@ -180,11 +180,7 @@ class AnalyticSolution final : public MethodSolution {
             lit = &stretch_batch;
           }
           // out[segment] += airlight, from the light's batch (the segments, or their lit stretches).
-          auto add = [&](int c, float intensity, const Rgb& scale) {
-            unit.assign(lit->count, 0.0f);
-            add_airlight(table_, {static_cast<float>(p.x), static_cast<float>(p.y), static_cast<float>(p.z), static_cast<float>(sigma_t_[c]),
-                                 static_cast<float>(sigma_s_[c]), intensity},
-                         *lit, unit.data());
+          light_airlight(add_airlight, light, *lit, unit, [&](const Rgb& scale) {
             for (int e = 0; e < 3; ++e) {
               if (scale[e] == 0.0) continue;
               std::vector<float>& to = batch_airlight[static_cast<size_t>(e)];
@@ -194,16 +190,7 @@ class AnalyticSolution final : public MethodSolution {
                 to[k] += static_cast<float>(scale[e] * carried * static_cast<double>(unit[i]));
               }
             }
-          };
-          // Grey: one batch at unit intensity, scaled per channel (airlight is linear in I).
-          if (grey_) add(0, 1.0f, light.intensity);
-          else
-            for (int c = 0; c < 3; ++c) {
-              if (sigma_s_[c] == 0.0 || light.intensity[c] == 0.0) continue;
-              Rgb only(0.0);
-              only[c] = 1.0;
-              add(c, static_cast<float>(light.intensity[c]), only);
-            }
+          });
         }
         for (int x = 0; x < camera.width_px; ++x) {
           const auto& [ray, t_hit, normal, hit, t_entry] = row[static_cast<size_t>(x)];
@@ -287,24 +274,10 @@ class AnalyticSolution final : public MethodSolution {
         first[width] = ox.size();
         const SegmentBatch batch{ox.data(), oy.data(), oz.data(), dx.data(), dy.data(), dz.data(), seg.data(), ox.size()};
         airlight.assign(batch.count, Rgb(0.0));
-        for (const auto& light : lights_) {
-          const Vec3& p = light.position;
-          auto add = [&](int c, float intensity, const Rgb& scale) {
-            unit.assign(batch.count, 0.0f);
-            add_airlight(table_, {static_cast<float>(p.x), static_cast<float>(p.y), static_cast<float>(p.z), static_cast<float>(sigma_t_[c]),
-                                  static_cast<float>(sigma_s_[c]), intensity},
-                         batch, unit.data());
+        for (const auto& light : lights_)
+          light_airlight(add_airlight, light, batch, unit, [&](const Rgb& scale) {
             for (size_t i = 0; i < batch.count; ++i) airlight[i] += scale * static_cast<double>(unit[i]);
-          };
-          if (grey_) add(0, 1.0f, light.intensity);  // as render(): one batch scaled per channel
-          else
-            for (int c = 0; c < 3; ++c) {
-              if (sigma_s_[c] == 0.0 || light.intensity[c] == 0.0) continue;
-              Rgb only(0.0);
-              only[c] = 1.0;
-              add(c, static_cast<float>(light.intensity[c]), only);
-            }
-        }
+          });
         for (size_t x = 0; x < width; ++x) {
           const double t0 = t0s[x], t1 = t1s[x];
           if (!(t1 > t0)) continue;
@@ -325,6 +298,32 @@ class AnalyticSolution final : public MethodSolution {
   }
 
  private:
+  // A point light's airlight over `batch` into `unit`, then accumulate(scale): unit times scale is
+  // the RGB airlight. Grey media take one batch at unit intensity scaled per channel (the airlight
+  // is linear in I), others one batch per channel.
+  template <class Accumulate>
+  void light_airlight(AirlightBatchFunction add_airlight, const AnalyticLight& light, const SegmentBatch& batch, std::vector<float>& unit,
+                      Accumulate accumulate) const {
+    const Vec3& p = light.position;
+    auto add = [&](int c, float intensity, const Rgb& scale) {
+      unit.assign(batch.count, 0.0f);
+      add_airlight(table_, {static_cast<float>(p.x), static_cast<float>(p.y), static_cast<float>(p.z), static_cast<float>(sigma_t_[c]),
+                            static_cast<float>(sigma_s_[c]), intensity},
+                   batch, unit.data());
+      accumulate(scale);
+    };
+    if (grey_) {
+      add(0, 1.0f, light.intensity);
+      return;
+    }
+    for (int c = 0; c < 3; ++c) {
+      if (sigma_s_[c] == 0.0 || light.intensity[c] == 0.0) continue;
+      Rgb only(0.0);
+      only[c] = 1.0;
+      add(c, static_cast<float>(light.intensity[c]), only);
+    }
+  }
+
   const Scene scene_;
   const std::vector<AnalyticLight> lights_;
   const std::unique_ptr<Medium> medium_;

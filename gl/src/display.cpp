@@ -6,6 +6,7 @@
 #include <haze/simd/phase_params.h>
 
 #include "api.h"
+#include "fullscreen.h"
 #include "march_shader.h"
 
 #include <algorithm>
@@ -21,41 +22,6 @@ namespace {
 
 // Texture units, one per sampler: samplers of different types may not share a unit.
 enum Unit : int { kDensityUnit = 0, kDepthUnit = 1, kPhaseUnit = 5, kMomentsUnit = 6, kWeightsUnit = 7, kVisibilityUnit = 8, kAtlasUnit = 12 };
-
-GLuint compile(const Api& gl, GLenum type, const char* source) {
-  const GLuint shader = gl.CreateShader(type);
-  gl.ShaderSource(shader, 1, &source, nullptr);
-  gl.CompileShader(shader);
-  GLint ok = 0;
-  gl.GetShaderiv(shader, GL_COMPILE_STATUS, &ok);
-  if (!ok) {
-    char log[4096] = {};
-    gl.GetShaderInfoLog(shader, sizeof log, nullptr, log);
-    gl.DeleteShader(shader);
-    throw Error(type == GL_VERTEX_SHADER ? "vertex shader" : "ray-march shader", log, "a shader this driver compiles");
-  }
-  return shader;
-}
-
-GLuint link_program(const Api& gl) {
-  const GLuint vs = compile(gl, GL_VERTEX_SHADER, internal::kFullscreenVertexShader);
-  const GLuint fs = compile(gl, GL_FRAGMENT_SHADER, internal::kMarchFragmentShader);
-  const GLuint program = gl.CreateProgram();
-  gl.AttachShader(program, vs);
-  gl.AttachShader(program, fs);
-  gl.LinkProgram(program);
-  gl.DeleteShader(vs);
-  gl.DeleteShader(fs);
-  GLint ok = 0;
-  gl.GetProgramiv(program, GL_LINK_STATUS, &ok);
-  if (!ok) {
-    char log[4096] = {};
-    gl.GetProgramInfoLog(program, sizeof log, nullptr, log);
-    gl.DeleteProgram(program);
-    throw Error("ray-march program", log, "a program this driver links");
-  }
-  return program;
-}
 
 float f(double v) { return static_cast<float>(v); }
 
@@ -81,12 +47,11 @@ struct VolumeDisplay::Impl {
   std::optional<grids::DomSolution> dom;
   int ms_groups = 0;
   std::optional<Camera> weights_camera;
-  GLuint program = 0, vao = 0, framebuffer = 0, target = 0;
-  int target_width = 0, target_height = 0;
+  GLuint program = 0, vao = 0;
+  internal::OffscreenTarget target;
 
   ~Impl() {
-    if (framebuffer) gl.DeleteFramebuffers(1, &framebuffer);
-    if (target) gl.DeleteTextures(1, &target);
+    target.release(gl);
     if (vao) gl.DeleteVertexArrays(1, &vao);
     if (program) gl.DeleteProgram(program);
   }
@@ -324,24 +289,6 @@ struct VolumeDisplay::Impl {
     weights_camera = camera;
   }
 
-  void ensure_target(int w, int h) {
-    if (w == target_width && h == target_height) return;
-    if (framebuffer) gl.DeleteFramebuffers(1, &framebuffer);
-    if (target) gl.DeleteTextures(1, &target);
-    gl.GenTextures(1, &target);
-    gl.BindTexture(GL_TEXTURE_2D, target);
-    gl.TexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, w, h, 0, GL_RGBA, GL_FLOAT, nullptr);
-    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-    gl.GenFramebuffers(1, &framebuffer);
-    gl.BindFramebuffer(GL_FRAMEBUFFER, framebuffer);
-    gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, target, 0);
-    const GLenum status = gl.CheckFramebufferStatus(GL_FRAMEBUFFER);
-    if (status != GL_FRAMEBUFFER_COMPLETE)
-      throw Error("display framebuffer", std::to_string(w) + " x " + std::to_string(h) + " RGBA32F incomplete", "a complete framebuffer");
-    target_width = w, target_height = h;
-  }
-
   void bind(int unit, GLenum type, GLuint texture) const {
     gl.ActiveTexture(static_cast<GLenum>(GL_TEXTURE0 + unit));
     gl.BindTexture(type, texture);
@@ -349,8 +296,7 @@ struct VolumeDisplay::Impl {
 
   void draw(const Camera& camera) {
     update_weights(camera);
-    ensure_target(camera.width_px, camera.height_px);
-    gl.BindFramebuffer(GL_FRAMEBUFFER, framebuffer);
+    target.bind(gl, camera.width_px, camera.height_px, "display");
     gl.Viewport(0, 0, camera.width_px, camera.height_px);
     gl.UseProgram(program);
     set_camera(camera);
@@ -406,7 +352,7 @@ VolumeDisplay::VolumeDisplay(const Scene& scene, const grids::ExtinctionVolume& 
   d.upload_depths(depths, {});
   d.upload_visibility(volume.density);
 
-  d.program = link_program(d.gl);
+  d.program = internal::fullscreen_program(d.gl, internal::kMarchFragmentShader, "ray-march");
   d.gl.GenVertexArrays(1, &d.vao);
   d.set_static_uniforms();
   internal::check(d.gl, "display set-up");
@@ -473,19 +419,7 @@ Image VolumeDisplay::render(const Camera& camera) {
                 "pinhole or orthographic for the GL display (a host's matrices and rays render through the CPU methods)");
   Impl& d = *impl_;
   d.draw(camera);
-  const int w = camera.width_px, h = camera.height_px;
-  std::vector<float> rgba(4 * static_cast<size_t>(w) * static_cast<size_t>(h));
-  d.gl.ReadBuffer(GL_COLOR_ATTACHMENT0);
-  d.gl.PixelStorei(GL_PACK_ALIGNMENT, 1);
-  d.gl.ReadPixels(0, 0, w, h, GL_RGBA, GL_FLOAT, rgba.data());
-  internal::check(d.gl, "display read-back");
-  Image image(w, h);
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) {
-      const float* p = &rgba[4 * (static_cast<size_t>(h - 1 - y) * static_cast<size_t>(w) + static_cast<size_t>(x))];
-      image.set(x, y, Rgb(p[0], p[1], p[2]));
-    }
-  return image;
+  return d.target.read(d.gl, "display read-back");
 }
 
 const Texture& VolumeDisplay::density() const { return *impl_->density; }

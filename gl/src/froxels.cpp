@@ -4,7 +4,7 @@
 #include <haze/core/error.h>
 
 #include "api.h"
-#include "march_shader.h"
+#include "fullscreen.h"
 
 #include <glm/matrix.hpp>
 
@@ -52,34 +52,18 @@ void main() {
 }
 )";
 
-GLuint compile(const Api& gl, GLenum type, const char* source) {
-  const GLuint shader = gl.CreateShader(type);
-  gl.ShaderSource(shader, 1, &source, nullptr);
-  gl.CompileShader(shader);
-  GLint ok = 0;
-  gl.GetShaderiv(shader, GL_COMPILE_STATUS, &ok);
-  if (!ok) {
-    char log[4096] = {};
-    gl.GetShaderInfoLog(shader, sizeof log, nullptr, log);
-    gl.DeleteShader(shader);
-    throw Error(type == GL_VERTEX_SHADER ? "vertex shader" : "froxel composite shader", log, "a shader this driver compiles");
-  }
-  return shader;
-}
-
 }  // namespace
 
 struct FroxelComposite::Impl {
   const Api& gl = internal::api();
   TexelFormat format;
-  GLuint program = 0, vao = 0, framebuffer = 0, target = 0;
-  int target_width = 0, target_height = 0;
+  GLuint program = 0, vao = 0;
+  internal::OffscreenTarget target;
   std::optional<Texture> inscatter, transmittance;
   FroxelGrid grid;
 
   ~Impl() {
-    if (framebuffer) gl.DeleteFramebuffers(1, &framebuffer);
-    if (target) gl.DeleteTextures(1, &target);
+    target.release(gl);
     if (vao) gl.DeleteVertexArrays(1, &vao);
     if (program) gl.DeleteProgram(program);
   }
@@ -89,21 +73,7 @@ struct FroxelComposite::Impl {
 FroxelComposite::FroxelComposite(TexelFormat format) : impl_(std::make_unique<Impl>()) {
   Impl& d = *impl_;
   d.format = format;
-  const GLuint vs = compile(d.gl, GL_VERTEX_SHADER, internal::kFullscreenVertexShader);
-  const GLuint fs = compile(d.gl, GL_FRAGMENT_SHADER, kCompositeShader);
-  d.program = d.gl.CreateProgram();
-  d.gl.AttachShader(d.program, vs);
-  d.gl.AttachShader(d.program, fs);
-  d.gl.LinkProgram(d.program);
-  d.gl.DeleteShader(vs);
-  d.gl.DeleteShader(fs);
-  GLint ok = 0;
-  d.gl.GetProgramiv(d.program, GL_LINK_STATUS, &ok);
-  if (!ok) {
-    char log[4096] = {};
-    d.gl.GetProgramInfoLog(d.program, sizeof log, nullptr, log);
-    throw Error("froxel composite program", log, "a program this driver links");
-  }
+  d.program = internal::fullscreen_program(d.gl, kCompositeShader, "froxel composite");
   d.gl.GenVertexArrays(1, &d.vao);
   d.gl.UseProgram(d.program);
   d.gl.Uniform1i(d.at("host_colour"), 0);
@@ -154,33 +124,9 @@ void FroxelComposite::draw(unsigned colour, unsigned depth, const glm::dmat4& pr
 
 Image FroxelComposite::render(unsigned colour, unsigned depth, const glm::dmat4& projection, int width, int height) {
   Impl& d = *impl_;
-  if (width != d.target_width || height != d.target_height) {
-    if (d.framebuffer) d.gl.DeleteFramebuffers(1, &d.framebuffer);
-    if (d.target) d.gl.DeleteTextures(1, &d.target);
-    d.gl.GenTextures(1, &d.target);
-    d.gl.BindTexture(GL_TEXTURE_2D, d.target);
-    d.gl.TexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, width, height, 0, GL_RGBA, GL_FLOAT, nullptr);
-    d.gl.GenFramebuffers(1, &d.framebuffer);
-    d.gl.BindFramebuffer(GL_FRAMEBUFFER, d.framebuffer);
-    d.gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, d.target, 0);
-    if (d.gl.CheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
-      throw Error("froxel composite framebuffer", std::to_string(width) + " x " + std::to_string(height) + " RGBA32F incomplete", "a complete framebuffer");
-    d.target_width = width, d.target_height = height;
-  }
-  d.gl.BindFramebuffer(GL_FRAMEBUFFER, d.framebuffer);
+  d.target.bind(d.gl, width, height, "froxel composite");
   draw(colour, depth, projection, width, height);
-  std::vector<float> rgba(4 * static_cast<size_t>(width) * static_cast<size_t>(height));
-  d.gl.ReadBuffer(GL_COLOR_ATTACHMENT0);
-  d.gl.PixelStorei(GL_PACK_ALIGNMENT, 1);
-  d.gl.ReadPixels(0, 0, width, height, GL_RGBA, GL_FLOAT, rgba.data());
-  internal::check(d.gl, "froxel composite read-back");
-  Image image(width, height);
-  for (int y = 0; y < height; ++y)
-    for (int x = 0; x < width; ++x) {
-      const float* p = &rgba[4 * (static_cast<size_t>(height - 1 - y) * static_cast<size_t>(width) + static_cast<size_t>(x))];
-      image.set(x, y, Rgb(p[0], p[1], p[2]));
-    }
-  return image;
+  return d.target.read(d.gl, "froxel composite read-back");
 }
 
 const Texture& FroxelComposite::inscatter() const { return *impl_->inscatter; }

@@ -10,6 +10,8 @@
 #include <glm/trigonometric.hpp>
 #include <gtest/gtest.h>
 
+#include "../methods/fog_box.h"
+
 #include <limits>
 
 namespace haze::gl {
@@ -18,14 +20,7 @@ namespace {
 TEST(FroxelComposite, MatchesTheCpuComposite) {
   HeadlessContext context;
   constexpr int w = 48, h = 32;
-  Scene scene;
-  MediumDesc medium;
-  medium.bounds = {Vec3(-2.0, -1.0, -2.0), Vec3(2.0, 2.0, 2.0)};
-  medium.sigma_t = Rgb(0.4, 0.5, 0.6);
-  medium.albedo = Rgb(0.8);
-  medium.phase = PhaseFunction::henyey_greenstein(0.3);
-  scene.medium = medium;
-  scene.lights.push_back(PointLight{Vec3(0.5, 2.5, 0.3), Rgb(4.0, 3.5, 3.0)});
+  Scene scene = haze::testing::fog_box(w, h, Vec3(0.5, 2.5, 0.3));
   const glm::dmat4 view = glm::lookAt(Vec3(0.2, 0.6, 5.0), Vec3(0.0, -0.4, 0.0), Vec3(0.0, 1.0, 0.0));
   const glm::dmat4 projection = glm::perspective(glm::radians(40.0), double(w) / h, 0.1, 100.0);
   const Camera camera = Camera::from_matrices(view, projection, w, h);

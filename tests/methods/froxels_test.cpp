@@ -8,6 +8,8 @@
 
 #include <gtest/gtest.h>
 
+#include "fog_box.h"
+
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -15,20 +17,7 @@
 namespace haze {
 namespace {
 
-// Homogeneous fog in a box, a point light; the host's floor at y = -1 given as a depth buffer.
-Scene fog(int width, int height, const Vec3& light = Vec3(0.5, 1.2, 0.3)) {
-  Scene scene;
-  scene.camera.position = Vec3(0.2, 0.6, 5.0), scene.camera.look_at = Vec3(0.0, -0.4, 0.0);
-  scene.camera.width_px = width, scene.camera.height_px = height;
-  MediumDesc medium;
-  medium.bounds = {Vec3(-2.0, -1.0, -2.0), Vec3(2.0, 2.0, 2.0)};
-  medium.sigma_t = Rgb(0.4, 0.5, 0.6);
-  medium.albedo = Rgb(0.8);
-  medium.phase = PhaseFunction::henyey_greenstein(0.3);
-  scene.medium = medium;
-  scene.lights.push_back(PointLight{light, Rgb(4.0, 3.5, 3.0)});
-  return scene;
-}
+using testing::fog_box;
 
 std::vector<float> floor_depth(const Camera& camera) {
   std::vector<float> depth;
@@ -50,7 +39,7 @@ TEST(Froxels, HoldTheLayersAtColumnsAndBoundaries) {
   grids::register_methods();
   particles::register_methods();
   for (const std::string method : {"analytic", "unbounded analytic", "propagation", "dom", "network"}) {
-    Scene scene = method == "network" ? Scene::load(std::string(HAZE_SOURCE_DIR) + "/examples/particle_cloud.json") : fog(12, 8);
+    Scene scene = method == "network" ? Scene::load(std::string(HAZE_SOURCE_DIR) + "/examples/particle_cloud.json") : fog_box(12, 8);
     if (method == "unbounded analytic") scene.medium->bounds = Aabb{};
     scene.camera.width_px = 12, scene.camera.height_px = 8;
     RenderOptions options;
@@ -79,7 +68,7 @@ TEST(Froxels, HoldTheLayersAtColumnsAndBoundaries) {
 // the view: the error falls as the froxels shrink (figures in docs/HOST.md; a light in view puts a
 // glow narrower than a froxel on screen, which only finer columns resolve).
 TEST(Froxels, CompositeConvergesToThePerPixelLayers) {
-  const Scene scene = fog(96, 64, Vec3(0.5, 2.5, 0.3));
+  const Scene scene = fog_box(96, 64, Vec3(0.5, 2.5, 0.3));
   const std::vector<float> depth = floor_depth(scene.camera);
   const Solution solution = prepare(scene, "analytic");
   const RenderResult exact = solution.render(View{scene.camera, depth, true});
@@ -104,7 +93,7 @@ TEST(Froxels, CompositeConvergesToThePerPixelLayers) {
 }
 
 TEST(Froxels, BadGridsAreClearErrors) {
-  const Scene scene = fog(8, 8);
+  const Scene scene = fog_box(8, 8);
   const Solution solution = prepare(scene, "analytic");
   auto field = [&](const FroxelGrid& grid) {
     try {

@@ -11,6 +11,8 @@
 #include <glm/trigonometric.hpp>
 #include <gtest/gtest.h>
 
+#include "fog_box.h"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -21,17 +23,8 @@ namespace {
 // Homogeneous fog in a box over a floor at y = -1, a point light above it; with `sphere`, a ball
 // in the fog (which shadows it).
 Scene fog_scene(bool floor, bool black_floor, bool sphere) {
-  Scene scene;
-  scene.camera.position = Vec3(0.2, 0.6, 5.0), scene.camera.look_at = Vec3(0.0, -0.4, 0.0);
-  scene.camera.width_px = 24, scene.camera.height_px = 16;
-  MediumDesc medium;
-  medium.bounds = {Vec3(-2.0, -1.0, -2.0), Vec3(2.0, 2.0, 2.0)};
-  medium.sigma_t = Rgb(0.4, 0.5, 0.6);
-  medium.albedo = Rgb(0.8);
-  medium.phase = PhaseFunction::henyey_greenstein(0.3);
-  scene.medium = medium;
+  Scene scene = testing::fog_box(24, 16);
   scene.background = Rgb(0.05, 0.1, 0.2);
-  scene.lights.push_back(PointLight{Vec3(0.5, 1.2, 0.3), Rgb(4.0, 3.5, 3.0)});
   const Rgb kd = black_floor ? Rgb(0.0) : Rgb(0.5), ks = black_floor ? Rgb(0.0) : Rgb(0.2);
   if (floor) scene.surfaces.push_back({Plane{Vec3(0.0, -1.0, 0.0), Vec3(0.0, 1.0, 0.0)}, kd, ks, 20.0});
   if (sphere) scene.surfaces.push_back({Sphere{Vec3(0.3, -0.4, 0.0), 0.5}, Rgb(0.6, 0.3, 0.2), Rgb(0.0), 1.0});

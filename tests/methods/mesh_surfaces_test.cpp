@@ -7,6 +7,8 @@
 
 #include <gtest/gtest.h>
 
+#include "fog_box.h"
+
 #include <cmath>
 #include <cstdio>
 
@@ -24,19 +26,11 @@ Surface floor_mesh(double y, double half, const Surface& like) {
 }
 
 Scene fog_over_floor() {
-  Scene scene;
+  Scene scene = testing::fog_box(32, 24);
   // Looking down enough that the floor fills the view up to the top row (the mesh's square ends
   // 100 away, the plane does not).
-  scene.camera.position = Vec3(0.2, 0.6, 5.0), scene.camera.look_at = Vec3(0.0, -1.5, 0.0);
-  scene.camera.width_px = 32, scene.camera.height_px = 24;
-  MediumDesc medium;
-  medium.bounds = {Vec3(-2.0, -1.0, -2.0), Vec3(2.0, 2.0, 2.0)};
-  medium.sigma_t = Rgb(0.4, 0.5, 0.6);
-  medium.albedo = Rgb(0.8);
-  medium.phase = PhaseFunction::henyey_greenstein(0.3);
-  scene.medium = medium;
+  scene.camera.look_at = Vec3(0.0, -1.5, 0.0);
   scene.background = Rgb(0.05, 0.1, 0.2);
-  scene.lights.push_back(PointLight{Vec3(0.5, 1.2, 0.3), Rgb(4.0, 3.5, 3.0)});
   scene.surfaces.push_back({Plane{Vec3(0.0, -1.0, 0.0), Vec3(0.0, 1.0, 0.0)}, Rgb(0.5), Rgb(0.2), 20.0});
   return scene;
 }
