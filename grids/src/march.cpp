@@ -216,7 +216,74 @@ void march_row(const Marcher& m, const simd::MarchVolume& v, const View& view, i
   }
 }
 
+// Row y's stretches between consecutive distances, one packet, chained per ray (march_distances).
+void march_row_distances(const Marcher& m, const simd::MarchVolume& v, const View& view, std::span<const double> distances, int y,
+                         std::vector<PixelLayers>& out) {
+  const Camera& camera = view.camera;
+  const auto width = static_cast<size_t>(camera.width_px), n = distances.size();
+  std::vector<Ray> rays(width);
+  camera.row_rays(y, rays.data());
+  std::vector<float> in;
+  std::vector<size_t> owner;  // the (x, k) of each segment, as x * n + k
+  std::vector<std::array<float, 9>> segments;
+  for (size_t x = 0; x < width; ++x) {
+    const Hit hit = m.hit(rays[x]);
+    double a = 0.0, b = hit.t;
+    if (!m.volume.density.bounds().clip(rays[x], a, b) || !(b > a)) continue;
+    for (size_t k = 0; k < n; ++k) {
+      const double from = std::max(a, k == 0 ? 0.0 : distances[k - 1]), to = std::min(b, distances[k]);
+      if (!(to > from)) continue;
+      const int count = static_cast<int>(std::ceil((to - from) / m.step));
+      const Ray& r = rays[x];
+      segments.push_back({static_cast<float>(r.origin.x), static_cast<float>(r.origin.y), static_cast<float>(r.origin.z),
+                          static_cast<float>(r.direction.x), static_cast<float>(r.direction.y), static_cast<float>(r.direction.z),
+                          static_cast<float>(from), static_cast<float>((to - from) / count), static_cast<float>(count)});
+      owner.push_back(x * n + k);
+    }
+  }
+  const size_t count = segments.size();
+  std::vector<float> packed(9 * count), result(6 * count, 0.0f);
+  for (size_t i = 0; i < count; ++i)
+    for (size_t a = 0; a < 9; ++a) packed[a * count + i] = segments[i][a];
+  auto row = [&](std::vector<float>& buffer, size_t a) { return buffer.data() + a * count; };
+  simd::RayPacket packet{row(packed, 0), row(packed, 1), row(packed, 2), row(packed, 3), row(packed, 4), row(packed, 5), row(packed, 6), row(packed, 7),
+                         row(packed, 8), count, {row(result, 0), row(result, 1), row(result, 2)}, {row(result, 3), row(result, 4), row(result, 5)}};
+  if (count > 0) simd::march_rays(v, m.volume.phase, packet);
+  // Each segment's own L and T, then chained along the ray.
+  std::vector<PixelLayers> own(width * n);
+  for (size_t i = 0; i < count; ++i)
+    for (int c = 0; c < 3; ++c) {
+      const size_t channel = v.channels == 1 ? 0 : static_cast<size_t>(c);
+      own[owner[i]].inscatter[c] = static_cast<double>(row(result, channel)[i]);
+      own[owner[i]].transmittance[c] = static_cast<double>(row(result, 3 + channel)[i]);
+    }
+  for (size_t x = 0; x < width; ++x) {
+    Rgb l(0.0), t(1.0);
+    for (size_t k = 0; k < n; ++k) {
+      const PixelLayers& s = own[x * n + k];
+      l += t * s.inscatter, t *= s.transmittance;
+      out[(static_cast<size_t>(y) * width + x) * n + k] = {l, t, Rgb(0.0)};
+    }
+  }
+}
+
 }  // namespace
+
+std::optional<std::vector<PixelLayers>> march_distances(const Scene& scene, const ExtinctionVolume& volume, const std::vector<DenseGrid>& depths,
+                                                        const MarchSettings& settings, const RenderOptions& options, const View& view,
+                                                        std::span<const double> distances, const std::vector<DenseGrid>* visibility) {
+  const Vec3 h = volume.density.cell_size();
+  const Marcher marcher(scene, volume, depths, settings.step_cells * std::min({h.x, h.y, h.z}), options.threads, visibility, false);
+  std::vector<simd::MarchLight> lights;
+  simd::MarchVolume simd_view;
+  if (settings.scalar || !simd_volume(marcher, lights, simd_view)) return std::nullopt;
+  const Camera& camera = view.camera;
+  std::vector<PixelLayers> out(static_cast<size_t>(camera.width_px) * static_cast<size_t>(camera.height_px) * distances.size());
+  parallel_for(camera.height_px, options.threads, 1, [&](long long y0, long long y1) {
+    for (auto y = static_cast<int>(y0); y < y1; ++y) march_row_distances(marcher, simd_view, view, distances, y, out);
+  });
+  return out;
+}
 
 Image march_image(const Scene& scene, const ExtinctionVolume& volume, const std::vector<DenseGrid>& depths,
                   const MarchSettings& settings, const RenderOptions& options, const std::vector<DenseGrid>* visibility) {

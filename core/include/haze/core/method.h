@@ -140,8 +140,8 @@ class Solution {
   RenderResult render(const RenderOptions& options = {}) const { return render(View{scene().camera}, options); }
   // L_in and T along each of the view's rays (its depth ignored; Haze's own surfaces still end
   // them) to each of `distances` (ascending, > 0): out[ray * distances.size() + k]. The method's
-  // one-pass path where it has one (analytic: point lights, no surfaces), else one layered render
-  // per distance. What build_froxels (froxels.h) calls.
+  // one-pass path where it has one (analytic with point lights and no surfaces; propagation), else
+  // one layered render per distance. What build_froxels (froxels.h) calls.
   std::vector<PixelLayers> render_distances(const View& view, std::span<const double> distances, const RenderOptions& options = {}) const;
   // Redoes only what the change reaches (the method says what in the report); a change nothing
   // can be reused for prepares again (report.rebuilt). The scene's camera may change freely: it
