@@ -64,7 +64,7 @@ class TriangleMesh {
  private:
   TriangleMesh() = default;
   void build(const std::string& field);
-  std::vector<Vec3f> positions_;  // one float of padding after the last (Embree reads 16 bytes)
+  std::vector<Vec3f> positions_;  // as placed (Embree holds its own padded copy)
   std::vector<std::uint32_t> indices_;
   Aabb bounds_;
   struct Embree;
