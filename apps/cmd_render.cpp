@@ -5,6 +5,7 @@
 #include <haze/core/auto.h>
 #include <haze/core/error.h>
 #include <haze/core/stopwatch.h>
+#include <haze/vdb/vdb.h>
 
 #include <optional>
 #include <iostream>
@@ -42,8 +43,8 @@ nlohmann::json save_result(const RenderResult& result, const std::string& method
 namespace {
 
 struct RenderArgs {
-  std::string scene, method, out, display = "cpu", depth;
-  int threads = 0;
+  std::string scene, method, out, display = "cpu", depth, fields;
+  int threads = 0, fields_resolution = 64;
   bool json = false, no_png = false, no_cache = false, explain = false, layers = false;
   std::optional<double> tolerance;
   std::vector<std::string> set;
@@ -107,7 +108,19 @@ int run(const RenderArgs& a) {
   if (a.display == "gl" && (a.layers || !depth.empty()))
     throw Error("--display", "gl", "cpu with --layers or --depth (the GL display renders the image only)");
   const View view{scene.camera, depth, a.layers};
-  RenderResult result = a.display == "gl" ? render_gl(scene, method, options) : render(scene, method, options, view);
+  if (a.display == "gl" && !a.fields.empty()) throw Error("--display", "gl", "cpu with --fields");
+  RenderResult result;
+  std::vector<std::string> fields;
+  if (!a.fields.empty()) {  // one solution for the image and the fields (prepared for any view)
+    const Solution solution = prepare(scene, method, options);
+    RenderOptions render_options;
+    render_options.threads = options.threads;
+    render_options.progress = options.progress;
+    result = solution.render(view, render_options);
+    fields = vdb::write_fields(a.fields, solution, a.fields_resolution, options.threads);
+  } else {
+    result = a.display == "gl" ? render_gl(scene, method, options) : render(scene, method, options, view);
+  }
   const double seconds = watch.seconds();
   // The method's warnings (method auto's: those of the method it chose).
   for (const nlohmann::json* stats : {&result.stats, result.stats.contains("method_stats") ? &result.stats["method_stats"] : nullptr})
@@ -116,6 +129,7 @@ int run(const RenderArgs& a) {
   std::filesystem::path out = a.out.empty() ? std::filesystem::path(a.scene).stem().string() + "_" + method + ".exr" : a.out;
   auto summary = save_result(result, method, seconds, out, !a.no_png);
   summary["scene"] = a.scene;
+  if (!a.fields.empty()) summary["fields"] = {{"output", a.fields}, {"grids", fields}, {"resolution", a.fields_resolution}};
   if (a.json) {
     std::cout << summary.dump(2) << "\n";
   } else {
@@ -150,6 +164,8 @@ Command add_render(CLI::App& app) {
       ->check(CLI::ExistingFile);
   sub->add_flag("--layers", a->layers, "Also write the layers a host composites, inscatter.R/G/B, transmittance.R/G/B and surface.R/G/B "
                                        "(R/G/B = inscatter + transmittance * surface)");
+  sub->add_option("--fields", a->fields, "Also write the solution's fields (fluence, transmittance per light) as OpenVDB grids to this .vdb file");
+  sub->add_option("--fields-resolution", a->fields_resolution, "Voxels along the medium's longest side for --fields (default 64)")->check(CLI::Range(2, 1024));
   sub->add_flag("--json", a->json, "Print a JSON summary");
   sub->add_flag("--no-png", a->no_png, "Do not write the PNG preview");
   sub->add_flag("--no-cache", a->no_cache, "Rebuild precomputed tables instead of reading them from the cache");

@@ -3,6 +3,7 @@
 #include <haze/grids/methods.h>
 #include <haze/particles/methods.h>
 #include <haze/simd/airlight_batch.h>
+#include <haze/vdb/vdb.h>
 
 namespace haze::app {
 
@@ -10,6 +11,7 @@ void register_all_methods() {
   simd::install();
   grids::register_methods();
   particles::register_methods();
+  vdb::register_readers();
 }
 
 }  // namespace haze::app

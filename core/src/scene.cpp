@@ -152,12 +152,16 @@ class Object {
   }
 
   // The "type" field, one of `types`; `fallback` when absent, or required when fallback is null.
-  std::string type(std::initializer_list<std::string_view> types, const char* fallback = nullptr) const {
-    const std::string expected = "one of " + join(types, "\"");
+  std::string type(std::initializer_list<std::string_view> types, const char* fallback = nullptr,
+                   const std::vector<std::string>& more = {}) const {
+    std::string expected = "one of " + join(types, "\"");
+    for (const std::string& t : more) expected += ", \"" + t + "\"";
     const json* v = find("type");
     if (!v && !fallback) throw Error(at("type"), "missing", expected);
     auto known = [&](const json& t) {
-      return t.is_string() && std::find(types.begin(), types.end(), t.get_ref<const std::string&>()) != types.end();
+      if (!t.is_string()) return false;
+      const std::string& name = t.get_ref<const std::string&>();
+      return std::find(types.begin(), types.end(), name) != types.end() || std::find(more.begin(), more.end(), name) != more.end();
     };
     if (v && !known(*v)) throw Error(at("type"), text(*v), expected);
     type_ = v ? v->get<std::string>() : fallback;
@@ -314,8 +318,33 @@ GridDensity read_grid(const Object& o, const fs::path& base_dir) {
   return grid;
 }
 
-Density read_density(const Object& o, bool bounded, const fs::path& base_dir) {
-  std::string type = o.type({"constant", "rbf", "grid"});
+struct MediumDensityRegistry {
+  std::mutex mutex;
+  std::map<std::string, MediumDensityReader> readers;
+};
+MediumDensityRegistry& medium_densities() {
+  static MediumDensityRegistry instance;
+  return instance;
+}
+
+Density read_density(const json& j, const std::string& path, bool bounded, const fs::path& base_dir) {
+  const Object o(j, path);
+  std::vector<std::string> modules;
+  MediumDensityReader module_reader;
+  {
+    std::lock_guard lock(medium_densities().mutex);
+    for (const auto& [name, reader] : medium_densities().readers) {
+      modules.push_back(name);
+      if (const json* t = o.find("type"); t && t->is_string() && t->get_ref<const std::string&>() == name) module_reader = reader;
+    }
+  }
+  std::string type = o.type({"constant", "rbf", "grid"}, nullptr, modules);
+  if (module_reader) {
+    if (bounded)
+      throw Error("medium.bounds", "given with a density of type \"" + type + "\"",
+                  "no bounds: the " + type + " data places the medium in the world itself");
+    return module_reader(j, path, base_dir);
+  }
   if (type == "constant") {
     o.allow({"type", "value"});
     return ConstantDensity{o.number("value", 1.0, kNonNegative)};
@@ -387,8 +416,7 @@ MediumDesc read_medium(const Object& o, const fs::path& base_dir) {
   o.allow({"bounds", "density", "sigma_t", "albedo", "phase"});
   MediumDesc m;
   if (const json* b = o.find("bounds")) m.bounds = read_bounds(*b, o.at("bounds"));
-  m.density = read_density(Object(o.need("density", "a density object with a \"type\""), o.at("density")),
-                           m.bounds.bounded(), base_dir);
+  m.density = read_density(o.need("density", "a density object with a \"type\""), o.at("density"), m.bounds.bounded(), base_dir);
   m.sigma_t = o.color("sigma_t", kNonNegative);
   m.albedo = o.color("albedo", Rgb(0.8), kUnit);
   if (const json* p = o.find("phase")) m.phase = read_phase(Object(*p, o.at("phase")));
@@ -542,6 +570,13 @@ void register_density(const std::string& type, DensityReader reader) {
     throw Error("density.type", "\"" + type + "\"", "a name no scene field has, and a reader");
   std::lock_guard lock(densities().mutex);
   densities().readers[type] = std::move(reader);
+}
+
+void register_medium_density(const std::string& type, MediumDensityReader reader) {
+  if (type.empty() || !reader || type == "constant" || type == "rbf" || type == "grid")
+    throw Error("medium.density.type", "\"" + type + "\"", "a name no built-in density type has, and a reader");
+  std::lock_guard lock(medium_densities().mutex);
+  medium_densities().readers[type] = std::move(reader);
 }
 
 std::vector<std::string> registered_densities() {

@@ -119,7 +119,9 @@ ExtinctionVolume make_extinction_volume(const Scene& scene, const CellCount& cel
     if (report) report->truncation_bound = injected.truncation_bound;
   } else if (const auto* field = std::get_if<FieldDensity>(&desc.density)) {
     if (!field->field) throw Error("medium.density", "a " + field->type + " field without data", "a density field");
-    const GridDensity grid = sample_grid(*field->field, field->grid_resolution > 0 ? field->grid_resolution : cells.per_axis() ? std::ranges::max(cells.axes) : cells.longest, threads);
+    int n = cells.per_axis() ? std::ranges::max(cells.axes) : cells.longest;
+    if (field->max_resolution > 0) n = std::min(n, std::max(2, field->max_resolution));
+    const GridDensity grid = sample_grid(*field->field, field->grid_resolution > 0 ? field->grid_resolution : n, threads);
     volume.density = DenseGrid(grid.resolution, field->field->bounds());
     volume.density.values() = grid.values;
   } else if (const auto* grid = std::get_if<GridDensity>(&desc.density)) {

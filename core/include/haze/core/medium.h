@@ -64,8 +64,10 @@ class DensityField {
 struct FieldDensity {
   std::string type;  // what supplies it, for messages ("particles")
   std::shared_ptr<const DensityField> field;
-  // Cells along the longest side when a grid method samples it (0: the method's own resolution).
+  // Cells along the longest side when a grid method samples it (0: the method's own resolution,
+  // but no more than max_resolution where that is set: the data's own voxels, say).
   int grid_resolution = 0;
+  int max_resolution = 0;
 };
 
 using Density = std::variant<ConstantDensity, RbfDensity, GridDensity, FieldDensity>;

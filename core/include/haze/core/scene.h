@@ -37,6 +37,13 @@ using DensityReader = std::function<MediumDesc(const nlohmann::json& block, cons
 void register_density(const std::string& type, DensityReader reader);
 std::vector<std::string> registered_densities();
 
+// A density type of the medium block a module supplies (`"medium": {"density": {"type": "vdb",
+// ...}}`: the vdb module registers it): the density object at `path` (e.g. "medium.density") into
+// a Density, usually the module's FieldDensity, which places itself in the world (the medium then
+// takes no `bounds`). A second registration under the same type replaces the first.
+using MediumDensityReader = std::function<Density(const nlohmann::json& density, const std::string& path, const std::filesystem::path& directory)>;
+void register_medium_density(const std::string& type, MediumDensityReader reader);
+
 struct Scene {
   Camera camera;
   // The medium: from `medium`, or from the block of a module's density type (`particles`).
