@@ -146,8 +146,11 @@ AutoChoice choose(const Scene& scene, double tolerance) {
     c.why.push_back(format("optical diameter %.2f, albedo %.2f: estimated multiple-scattering share %.0f%%", f.optical_diameter, f.albedo,
                            100.0 * f.multiple_share));
   std::vector<std::pair<std::string, AutoOffer>> offers;
-  for (const MethodInfo& info : registered_methods())
-    if (info.offer) offers.emplace_back(info.name, info.offer(f, tolerance));
+  const bool emits = scene.medium->emission.emits();
+  for (const MethodInfo& info : registered_methods()) {
+    if (!info.offer) continue;
+    offers.emplace_back(info.name, emits && !info.emission ? AutoOffer{false, {}, 0.0, "does not render emission"} : info.offer(f, tolerance));
+  }
   const auto best = std::min_element(offers.begin(), offers.end(), [](const auto& a, const auto& b) {
     if (a.second.offered != b.second.offered) return a.second.offered;
     return a.second.expected_seconds < b.second.expected_seconds;
@@ -170,6 +173,7 @@ AutoChoice choose(const Scene& scene, double tolerance) {
 MethodInfo internal::auto_info() {
   MethodInfo info;
   info.name = "auto";
+  info.emission = true;  // only methods that render emission bid for an emitting medium
   info.summary = "the cheapest registered method and settings expected to meet --set tolerance=T (0.05), chosen from the scene alone";
   info.create = [] { return std::make_unique<AutoMethod>(); };
   info.handles = {"what the chosen method handles", "what the chosen method handles", "what the chosen method handles", true};

@@ -1,3 +1,4 @@
+#include <haze/core/blackbody.h>
 #include <haze/core/error.h>
 #include <haze/core/grid_walk.h>
 #include <haze/core/majorant.h>
@@ -22,6 +23,21 @@ double Medium::density_integral(const Vec3& a, const Vec3& b) const {
   double sum = density(ray.at(t0)) + density(ray.at(t1));
   for (int i = 1; i < n; ++i) sum += (i % 2 ? 4.0 : 2.0) * density(ray.at(t0 + i * h));
   return sum * h / 3.0;
+}
+
+std::shared_ptr<const DensityField> DensityField::sibling(const std::string& name, const std::string& field) const {
+  throw Error(field, "\"" + name + "\"", "no grid name: this density has no other grids (a vdb density's file has)");
+}
+
+Rgb Medium::emission(const Vec3& x) const {
+  Rgb e(0.0);
+  if (!emission_.emits() || !bounds().contains(x)) return e;
+  if (emission_.strength > 0.0) e += emission_.strength * emission_.color * (emission_.grid ? emission_.grid->density(x) : density(x));
+  if (emission_.blackbody_intensity > 0.0) {
+    const double T = emission_.temperature * (emission_.temperature_grid ? emission_.temperature_grid->density(x) : 1.0);
+    if (T > 0.0) e += emission_.blackbody_intensity * emission_.blackbody_tint * blackbody_color(T) * (kBlackbodySigma * T * T * T * T);
+  }
+  return e;
 }
 
 std::shared_ptr<const MajorantGrid> Medium::make_majorants() const { return std::make_shared<MajorantGrid>(*this); }
@@ -213,6 +229,18 @@ void check_medium(const MediumDesc& desc, const std::string& path) {
   if (!finite_non_negative(desc.sigma_t)) throw Error(path + ".sigma_t", text(desc.sigma_t), "finite values >= 0");
   if (!(finite_non_negative(desc.albedo) && desc.albedo.r <= 1.0 && desc.albedo.g <= 1.0 && desc.albedo.b <= 1.0))
     throw Error(path + ".albedo", text(desc.albedo), "values in [0, 1]");
+  const Emission& e = desc.emission;
+  auto check = [&](double v, const std::string& field, double max, const char* expected) {
+    if (!(std::isfinite(v) && v >= 0.0 && v <= max)) throw Error(path + field, to_text(v), expected);
+  };
+  check(e.strength, ".emission.strength", kInfinity, "a finite strength >= 0");
+  if (!finite_non_negative(e.color)) throw Error(path + ".emission.color", text(e.color), "finite values >= 0");
+  check(e.blackbody_intensity, ".blackbody.intensity", kInfinity, "a finite intensity >= 0");
+  if (!finite_non_negative(e.blackbody_tint)) throw Error(path + ".blackbody.tint", text(e.blackbody_tint), "finite values >= 0");
+  check(e.temperature, ".blackbody.temperature", 1e6, "kelvin in [0, 1e6]");
+  if (e.emits() && unbounded && !(desc.sigma_t.r > 0.0 && desc.sigma_t.g > 0.0 && desc.sigma_t.b > 0.0) &&
+      !std::holds_alternative<RbfDensity>(desc.density) && !std::holds_alternative<FieldDensity>(desc.density))
+    throw Error(path + ".sigma_t", text(desc.sigma_t), "> 0 in every channel for an unbounded medium that emits (else its radiance is infinite)");
   if (const auto* c = std::get_if<ConstantDensity>(&desc.density)) {
     if (!(std::isfinite(c->value) && c->value >= 0.0)) throw Error(path + ".density.value", to_text(c->value), "a finite density >= 0");
   } else if (const auto* rbf = std::get_if<RbfDensity>(&desc.density)) {
@@ -266,13 +294,19 @@ GridDensity sample_grid(const DensityField& field, int resolution, int threads) 
 }
 
 std::unique_ptr<Medium> make_medium(const MediumDesc& desc) {
-  if (auto* c = std::get_if<ConstantDensity>(&desc.density)) return std::make_unique<ConstantMedium>(desc, c->value);
-  if (auto* r = std::get_if<RbfDensity>(&desc.density)) return std::make_unique<RbfMedium>(desc, *r);
-  if (auto* f = std::get_if<FieldDensity>(&desc.density)) {
+  std::unique_ptr<Medium> medium;
+  if (auto* c = std::get_if<ConstantDensity>(&desc.density)) {
+    medium = std::make_unique<ConstantMedium>(desc, c->value);
+  } else if (auto* r = std::get_if<RbfDensity>(&desc.density)) {
+    medium = std::make_unique<RbfMedium>(desc, *r);
+  } else if (auto* f = std::get_if<FieldDensity>(&desc.density)) {
     if (!f->field) throw Error("medium.density", "a " + f->type + " field without data", "a density field");
-    return std::make_unique<FieldMedium>(desc, f->field);
+    medium = std::make_unique<FieldMedium>(desc, f->field);
+  } else {
+    medium = std::make_unique<GridMedium>(desc, std::get<GridDensity>(desc.density));
   }
-  return std::make_unique<GridMedium>(desc, std::get<GridDensity>(desc.density));
+  medium->emission_ = desc.emission;
+  return medium;
 }
 
 }  // namespace haze

@@ -1,5 +1,5 @@
 // Method "quadrature": single scattering by deterministic numerical quadrature, for any Medium.
-// L = integral_{t0}^{t1} T(o, x) sigma_s(x) sum_lights p(wi . wo) E_light(x) T(x, light) dt
+// L = integral_{t0}^{t1} T(o, x) [L_e(x) + sigma_s(x) sum_lights p(wi . wo) E_light(x) T(x, light)] dt
 //     + T(o, t1) L_surface_or_escape,
 // with Gauss-Legendre panels along the view ray (graded geometrically toward each point light's
 // closest approach, where the integrand peaks), sky in-scattering over a Fibonacci DirectionSet, and surface direct
@@ -119,9 +119,10 @@ struct Context {
           Vec3 x = ray.at(a + h * (0.5 + 0.5 * gl_nodes[q]));
           view_t *= glm::exp(-medium->sigma_t_scale() * medium->density_integral(previous, x));
           previous = x;
-          Rgb sigma_s = medium->sigma_s(x);
-          if (sigma_s == Rgb(0.0)) continue;
-          radiance += 0.5 * h * gl_weights[q] * view_t * sigma_s * in_scattered(x, wo);
+          const Rgb sigma_s = medium->sigma_s(x);
+          const Rgb emitted = medium->emits() ? medium->emission(x) : Rgb(0.0);  // L_e: the source's own term
+          if (sigma_s == Rgb(0.0) && emitted == Rgb(0.0)) continue;
+          radiance += 0.5 * h * gl_weights[q] * view_t * (emitted + (sigma_s == Rgb(0.0) ? Rgb(0.0) : sigma_s * in_scattered(x, wo)));
         }
       }
       view_t *= glm::exp(-medium->sigma_t_scale() * medium->density_integral(previous, ray.at(t1)));
@@ -197,6 +198,7 @@ MethodInfo quadrature_info() {
     return AutoOffer{true, {{"steps", 128}}, 0.06, "single scattering of any medium and light (thin_haze: 0.056 s at 128 steps)"};
   };
   info.single_scattering = true;
+  info.emission = true;
   return info;
 }
 

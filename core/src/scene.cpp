@@ -412,14 +412,47 @@ PhaseFunction read_phase(const Object& o) {
   return make_phase(o, [&] { return PhaseFunction::tabulated(std::move(table)); });
 }
 
+// A grid named by an emission block: another grid of the density's data (a vdb density's file).
+std::shared_ptr<const DensityField> sibling_grid(const Object& o, const Density& density) {
+  const std::string path = o.at("grid");
+  const std::string name = read_string(*o.find("grid"), path, "a grid name of the density's file (\"flame\", \"temperature\")");
+  const auto* field = std::get_if<FieldDensity>(&density);
+  if (!field || !field->field)
+    throw Error(path, "\"" + name + "\"", "no grid: the density has no file of grids (a vdb density's has; without a grid, emission follows the density)");
+  return field->field->sibling(name, path);
+}
+
+Emission read_emission(const Object* emission, const Object* blackbody, const Density& density) {
+  Emission e;
+  if (emission) {
+    emission->allow({"strength", "color", "grid"});
+    e.strength = emission->number("strength", 1.0, kNonNegative);
+    e.color = emission->color("color", Rgb(1.0), kNonNegative);
+    if (emission->find("grid")) e.grid = sibling_grid(*emission, density);
+  }
+  if (blackbody) {
+    blackbody->allow({"intensity", "tint", "temperature", "grid"});
+    e.blackbody_intensity = blackbody->number("intensity", 1.0, kNonNegative);
+    e.blackbody_tint = blackbody->color("tint", Rgb(1.0), kNonNegative);
+    e.temperature = blackbody->number("temperature", 1000.0, {[](double t) { return t >= 0.0 && t <= 1e6; }, "kelvin in [0, 1e6]"});
+    if (blackbody->find("grid")) e.temperature_grid = sibling_grid(*blackbody, density);
+  }
+  return e;
+}
+
 MediumDesc read_medium(const Object& o, const fs::path& base_dir) {
-  o.allow({"bounds", "density", "sigma_t", "albedo", "phase"});
+  o.allow({"bounds", "density", "sigma_t", "albedo", "phase", "emission", "blackbody"});
   MediumDesc m;
   if (const json* b = o.find("bounds")) m.bounds = read_bounds(*b, o.at("bounds"));
   m.density = read_density(o.need("density", "a density object with a \"type\""), o.at("density"), m.bounds.bounded(), base_dir);
   m.sigma_t = o.color("sigma_t", kNonNegative);
   m.albedo = o.color("albedo", Rgb(0.8), kUnit);
   if (const json* p = o.find("phase")) m.phase = read_phase(Object(*p, o.at("phase")));
+  const json* emission = o.find("emission");
+  const json* blackbody = o.find("blackbody");
+  const std::optional<Object> e = emission ? std::optional<Object>(std::in_place, *emission, o.at("emission")) : std::nullopt;
+  const std::optional<Object> b = blackbody ? std::optional<Object>(std::in_place, *blackbody, o.at("blackbody")) : std::nullopt;
+  m.emission = read_emission(e ? &*e : nullptr, b ? &*b : nullptr, m.density);
   return m;
 }
 

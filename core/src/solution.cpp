@@ -240,6 +240,12 @@ Solution prepare(const Scene& scene, const std::string& method_name, RenderOptio
   if (scene.medium) check_medium(*scene.medium);
   auto state = std::make_unique<Solution::State>();
   state->info = method_info(name);
+  if (scene.medium && scene.medium->emission.emits() && !state->info.emission) {
+    std::string methods;
+    for (const MethodInfo& info : registered_methods())
+      if (info.emission) methods += (methods.empty() ? "" : ", ") + info.name;
+    throw Error("medium.emission", "an emitting medium for method " + name, "a method that renders emission: " + methods);
+  }
   state->method = state->info.create();
   state->scene = scene;
   nlohmann::json settings = nlohmann::json::object();

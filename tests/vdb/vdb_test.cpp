@@ -274,6 +274,48 @@ TEST(VdbScene, RendersWithEveryMethod) {
   EXPECT_NE(message_of([&] { render(scene, "network"); }).find("particles"), std::string::npos);
 }
 
+// Emission from a grid of the density's file ("flame"): the medium emits strength color flame(x);
+// the reference (tracking the flame at a rate of its own, as it may reach where the density does
+// not) and quadrature agree on the image's sum within the reference's noise.
+TEST(VdbScene, EmitsFromASiblingGrid) {
+  register_readers();
+  grids::register_methods();
+  const fs::path dir = scratch();
+  auto density = box_grid(8, 0.25, Vec3(-0.875), 1.0f);
+  auto flame = box_grid(8, 0.25, Vec3(-0.875), 0.0f);
+  flame->setName("flame");
+  flame->tree().fill(openvdb::CoordBBox(openvdb::Coord(2), openvdb::Coord(5)), 3.0f, true);
+  write(dir / "fire.vdb", {density, flame});
+  const nlohmann::json j = {
+      {"camera", {{"position", {0.2, 0.3, 4.0}}, {"look_at", {0, 0, 0}}, {"fov_y_deg", 35}, {"width_px", 12}, {"height_px", 12}}},
+      {"medium",
+       {{"density", {{"type", "vdb"}, {"file", "fire.vdb"}}},
+        {"sigma_t", 1.5},
+        {"albedo", 0.0},
+        {"emission", {{"strength", 2.0}, {"color", {1.0, 0.6, 0.2}}, {"grid", "flame"}}}}}};
+  const Scene scene = Scene::from_json(j, dir);
+  const auto medium = make_medium(*scene.medium);
+  EXPECT_NEAR(medium->emission(Vec3(0.0625 - 0.875 + 0.75)).g, 2.0 * 0.6 * 3.0, 1e-5);  // voxel (3, 3, 3)
+  EXPECT_EQ(medium->emission(Vec3(5.0)), Rgb(0.0));
+  RenderOptions reference;
+  reference.settings = {{"spp", 1024}, {"seed", 2}};
+  const RenderResult q = render(scene, "quadrature"), r = render(scene, "reference", reference);
+  for (int c = 0; c < 3; ++c) {
+    double difference = 0.0, variance = 0.0;
+    for (int y = 0; y < 12; ++y)
+      for (int x = 0; x < 12; ++x) {
+        difference += r.radiance.at(x, y)[c] - q.radiance.at(x, y)[c];
+        variance += std::pow(r.std_error->at(x, y)[c], 2);
+      }
+    EXPECT_LT(std::abs(difference), 4.0 * std::sqrt(variance)) << "channel " << c;
+    EXPECT_GT(q.radiance.mean()[c], 0.01) << c;
+  }
+  EXPECT_NE(message_of([&] { render(scene, "dom"); }).find("medium.emission"), std::string::npos);
+  nlohmann::json bad = j;
+  bad["medium"]["emission"]["grid"] = "smoke";
+  EXPECT_NE(message_of([&] { Scene::from_json(bad, dir); }).find("medium.emission.grid: got \"smoke\""), std::string::npos);
+}
+
 // The fields written as VDB grids hold the solution's own values at their voxels' world centres,
 // one transmittance grid per light that has one.
 TEST(VdbFields, HoldTheSolutionsFieldsAtTheirVoxels) {

@@ -76,6 +76,12 @@ std::shared_ptr<const MajorantGrid> VolumeField::majorants() const {
   return std::make_shared<MajorantGrid>(b, n, std::move(m));
 }
 
+std::shared_ptr<const DensityField> VolumeField::sibling(const std::string& name, const std::string& field) const {
+  // read() names its fields "<field>.file" and "<field>.grid": the emission block's own.
+  const std::string block = field.ends_with(".grid") ? field.substr(0, field.size() - 5) : field;
+  return read(data_->info.file, name, block);
+}
+
 FieldDensity volume_density(std::shared_ptr<const VolumeField> volume, int grid_resolution) {
   FieldDensity f{"vdb", volume, grid_resolution};
   if (volume) {

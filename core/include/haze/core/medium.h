@@ -60,6 +60,9 @@ class DensityField {
   virtual std::optional<double> density_integral(const Vec3& /*a*/, const Vec3& /*b*/) const { return std::nullopt; }
   // Its own majorant grid (Medium::majorants); by default built from max_density.
   virtual std::shared_ptr<const MajorantGrid> majorants() const { return nullptr; }
+  // Another grid of the same data by name (a VDB file's "flame" or "temperature"), for emission;
+  // by default there is none: throws haze::Error naming `field`.
+  virtual std::shared_ptr<const DensityField> sibling(const std::string& name, const std::string& field) const;
 };
 struct FieldDensity {
   std::string type;  // what supplies it, for messages ("particles")
@@ -72,12 +75,32 @@ struct FieldDensity {
 
 using Density = std::variant<ConstantDensity, RbfDensity, GridDensity, FieldDensity>;
 
+// Emission (DESIGN.md, "Emission", after Blender Cycles' Principled Volume): radiance per unit
+// length added to the transfer equation's source, unaffected by albedo, inside the medium's bounds:
+//   L_e(x) = strength color g(x) + blackbody_intensity tint blackbody_color(T) sigma T^4,
+// g the emission grid where given, else the medium's density; T = temperature times the
+// temperature grid where given (kelvin, Cycles' convention); sigma = kBlackbodySigma (blackbody.h).
+struct Emission {
+  double strength = 0.0;
+  Rgb color{1.0};
+  std::shared_ptr<const DensityField> grid;
+  double blackbody_intensity = 0.0;
+  Rgb blackbody_tint{1.0};
+  double temperature = 1000.0;
+  std::shared_ptr<const DensityField> temperature_grid;
+
+  bool emits() const { return strength > 0.0 || blackbody_intensity > 0.0; }
+  // Whether L_e may be non-zero where the density is zero (a grid of its own, or blackbody).
+  bool beyond_density() const { return (strength > 0.0 && grid) || blackbody_intensity > 0.0; }
+};
+
 struct MediumDesc {
   Aabb bounds;  // unbounded unless given; a grid density needs bounds
   Density density = ConstantDensity{};
   Rgb sigma_t{1.0};
   Rgb albedo{0.8};
   PhaseFunction phase;
+  Emission emission;
 };
 
 class Medium {
@@ -106,6 +129,10 @@ class Medium {
   const PhaseFunction& phase() const { return phase_; }
   Rgb sigma_t(const Vec3& x) const { return sigma_t_ * density(x); }
   Rgb sigma_s(const Vec3& x) const { return albedo_ * sigma_t(x); }
+  // L_e(x), the emitted radiance per unit length (Emission); 0 outside bounds().
+  Rgb emission(const Vec3& x) const;
+  const Emission& emission_desc() const { return emission_; }
+  bool emits() const { return emission_.emits(); }
   // exp(-optical depth) between a and b, per channel.
   Rgb transmittance(const Vec3& a, const Vec3& b) const;
   // From x along the unit direction over distance, which may be infinite (directional lights, the
@@ -118,8 +145,10 @@ class Medium {
   virtual std::shared_ptr<const MajorantGrid> make_majorants() const;
 
  private:
+  friend std::unique_ptr<Medium> make_medium(const MediumDesc& desc);
   Rgb sigma_t_, albedo_;
   PhaseFunction phase_;
+  Emission emission_;
   mutable std::once_flag majorants_once_;
   mutable std::shared_ptr<const MajorantGrid> majorants_;
 };

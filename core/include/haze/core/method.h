@@ -81,6 +81,9 @@ struct MethodInfo {
   // The image holds light scattered or reflected once only, at points the camera sees: a light
   // that reaches none of the view is left out too (light_culling.h).
   bool single_scattering = false;
+  // Renders a medium's emission (MediumDesc::emission); haze::prepare refuses an emitting medium
+  // to a method without it.
+  bool emission = false;
 
   const SettingInfo* setting(const std::string& key) const;
 };

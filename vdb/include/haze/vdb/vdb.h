@@ -41,6 +41,8 @@ class VolumeField final : public DensityField {
   double max_density(const Aabb& region) const override;
   double feature_size() const override;
   std::shared_ptr<const MajorantGrid> majorants() const override;
+  // Grid `name` of the same file (emission's "flame", "temperature"), read as read() does.
+  std::shared_ptr<const DensityField> sibling(const std::string& name, const std::string& field) const override;
 
   const VolumeInfo& info() const;
 
