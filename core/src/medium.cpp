@@ -29,15 +29,19 @@ std::shared_ptr<const DensityField> DensityField::sibling(const std::string& nam
   throw Error(field, "\"" + name + "\"", "no grid name: this density has no other grids (a vdb density's file has)");
 }
 
-Rgb Medium::emission(const Vec3& x) const {
+Rgb emitted_radiance(const Emission& emission, const Vec3& x, double density) {
   Rgb e(0.0);
-  if (!emission_.emits() || !bounds().contains(x)) return e;
-  if (emission_.strength > 0.0) e += emission_.strength * emission_.color * (emission_.grid ? emission_.grid->density(x) : density(x));
-  if (emission_.blackbody_intensity > 0.0) {
-    const double T = emission_.temperature * (emission_.temperature_grid ? emission_.temperature_grid->density(x) : 1.0);
-    if (T > 0.0) e += emission_.blackbody_intensity * emission_.blackbody_tint * blackbody_color(T) * (kBlackbodySigma * T * T * T * T);
+  if (emission.strength > 0.0) e += emission.strength * emission.color * (emission.grid ? emission.grid->density(x) : density);
+  if (emission.blackbody_intensity > 0.0) {
+    const double T = emission.temperature * (emission.temperature_grid ? emission.temperature_grid->density(x) : 1.0);
+    if (T > 0.0) e += emission.blackbody_intensity * emission.blackbody_tint * blackbody_color(T) * (kBlackbodySigma * T * T * T * T);
   }
   return e;
+}
+
+Rgb Medium::emission(const Vec3& x) const {
+  if (!emission_.emits() || !bounds().contains(x)) return Rgb(0.0);
+  return emitted_radiance(emission_, x, emission_.strength > 0.0 && !emission_.grid ? density(x) : 0.0);
 }
 
 std::shared_ptr<const MajorantGrid> Medium::make_majorants() const { return std::make_shared<MajorantGrid>(*this); }

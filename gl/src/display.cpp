@@ -322,6 +322,8 @@ VolumeDisplay::VolumeDisplay(const Scene& scene, const grids::ExtinctionVolume& 
     : impl_(std::make_unique<Impl>()) {
   Impl& d = *impl_;
   if (!(settings.step_cells > 0.0)) throw Error("step", std::to_string(settings.step_cells), "a step > 0 cells");
+  if (volume.emission.emits())
+    throw Error("medium.emission", "an emitting medium", "one that does not emit for the GL display (render emission on the CPU: --display cpu)");
   d.settings = settings;
   d.scene = scene;
   d.scene.lights.clear();

@@ -429,6 +429,7 @@ AutoOffer surface_offer(const SceneFeatures& f, double tolerance) {
 MethodInfo dom_info() {
   MethodInfo info;
   info.name = "dom";
+  info.emission = true;  // an isotropic source in the sweeps (lights the medium and surfaces) and in the camera's march
   info.summary = "multiple scattering on grids: discrete ordinates with a separable phase function (seed 000)";
   info.create = [] { return std::make_unique<DomMethod>(); };
   info.handles = {"RBF, grid and bounded constant densities, the particles' density", "point, spot, directional, sky",

@@ -317,6 +317,8 @@ DomSolution solve_dom(const ExtinctionVolume& volume, const std::vector<Light>& 
   bool grey = is_grey(volume.sigma_t_scale) && is_grey(volume.albedo);
   for (const Light& l : lights) grey = grey && is_grey(l);
   grey = grey && (!boundary || boundary->grey);
+  const Emission& emission = volume.emission;
+  grey = grey && (!emission.emits() || (is_grey(emission.color) && emission.blackbody_intensity <= 0.0));
   Stopwatch start;
   DomSolution out;
   out.channels = grey ? 1 : 3;

@@ -269,6 +269,7 @@ FirstCollision Transport::first_collision(const ExtinctionVolume& volume, const 
     return sum / (n * n * n);
   };
   const double sigma_t = volume.sigma_t_scale[channel], weight = 4.0 * kPi / d_;
+  const bool emits = volume.emission.emits();
   // p(w_light . w_d) / (sum_j p(w_light . w_j) w_j) per direction: for a directional light the
   // same in every cell, so made once here.
   auto normalized_phase = [&](const Vec3& to_light, std::vector<float>& cosines, std::vector<float>& phase) {
@@ -324,6 +325,18 @@ FirstCollision Transport::first_collision(const ExtinctionVolume& volume, const 
             const float* row = rows[l].empty() ? phase.data() : rows[l].data();
             const auto scale = static_cast<float>(scale_all * e);
             for (size_t t = 0; t < d; ++t) f[padded_index_[t]] += scale * row[t];
+          }
+          // Emission: an isotropic source L_e of its own, entering the sweep's sigma_s S as
+          // L_e / sigma_s (and, under delta-M, the scaled sigma_s: scale_all). Not slope-weighted.
+          // Cells that scatter nothing send their emission to the camera only (render_dom's march).
+          if (emits) {
+            const double sigma_s = volume.albedo[channel] * sigma_t * static_cast<double>(grid.values()[c]);
+            const double emitted = emitted_radiance(volume.emission, x, grid.values()[c])[channel];
+            if (sigma_s > 0.0 && emitted > 0.0) {
+              const auto value = static_cast<float>(scale_all * emitted / sigma_s);
+              for (size_t t = 0; t < d; ++t) f[padded_index_[t]] += value;
+              total += 4.0 * kPi * emitted / sigma_s;
+            }
           }
           if (total > 0.0)
             for (size_t axis = 0; axis < 3; ++axis) first.slope[c * 3 + axis] = static_cast<float>(slope[axis] / total);

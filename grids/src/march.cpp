@@ -84,6 +84,8 @@ struct Marcher {
   // point light nearer than cone t at a step delivers its irradiance at that distance, no more.
   void march(const Ray& ray, const Steps& s, Rgb& radiance, Rgb& transmittance, double cone_tangent = 0.0) const {
     radiance = Rgb(0.0), transmittance = Rgb(1.0);
+    const Emission& emission = volume.emission;
+    const bool emits = emission.emits();
     const size_t lights = scene.lights.size();
     std::vector<double> depth(lights), visible(lights, 1.0);
     LightArrival a;
@@ -91,7 +93,8 @@ struct Marcher {
       const Vec3 x = ray.at(s.t0 + (i + 0.5) * s.dt);
       const TrilinearStencil stencil(volume.density.bounds(), volume.density.resolution(), x);
       const double rho = stencil.apply(volume.density.values().data());
-      if (rho <= 0.0) continue;
+      const Rgb emitted = emits ? emitted_radiance(emission, x, rho) : Rgb(0.0);
+      if (rho <= 0.0 && emitted == Rgb(0.0)) continue;
       std::fill(depth.begin(), depth.end(), 0.0);
       for (int m = 0; m < 8; ++m) {
         const float* run = packed.data() + stencil.offset[m] * lights;
@@ -111,8 +114,11 @@ struct Marcher {
           a.irradiance *= (a.distance / radius) * (a.distance / radius);
         in += volume.phase.eval(-a.to_light, -ray.direction) * a.irradiance * visible[l] * glm::exp(-sigma_t * depth[l]);
       }
-      const Rgb step_transmittance = glm::exp(-sigma_t * rho * s.dt);
+      const Rgb tau = sigma_t * rho * s.dt, step_transmittance = glm::exp(-tau);
       radiance += transmittance * volume.albedo * (Rgb(1.0) - step_transmittance) * in;
+      // Emission over the step, L_e constant across it: L_e integral_0^dt e^(-sigma_t rho s) ds.
+      for (int c = 0; emits && c < 3; ++c)
+        radiance[c] += transmittance[c] * emitted[c] * (tau[c] > 1e-9 ? (1.0 - step_transmittance[c]) / (sigma_t[c] * rho) : s.dt);
       transmittance *= step_transmittance;
     }
   }
@@ -144,9 +150,9 @@ struct Marcher {
 };
 
 // The kernel's view of the volume and lights; false where it cannot take them (a tabulated phase
-// function, a sky light).
+// function, a sky light, emission).
 bool simd_volume(const Marcher& m, std::vector<simd::MarchLight>& lights, simd::MarchVolume& v) {
-  if (!simd::march_supported(m.volume.phase)) return false;
+  if (!simd::march_supported(m.volume.phase) || m.volume.emission.emits()) return false;
   const DenseGrid& density = m.volume.density;
   const Vec3 h = density.cell_size();
   for (int e = 0; e < 3; ++e) {

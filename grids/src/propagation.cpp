@@ -133,6 +133,7 @@ MethodInfo propagation_info() {
     return AutoOffer{true, {{"resolution", 64}, {"step", 0.5}}, 0.008, "heterogeneous medium or a directional light (thin_haze: 0.0078 s at 64^3)"};
   };
   info.single_scattering = true;
+  info.emission = true;  // in the float64 marcher (the SIMD kernel takes none)
   return info;
 }
 

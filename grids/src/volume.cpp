@@ -101,7 +101,7 @@ ExtinctionVolume make_extinction_volume(const Scene& scene, const CellCount& cel
     if (n < 2 || n > 1024) throw Error("resolution", cells.text(), "integers in [2, 1024]");
   const MediumDesc& desc = *scene.medium;
   Aabb bounds = desc.bounds;
-  ExtinctionVolume volume{DenseGrid({1, 1, 1}, {Vec3(0), Vec3(1)}), desc.sigma_t, desc.albedo, desc.phase};
+  ExtinctionVolume volume{DenseGrid({1, 1, 1}, {Vec3(0), Vec3(1)}), desc.sigma_t, desc.albedo, desc.phase, desc.emission};
   if (const auto* rbf = std::get_if<RbfDensity>(&desc.density)) {
     if (!bounds.bounded()) {
       // Unbounded: the blobs' supports at the injection cutoff.
@@ -141,7 +141,7 @@ MediumDesc ExtinctionVolume::medium() const {
   MediumDesc m;
   m.bounds = density.bounds();
   m.density = GridDensity::viewing(density.resolution(), density.values());
-  m.sigma_t = sigma_t_scale, m.albedo = albedo, m.phase = phase;
+  m.sigma_t = sigma_t_scale, m.albedo = albedo, m.phase = phase, m.emission = emission;
   return m;
 }
 

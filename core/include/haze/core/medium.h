@@ -94,6 +94,9 @@ struct Emission {
   bool beyond_density() const { return (strength > 0.0 && grid) || blackbody_intensity > 0.0; }
 };
 
+// L_e at x where the medium's density is `density` (Emission's formula).
+Rgb emitted_radiance(const Emission& emission, const Vec3& x, double density);
+
 struct MediumDesc {
   Aabb bounds;  // unbounded unless given; a grid density needs bounds
   Density density = ConstantDensity{};

@@ -25,6 +25,7 @@ struct ExtinctionVolume {
   DenseGrid density;
   Rgb sigma_t_scale{1.0}, albedo{0.8};
   PhaseFunction phase;
+  Emission emission{};  // the medium's; where it follows the density, the grid's density
 
   // The volume as a haze medium: core's grid medium over a view of `density` (valid while the
   // volume lives), the same trilinear lookup the marchers use; for the reference, quadrature or
