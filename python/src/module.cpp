@@ -2,6 +2,7 @@
 // dicts or files, numpy densities viewed in place where their layout allows, images and fields out
 // as numpy arrays, solutions with update, progress and cancellation, haze.Error.
 #include <haze/core/error.h>
+#include <haze/core/image.h>
 #include <haze/core/method.h>
 #include <haze/core/scene.h>
 #include <haze/grids/methods.h>
@@ -233,6 +234,18 @@ PYBIND11_MODULE(haze, m) {
       },
       py::arg("scene"), py::arg("method") = "", py::arg("settings") = py::none(), py::arg("threads") = 0, py::arg("progress") = std::nullopt,
       "Prepares and renders the scene's camera: {'radiance': (h, w, 3) float32, 'std_error', 'stats'}");
+  auto image_from = [](const py::array_t<float, py::array::c_style | py::array::forcecast>& array) {
+    if (array.ndim() != 3 || array.shape(2) != 3) throw Error("image", "an array of " + to_text(array.ndim()) + " dimensions", "(height, width, 3)");
+    Image image(static_cast<int>(array.shape(1)), static_cast<int>(array.shape(0)));
+    std::copy(array.data(), array.data() + array.size(), image.data().begin());
+    return image;
+  };
+  m.def(
+      "write_exr", [image_from](const std::string& path, const py::array& image) { write_exr(path, image_from(image)); }, py::arg("path"),
+      py::arg("image"), "Writes a (height, width, 3) image as linear float32 EXR (R, G, B)");
+  m.def(
+      "write_png", [image_from](const std::string& path, const py::array& image, double exposure) { write_png(path, image_from(image), exposure); },
+      py::arg("path"), py::arg("image"), py::arg("exposure") = 1.0, "Writes a (height, width, 3) image as a tone-mapped 8-bit PNG preview");
   m.def(
       "methods", [] {
         std::vector<std::string> names;
