@@ -422,20 +422,23 @@ std::shared_ptr<const DensityField> sibling_grid(const Object& o, const Density&
   return field->field->sibling(name, path);
 }
 
-Emission read_emission(const Object* emission, const Object* blackbody, const Density& density) {
+// The medium's `emission` and `blackbody` blocks.
+Emission read_emission(const Object& medium, const Density& density) {
   Emission e;
-  if (emission) {
-    emission->allow({"strength", "color", "grid"});
-    e.strength = emission->number("strength", 1.0, kNonNegative);
-    e.color = emission->color("color", Rgb(1.0), kNonNegative);
-    if (emission->find("grid")) e.grid = sibling_grid(*emission, density);
+  if (const json* j = medium.find("emission")) {
+    const Object o(*j, medium.at("emission"));
+    o.allow({"strength", "color", "grid"});
+    e.strength = o.number("strength", 1.0, kNonNegative);
+    e.color = o.color("color", Rgb(1.0), kNonNegative);
+    if (o.find("grid")) e.grid = sibling_grid(o, density);
   }
-  if (blackbody) {
-    blackbody->allow({"intensity", "tint", "temperature", "grid"});
-    e.blackbody_intensity = blackbody->number("intensity", 1.0, kNonNegative);
-    e.blackbody_tint = blackbody->color("tint", Rgb(1.0), kNonNegative);
-    e.temperature = blackbody->number("temperature", 1000.0, {[](double t) { return t >= 0.0 && t <= 1e6; }, "kelvin in [0, 1e6]"});
-    if (blackbody->find("grid")) e.temperature_grid = sibling_grid(*blackbody, density);
+  if (const json* j = medium.find("blackbody")) {
+    const Object o(*j, medium.at("blackbody"));
+    o.allow({"intensity", "tint", "temperature", "grid"});
+    e.blackbody_intensity = o.number("intensity", 1.0, kNonNegative);
+    e.blackbody_tint = o.color("tint", Rgb(1.0), kNonNegative);
+    e.temperature = o.number("temperature", 1000.0, {[](double t) { return t >= 0.0 && t <= 1e6; }, "kelvin in [0, 1e6]"});
+    if (o.find("grid")) e.temperature_grid = sibling_grid(o, density);
   }
   return e;
 }
@@ -448,11 +451,7 @@ MediumDesc read_medium(const Object& o, const fs::path& base_dir) {
   m.sigma_t = o.color("sigma_t", kNonNegative);
   m.albedo = o.color("albedo", Rgb(0.8), kUnit);
   if (const json* p = o.find("phase")) m.phase = read_phase(Object(*p, o.at("phase")));
-  const json* emission = o.find("emission");
-  const json* blackbody = o.find("blackbody");
-  const std::optional<Object> e = emission ? std::optional<Object>(std::in_place, *emission, o.at("emission")) : std::nullopt;
-  const std::optional<Object> b = blackbody ? std::optional<Object>(std::in_place, *blackbody, o.at("blackbody")) : std::nullopt;
-  m.emission = read_emission(e ? &*e : nullptr, b ? &*b : nullptr, m.density);
+  m.emission = read_emission(o, m.density);
   return m;
 }
 
