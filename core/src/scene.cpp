@@ -168,6 +168,8 @@ class Object {
     return type_;
   }
 
+  void name_type(const std::string& type) const { type_ = type; }  // for allow()'s message, where type() was not called
+
   double number(const char* key, Check check) const { return read_number(need(key, check.expected), at(key), check); }
   double number(const char* key, double fallback, Check check) const {
     const json* v = find(key);
@@ -260,7 +262,7 @@ void check_grid_values(const GridDensity& grid, const std::string& path, const f
 
 // The existing file o.file names, relative to the scene's folder, as an absolute path (so that
 // messages say exactly where Haze looked).
-fs::path existing_file(const Object& o, const fs::path& base_dir, const char* expected) {
+fs::path existing_file(const Object& o, const fs::path& base_dir, const std::string& expected) {
   fs::path file = read_string(o.need("file", expected), o.at("file"), expected);
   if (file.is_relative()) file = base_dir / file;
   std::error_code ec;
@@ -422,7 +424,7 @@ std::shared_ptr<const DensityField> sibling_grid(const Object& o, const Density&
   return field->field->sibling(name, path);
 }
 
-// The medium's `emission` and `blackbody` blocks.
+// The medium's (or a particle set's) `emission` and `blackbody` blocks.
 Emission read_emission(const Object& medium, const Density& density) {
   Emission e;
   if (const json* j = medium.find("emission")) {
@@ -626,6 +628,40 @@ MaterialDesc read_material(const nlohmann::json& j, const std::string& path) {
   if (const json* p = o.find("phase")) m.phase = read_phase(Object(*p, o.at("phase")));
   return m;
 }
+
+Emission read_emission(const nlohmann::json& j, const std::string& path, const Density& density) { return read_emission(Object(j, path), density); }
+
+namespace scene_fields {
+
+void allow(const nlohmann::json& j, const std::string& path, std::initializer_list<std::string_view> fields, const std::string& type) {
+  const Object o(j, path);
+  o.name_type(type);
+  o.allow(fields);
+}
+
+int integer(const nlohmann::json& j, const std::string& path, const char* key, int fallback, int lo, int hi, const std::string& meaning) {
+  const Object o(j, path);
+  try {
+    return o.integer(key, fallback, lo, hi);
+  } catch (const Error& e) {
+    if (meaning.empty()) throw;
+    throw Error(e.field(), e.value(), e.expected() + ": " + meaning);
+  }
+}
+
+std::string text(const nlohmann::json& j, const std::string& path, const char* key, const std::string& fallback, const std::string& expected) {
+  const Object o(j, path);
+  const json* v = o.find(key);
+  if (!v && !fallback.empty()) return fallback;
+  return read_string(v ? *v : o.need(key, expected), o.at(key), expected);
+}
+
+std::filesystem::path existing_file(const nlohmann::json& j, const std::string& path, const std::filesystem::path& directory,
+                                    const std::string& expected) {
+  return haze::existing_file(Object(j, path), directory, expected);
+}
+
+}  // namespace scene_fields
 
 Scene Scene::from_json(const nlohmann::json& json, const std::filesystem::path& base_dir) {
   try {

@@ -62,19 +62,14 @@ void read_csv(const std::filesystem::path& path, ParticleSet& set) {
 }  // namespace
 
 ParticleSet ParticleSet::from_json(const json& j, const std::filesystem::path& base_dir) {
-  if (!j.is_object()) throw Error("particles", j.dump(), "a JSON object {...}");
-  for (const auto& [key, value] : j.items())
-    if (key != "positions" && key != "file" && key != "density" && key != "diameter" && key != "sigma_t" && key != "albedo" && key != "phase" &&
-        key != "grid_resolution")  // the density reader's (methods.cpp)
-      throw Error("particles." + key, "unknown field \"" + key + "\"",
-                  "a field of particles: positions, file, density, diameter, sigma_t, albedo, phase, grid_resolution");
+  scene_fields::allow(j, "particles", {"positions", "file", "density", "diameter", "sigma_t", "albedo", "phase", "emission", "blackbody",
+                                       "grid_resolution"});  // the last three the density reader's (methods.cpp)
   ParticleSet set;
   set.material = read_material(j, "particles");
   const bool inline_positions = j.contains("positions"), file = j.contains("file");
   if (inline_positions == file) throw Error("particles.positions", file ? "given with file" : "missing", "one of positions and file");
   if (file) {
-    if (!j["file"].is_string()) throw Error("particles.file", j["file"].dump(), "a file name");
-    read_csv(base_dir / j["file"].get<std::string>(), set);
+    read_csv(scene_fields::existing_file(j, "particles", base_dir, "a CSV file name (relative to the scene file's folder)"), set);
   } else {
     const json& p = j["positions"];
     if (!p.is_array()) throw Error("particles.positions", p.dump(), "an array of [x, y, z]");

@@ -12,8 +12,10 @@
 
 #include <filesystem>
 #include <functional>
+#include <initializer_list>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #pragma GCC visibility push(default)  // the public API: exported from shared builds
@@ -28,6 +30,23 @@ struct MaterialDesc {
   PhaseFunction phase;  // isotropic unless given
 };
 MaterialDesc read_material(const nlohmann::json& j, const std::string& path);
+// The `emission` and `blackbody` fields of the object `j` at `path` (a medium, a particle set):
+// the medium's emission (MediumDesc::emission); their `grid`s are siblings of `density`'s field.
+Emission read_emission(const nlohmann::json& j, const std::string& path, const Density& density);
+
+// For modules reading their own blocks with the scene reader's checks and messages (each throws
+// haze::Error naming path.key, the value shortened to 80 characters, and what was expected):
+namespace scene_fields {
+// Rejects a key of the object `j` not among `fields` (the message names the block's `type`, if any).
+void allow(const nlohmann::json& j, const std::string& path, std::initializer_list<std::string_view> fields, const std::string& type = "");
+// j[key], an integer in [lo, hi], or `fallback` when absent; `meaning` follows the range in messages.
+int integer(const nlohmann::json& j, const std::string& path, const char* key, int fallback, int lo, int hi, const std::string& meaning = "");
+// j[key], a non-empty string, or `fallback` when absent (required when fallback is empty).
+std::string text(const nlohmann::json& j, const std::string& path, const char* key, const std::string& fallback, const std::string& expected);
+// j.file: an existing file, relative to `directory` unless absolute, as an absolute path.
+std::filesystem::path existing_file(const nlohmann::json& j, const std::string& path, const std::filesystem::path& directory,
+                                    const std::string& expected);
+}  // namespace scene_fields
 
 // A density a module supplies, read from the scene's top-level block of the type's name
 // ("particles": the particle module registers it): the block at `path` into a medium, whose
