@@ -61,9 +61,25 @@ std::vector<const Light*> delta_lights(const std::vector<Light>& lights, Rgb& sk
   return delta;
 }
 
-bool grey_scene(const MaterialDesc& material, const Rgb& sky, const std::vector<const Light*>& delta) {
+bool grey_scene(const MaterialDesc& material, const Emission& emission, const Rgb& sky, const std::vector<const Light*>& delta) {
   return is_grey(material.sigma_t) && is_grey(material.albedo) && is_grey(sky) &&
+         (!emission.emits() || (is_grey(emission.color) && emission.blackbody_intensity <= 0.0)) &&
          std::all_of(delta.begin(), delta.end(), [](const Light* l) { return is_grey(*l); });
+}
+
+void emission_source(NetworkSolution& s, const ParticleField& field) {
+  for (auto& e : s.emitted) e.clear();
+  if (!s.emission.emits()) return;
+  const Rgb& sigma_t = field.particles().material.sigma_t;
+  const size_t n = field.size();
+  for (auto& e : s.emitted) e.assign(n, 0.0f);
+  for (size_t p = 0; p < n; ++p) {
+    const double rho = s.rho[p];
+    if (!(rho > 0.0)) continue;
+    const Rgb le = emitted_radiance(s.emission, field.position(p), rho);
+    for (int c = 0; c < 3; ++c)
+      if (sigma_t[c] > 0.0) s.emitted[static_cast<size_t>(c)][p] = static_cast<float>(le[c] / (sigma_t[c] * rho));
+  }
 }
 
 // Direct light at each particle, attenuated by the continuous density (a depth map per light);
@@ -200,7 +216,7 @@ VisibilityNetwork build_visibility(const ParticleField& field, const std::vector
 }
 
 NetworkSolution solve_network(const ParticleField& field, const std::vector<Light>& lights, const NetworkSettings& settings,
-                              const NetworkSolution* warm, const std::vector<Surface>& surfaces) {
+                              const NetworkSolution* warm, const std::vector<Surface>& surfaces, const Emission& emission) {
   if (settings.directions < 8 || settings.directions > 4096)
     throw Error("directions", to_text(settings.directions), "a direction count in [8, 4096]");
   if (settings.max_iterations < 0) throw Error("iterations", to_text(settings.max_iterations), "at least 0 (0: single scattering only)");
@@ -219,7 +235,9 @@ NetworkSolution solve_network(const ParticleField& field, const std::vector<Ligh
   start.restart();
   const std::vector<const Light*> delta = delta_lights(lights, out.sky);
   for (const Light* l : delta) out.light_maps.emplace_back(field, *l, settings.threads);
-  out.channels = grey_scene(material, out.sky, delta) ? 1 : 3;
+  out.channels = grey_scene(material, emission, out.sky, delta) ? 1 : 3;
+  out.emission = emission;
+  emission_source(out, field);
   out.surfaces = surfaces;
   for (size_t c = 0; c < static_cast<size_t>(out.channels); ++c) out.source[c].assign(n * d, 0.0f);
   std::vector<int> all(n);
@@ -256,9 +274,9 @@ NetworkSolution solve_network(const ParticleField& field, const std::vector<Ligh
 
 // Iteration (section 3.3, with DESIGN.md's normalization): for p and direction i with upstream
 // v, over the gap's transmittance T = exp(-sigma_t depth),
-//   I[p, i] = T I[v, i] + (1 - T) albedo (J[v, i] + J[p, i]) / 2,   J[q, i] = sum_d P[i][d] I[q, d] + S[q, i],
-// the formal solution over the gap with its in-scattered radiance averaged from both ends; I = sky
-// where no particle is upstream. Columns run in upstream order (Gauss-Seidel along each column).
+//   I[p, i] = T I[v, i] + (1 - T) (albedo (J[v, i] + J[p, i]) + e[v] + e[p]) / 2,   J[q, i] = sum_d P[i][d] I[q, d] + S[q, i],
+// the formal solution over the gap with its source (in-scattered radiance, and emission's
+// e = L_e / sigma_t rho) averaged from both ends; I = sky where no particle is upstream. Columns run in upstream order (Gauss-Seidel along each column).
 double iterate_network(NetworkSolution& s, int threads) {
   using Matrix = Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic>;
   using Block = Eigen::Map<Matrix, 0, Eigen::OuterStride<>>;
@@ -283,6 +301,7 @@ double iterate_network(NetworkSolution& s, int threads) {
       else out.noalias() += (i_block * s.scatter_a) * s.scatter_b;
     });
     const auto albedo = static_cast<float>(s.albedo[static_cast<int>(c)]), sky = static_cast<float>(s.sky[static_cast<int>(c)]);
+    const float* emitted = s.emitted[c].empty() ? nullptr : s.emitted[c].data();
     // In sweep order a particle's upstream one is the previous particle of its column (the
     // transmittance is stored in that order, -1 where a column starts), so I and J of the upstream
     // particle are the values just handled.
@@ -294,15 +313,15 @@ double iterate_network(NetworkSolution& s, int threads) {
         float* in_i = in.data() + base;
         const float* j_i = j.data() + base;
         double change = 0.0, total = 0.0;
-        float up_in = 0.0f, up_j = 0.0f;
+        float up_in = 0.0f, up_j = 0.0f, up_e = 0.0f;
         for (size_t k = 0; k < n; ++k) {
           const auto p = static_cast<size_t>(order[k]);
-          const float jp = j_i[p], tp = tk[k];
-          const float value = tp < 0.0f ? sky : tp * up_in + (1.0f - tp) * albedo * 0.5f * (up_j + jp);
+          const float jp = j_i[p], tp = tk[k], ep = emitted ? emitted[p] : 0.0f;
+          const float value = tp < 0.0f ? sky : tp * up_in + (1.0f - tp) * 0.5f * (albedo * (up_j + jp) + up_e + ep);
           const float delta = value - in_i[p];
           change += static_cast<double>(delta * delta), total += static_cast<double>(value * value);
           in_i[p] = value;
-          up_in = value, up_j = jp;
+          up_in = value, up_j = jp, up_e = ep;
         }
         diff[i] = change, ref[i] = total;
       }

@@ -44,8 +44,11 @@ std::array<Vec3, 8> gaussian_nodes(const Vec3& x, double h);
 // The delta lights of `lights` (point, spot, directional), and the sky radiance summed.
 std::vector<const Light*> delta_lights(const std::vector<Light>& lights, Rgb& sky);
 
-// Whether the medium, the sky and every light are grey (one channel serves three).
-bool grey_scene(const MaterialDesc& material, const Rgb& sky, const std::vector<const Light*>& delta);
+// Whether the medium, its emission, the sky and every light are grey (one channel serves three).
+bool grey_scene(const MaterialDesc& material, const Emission& emission, const Rgb& sky, const std::vector<const Light*>& delta);
+
+// s.emitted from s.emission and s.rho.
+void emission_source(NetworkSolution& s, const ParticleField& field);
 
 // S[c][i * n + p] for the listed particles p from the solution's light maps:
 // the direct light scattered into each direction, per unit albedo, overwriting what was there.

@@ -140,6 +140,10 @@ RenderResult render_network(const Scene& scene, const ParticleField& field, cons
   // paragraphs): albedo times the network's in-scattering at the eye's direction (the phase-matrix
   // row extended off the direction set, PhaseMatrix::row). Direct light is added per ray step.
   const auto d = static_cast<size_t>(solution.directions->size());
+  const auto emitted = [&](size_t p) {  // the emission's source function at particle p
+    if (solution.emitted[0].empty()) return Rgb(0.0);
+    return Rgb(solution.emitted[0][p], solution.emitted[1][p], solution.emitted[2][p]);
+  };
   std::vector<Rgb> scattered(n);
   parallel_for(static_cast<long long>(n), options.threads, 64, [&](long long p0, long long p1) {
     for (auto p = static_cast<size_t>(p0); p < static_cast<size_t>(p1); ++p) {
@@ -149,7 +153,7 @@ RenderResult render_network(const Scene& scene, const ParticleField& field, cons
       Rgb j(0.0);
       for (int c = 0; c < 3; ++c)
         for (size_t i = 0; i < d; ++i) j[c] += row(static_cast<long>(i)) * static_cast<double>(solution.incoming[static_cast<size_t>(c)][i * n + p]);
-      scattered[p] = material.albedo * j;
+      scattered[p] = material.albedo * j + emitted(p);
     }
   });
   // Single-scattered direct light at any point, from the lights' depth maps, with the exact phase
@@ -183,7 +187,7 @@ RenderResult render_network(const Scene& scene, const ParticleField& field, cons
           Rgb sum(0.0);
           for (int c = 0; c < 3; ++c)
             for (size_t i = 0; i < d; ++i) sum[c] += row(static_cast<long>(i)) * static_cast<double>(solution.incoming[static_cast<size_t>(c)][i * n + p]);
-          around_scattered[static_cast<size_t>(j)][p] = material.albedo * sum;
+          around_scattered[static_cast<size_t>(j)][p] = material.albedo * sum + emitted(p);
         }
       }
     });
@@ -282,11 +286,11 @@ namespace {
 // Prepared: the particle set, its field and the networks with the converged I.
 class NetworkMethodSolution final : public MethodSolution {
  public:
-  NetworkMethodSolution(const Scene& scene, ParticleSet set, int neighbours, const NetworkSettings& settings)
+  NetworkMethodSolution(const Scene& scene, ParticleSet set, int neighbours, const NetworkSettings& settings, const Emission& emission)
       : scene_(scene), neighbours_(neighbours), settings_(settings) {
     set_ = std::make_unique<ParticleSet>(std::move(set));
     field_ = std::make_unique<ParticleField>(set_->view(), neighbours_);
-    solution_ = solve_network(*field_, scene_.lights, settings_, nullptr, scene_.surfaces);
+    solution_ = solve_network(*field_, scene_.lights, settings_, nullptr, scene_.surfaces, emission);
     settings_.progress = nullptr;
     describe();
   }
@@ -313,6 +317,7 @@ class NetworkMethodSolution final : public MethodSolution {
       if (!moved || moved->set().positions.size() != set_->positions.size()) return std::nullopt;
       set = std::make_unique<ParticleSet>(moved->set());
       field = std::make_unique<ParticleField>(set->view(), neighbours_);
+      solution_.emission = change.medium->emission;
     }
     UpdateReport report;
     if (change.lights || change.medium) {
@@ -375,7 +380,7 @@ class NetworkMethod final : public Method {
     if (!particles)
       throw Error("particles", scene.medium ? "a `medium` instead" : "missing", "a particles block: method network renders particle sets only");
     network.progress = options.progress;
-    return std::make_unique<NetworkMethodSolution>(scene, particles->set(), neighbours, network);
+    return std::make_unique<NetworkMethodSolution>(scene, particles->set(), neighbours, network, scene.medium->emission);
   }
 };
 
@@ -386,6 +391,7 @@ MethodInfo network_info() {
   info.name = "network";
   info.summary = "multiple scattering in particle media: visibility and illumination networks (seed 001)";
   info.create = [] { return std::make_unique<NetworkMethod>(); };
+  info.emission = true;  // where the particles are: each one's L_e / (sigma_t rho) in the iteration and the camera's march
   info.handles = {"particles (a Gaussian each)", "point, spot, directional, sky", "planes, spheres and meshes lit through the particles and by their scattered light, with shadows (also in the particles' direct light)", true};
   const NetworkSettings n;
   info.settings = {SettingInfo::integer("directions", n.directions, 8, 4096, "D, the network's directions"),

@@ -15,7 +15,7 @@ NetworkSolution update_network(NetworkSolution s, const ParticleField& field, co
   const MaterialDesc& material = field.particles().material;
   const size_t n = field.size();
   const auto rebuild = [&](const char* reason) {
-    NetworkSolution out = solve_network(field, lights, settings, &s, s.surfaces);
+    NetworkSolution out = solve_network(field, lights, settings, &s, s.surfaces, s.emission);
     out.update.rebuilt = true, out.update.reason = reason;
     return out;
   };
@@ -26,7 +26,7 @@ NetworkSolution update_network(NetworkSolution s, const ParticleField& field, co
   if (settings.window != 0 && settings.window != s.visibility.window.size) return rebuild("M changed");
   if (settings.terms != 0 && std::min(settings.terms, settings.directions) != s.terms) return rebuild("the separable terms changed");
   if (material.sigma_t != s.sigma_t || material.albedo != s.albedo) return rebuild("the extinction or the albedo changed");
-  if ((grey_scene(material, sky, delta) ? 1 : 3) != s.channels) return rebuild("the lights' colours changed the channel count");
+  if ((grey_scene(material, s.emission, sky, delta) ? 1 : 3) != s.channels) return rebuild("the lights' colours changed the channel count");
 
   Stopwatch start;
   NetworkSolution::Update& u = s.update;
@@ -177,6 +177,7 @@ NetworkSolution update_network(NetworkSolution s, const ParticleField& field, co
   s.direct_seconds = start.seconds();
 
   start.restart();
+  emission_source(s, field);
   iterate(s, settings);
   s.iterate_seconds = start.seconds();
   remember(s, field, delta);

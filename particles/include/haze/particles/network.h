@@ -76,6 +76,12 @@ struct NetworkSolution {
   std::shared_ptr<const PhaseMatrix> matrix;
   VisibilityNetwork visibility;
   std::vector<float> rho;                 // the continuous density at each particle
+  // The medium's emission (DESIGN.md, "Emission") where the particles are: per channel, each
+  // particle's source function L_e / (sigma_t rho) at its centre (exact where L_e follows the
+  // density: strength color / sigma_t), added to the gaps' source in the iteration and to what
+  // each particle sends to the eye; empty when the medium does not emit.
+  Emission emission;
+  std::array<std::vector<float>, 3> emitted;
   // 1 when the medium and every light are grey (one solve serves all three), else 3.
   int channels = 3;
   std::array<std::vector<float>, 3> incoming;  // I per channel, [i * particles + p] (all three filled)
@@ -111,10 +117,11 @@ struct NetworkSolution {
   } update;
 };
 
-// Emission is not modelled. `warm` (same particles and directions) starts from its I. `surfaces`
-// shadow the direct light at the particles (at each point of their Gaussians' quadrature).
+// `warm` (same particles and directions) starts from its I. `surfaces` shadow the direct light at
+// the particles (at each point of their Gaussians' quadrature). `emission`: the medium's (a
+// channel whose sigma_t is 0 emits nothing here).
 NetworkSolution solve_network(const ParticleField& field, const std::vector<Light>& lights, const NetworkSettings& settings,
-                              const NetworkSolution* warm = nullptr, const std::vector<Surface>& surfaces = {});
+                              const NetworkSolution* warm = nullptr, const std::vector<Surface>& surfaces = {}, const Emission& emission = {});
 // One iteration of the network (every direction swept once, threaded over directions; the
 // in-scattering product threaded over particles): updates solution.incoming for the solved
 // channels and returns the relative L2 change of I. solve_network calls it until converged.
