@@ -21,7 +21,7 @@ using internal::Api;
 namespace {
 
 // Texture units, one per sampler: samplers of different types may not share a unit.
-enum Unit : int { kDensityUnit = 0, kDepthUnit = 1, kPhaseUnit = 5, kMomentsUnit = 6, kWeightsUnit = 7, kVisibilityUnit = 8, kAtlasUnit = 12 };
+enum Unit : int { kDensityUnit = 0, kDepthUnit = 1, kPhaseUnit = 5, kMomentsUnit = 6, kWeightsUnit = 7, kVisibilityUnit = 8, kAtlasUnit = 12, kEmissionUnit = 13 };
 
 float f(double v) { return static_cast<float>(v); }
 
@@ -35,7 +35,7 @@ struct VolumeDisplay::Impl {
   Aabb bounds;
   Rgb sigma_t{1.0}, albedo{0.8};
   PhaseFunction phase;
-  std::optional<Texture> density, phase_table, moments, weights, surface_atlas;
+  std::optional<Texture> density, phase_table, moments, weights, surface_atlas, emission;
   Rgb sky{0.0};  // the sky's radiance, for the surfaces' texels (E_s = pi sky where they have none)
   // Bound to the units of samplers the scene does not use: a unit without a complete texture of
   // its sampler's type is undefined on some drivers.
@@ -67,7 +67,7 @@ struct VolumeDisplay::Impl {
 
   // Four lights' volumes a texture, in r, g, b, a.
   void upload_groups(const std::vector<DenseGrid>& grids, std::vector<Texture>& textures, std::span<const Brick> bricks) {
-    const size_t n = grids.empty() ? 1 : grids.front().cell_count();
+    const size_t n = static_cast<size_t>(cells[0]) * static_cast<size_t>(cells[1]) * static_cast<size_t>(cells[2]);  // zeros for no lights
     for (size_t g = 0; g < textures.size(); ++g) {
       packed.assign(4 * n, 0.0f);
       for (size_t c = 0; c < 4 && 4 * g + c < grids.size(); ++c) {
@@ -96,6 +96,29 @@ struct VolumeDisplay::Impl {
     upload_groups(v, visibility, {});
   }
 
+  // Emission: what follows the density as a uniform, the rest (a grid of its own, blackbody) as an
+  // RGB volume at the cell centres, so that update_density changes the glow with the density.
+  void upload_emission(const Emission& e) {
+    gl.UseProgram(program);
+    const Rgb per_density = e.strength > 0.0 && !e.grid ? e.strength * e.color : Rgb(0.0);
+    gl.Uniform3f(at("emission_per_density"), f(per_density.r), f(per_density.g), f(per_density.b));
+    gl.Uniform1i(at("emission_on"), e.beyond_density() ? 1 : 0);
+    if (!e.beyond_density()) return;
+    Emission rest = e;
+    if (!e.grid) rest.strength = 0.0;
+    const Vec3 h = bounds.extent() / Vec3(cells[0], cells[1], cells[2]);
+    std::vector<float> values(4 * static_cast<size_t>(cells[0]) * static_cast<size_t>(cells[1]) * static_cast<size_t>(cells[2]), 0.0f);
+    size_t i = 0;
+    for (int z = 0; z < cells[2]; ++z)
+      for (int y = 0; y < cells[1]; ++y)
+        for (int x = 0; x < cells[0]; ++x, i += 4) {
+          const Rgb le = emitted_radiance(rest, bounds.lo + h * Vec3(x + 0.5, y + 0.5, z + 0.5), 0.0);
+          for (int c = 0; c < 3; ++c) values[i + static_cast<size_t>(c)] = f(le[c]);
+        }
+    emission.emplace(Texture::volume(cells, 4, TexelFormat::float32));
+    emission->upload(values);
+  }
+
   void set_static_uniforms() {
     gl.UseProgram(program);
     gl.Uniform3f(at("box_lo"), f(bounds.lo.x), f(bounds.lo.y), f(bounds.lo.z));
@@ -113,6 +136,7 @@ struct VolumeDisplay::Impl {
     gl.Uniform1i(at("moments"), kMomentsUnit);
     gl.Uniform1i(at("weights"), kWeightsUnit);
     gl.Uniform1i(at("surface_atlas"), kAtlasUnit);
+    gl.Uniform1i(at("emission"), kEmissionUnit);
     gl.Uniform1i(at("surface_texels_on"), 0);
     set_phase();
     set_lights();
@@ -309,6 +333,7 @@ struct VolumeDisplay::Impl {
     bind(kMomentsUnit, GL_TEXTURE_3D, (moments ? *moments : *unused_volume).id());
     bind(kWeightsUnit, GL_TEXTURE_2D, (weights ? *weights : *unused_plane).id());
     bind(kAtlasUnit, GL_TEXTURE_2D, (surface_atlas ? *surface_atlas : *unused_plane).id());
+    bind(kEmissionUnit, GL_TEXTURE_3D, (emission ? *emission : *unused_volume).id());
     gl.ActiveTexture(GL_TEXTURE0);
     gl.BindVertexArray(vao);
     gl.DrawArrays(GL_TRIANGLES, 0, 3);
@@ -322,8 +347,6 @@ VolumeDisplay::VolumeDisplay(const Scene& scene, const grids::ExtinctionVolume& 
     : impl_(std::make_unique<Impl>()) {
   Impl& d = *impl_;
   if (!(settings.step_cells > 0.0)) throw Error("step", std::to_string(settings.step_cells), "a step > 0 cells");
-  if (volume.emission.emits())
-    throw Error("medium.emission", "an emitting medium", "one that does not emit for the GL display (render emission on the CPU: --display cpu)");
   d.settings = settings;
   d.scene = scene;
   d.scene.lights.clear();
@@ -357,6 +380,7 @@ VolumeDisplay::VolumeDisplay(const Scene& scene, const grids::ExtinctionVolume& 
   d.program = internal::fullscreen_program(d.gl, internal::kMarchFragmentShader, "ray-march");
   d.gl.GenVertexArrays(1, &d.vao);
   d.set_static_uniforms();
+  d.upload_emission(volume.emission);
   internal::check(d.gl, "display set-up");
 }
 
@@ -429,7 +453,7 @@ const Texture& VolumeDisplay::density() const { return *impl_->density; }
 std::vector<const Texture*> VolumeDisplay::textures() const {
   std::vector<const Texture*> all{&*impl_->density};
   for (const Texture& t : impl_->depths) all.push_back(&t);
-  for (const auto* t : {&impl_->phase_table, &impl_->moments, &impl_->weights, &impl_->surface_atlas})
+  for (const auto* t : {&impl_->phase_table, &impl_->moments, &impl_->weights, &impl_->surface_atlas, &impl_->emission})
     if (*t) all.push_back(&**t);
   return all;
 }

@@ -30,6 +30,11 @@ uniform sampler3D depths0, depths1, depths2, depths3;  // lights 4i..4i+3 in r, 
 uniform sampler3D visibility0, visibility1, visibility2, visibility3;  // the surfaces' shadows, as the depths
 uniform int shadows;  // 1: the visibility volumes hold the surfaces' shadows
 uniform vec3 sigma_t_view, sigma_t_light, albedo_single, albedo_ms, background;
+// Emission (core Emission): L_e = emission_per_density rho + the texture's L_e at the cell centres
+// of what does not follow the density (an emission grid, blackbody), read where emission_on is 1.
+uniform vec3 emission_per_density;
+uniform int emission_on;
+uniform sampler3D emission;
 
 // Phase: [c0 + c2 mu^2] [sum of lobes k / d^(3/2)], d = a + b (1 - s mu); or a table in mu.
 uniform int phase_lobes;  // -1: table, 0: polynomial only, 1 or 2 lobes
@@ -251,7 +256,12 @@ void main() {
       vec3 x = o + d * (t0 + (float(s) + 0.5) * dt);
       vec3 uvw = (x - box_lo) / size;
       float rho = texture(density, uvw).r;
-      if (rho <= 0.0) continue;
+      vec3 Le = emission_per_density * rho;
+      if (emission_on == 1) Le += texture(emission, uvw).rgb;
+      if (rho <= 0.0) {
+        L += T * Le * dt;
+        continue;
+      }
       vec4 g0 = texture(depths0, uvw), g1 = vec4(0.0), g2 = vec4(0.0), g3 = vec4(0.0);
       if (light_count > 4) g1 = texture(depths1, uvw);
       if (light_count > 8) g2 = texture(depths2, uvw);
@@ -283,8 +293,10 @@ void main() {
         if (ms_channels == 1) ms = vec3(ms.x);
         scattered += albedo_ms * ms;
       }
-      vec3 step_T = exp(-sigma_t_view * rho * dt);
+      vec3 tau = sigma_t_view * rho * dt, step_T = exp(-tau);
       L += T * (vec3(1.0) - step_T) * scattered;
+      // L_e integral_0^dt e^(-sigma_t rho s) ds, as grids/src/march.cpp.
+      for (int c = 0; c < 3; ++c) L[c] += T[c] * Le[c] * (tau[c] > 1e-6 ? (1.0 - step_T[c]) / (sigma_t_view[c] * rho) : dt);
       T *= step_T;
     }
   }

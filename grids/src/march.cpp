@@ -94,7 +94,10 @@ struct Marcher {
       const TrilinearStencil stencil(volume.density.bounds(), volume.density.resolution(), x);
       const double rho = stencil.apply(volume.density.values().data());
       const Rgb emitted = emits ? emitted_radiance(emission, x, rho) : Rgb(0.0);
-      if (rho <= 0.0 && emitted == Rgb(0.0)) continue;
+      if (rho <= 0.0) {  // nothing scatters or absorbs here: only emission (a flame grid past the smoke)
+        radiance += transmittance * emitted * s.dt;
+        continue;
+      }
       std::fill(depth.begin(), depth.end(), 0.0);
       for (int m = 0; m < 8; ++m) {
         const float* run = packed.data() + stencil.offset[m] * lights;

@@ -4,6 +4,7 @@
 // per step of a camera ray inside the volume,
 //   L += T albedo_1 (1 - e^(-sigma_t' rho dt)) sum_l p(wi . wo) E_l e^(-sigma_t depth_l)
 //      + T albedo' (1 - e^(-sigma_t' rho dt)) sum_k c_k(wo) m_k        (when a DOM solution is shown)
+//      + T L_e (1 - e^(-sigma_t' rho dt)) / (sigma_t' rho)           (an emitting medium)
 // then surfaces (lit through the depth volumes inside the grid, a DDA walk through the density
 // outside it, shadowed by each other; with a DOM solution that carries surface texels, plus
 // (kd + ks) / pi times their irradiance, as render_dom with surface_view "texels") and the
