@@ -14,6 +14,21 @@ namespace haze::grids::dom {
 
 namespace {
 
+// L_e of the cell around x (sides h) whose density is rho: what follows the density at rho, the
+// cell's own value; the rest (an emission grid, blackbody) averaged over the cell by 2-point
+// Gauss-Legendre per axis, since a temperature's T^4 is far from linear across a voxel and its
+// value at the centre (a voxel's, where the cells sit on a VDB's voxels) is a local extreme.
+Rgb cell_emission(const Emission& emission, const Vec3& x, const Vec3& h, double rho) {
+  Rgb e(0.0);
+  Emission rest = emission;
+  if (emission.strength > 0.0 && !emission.grid) e += emission.strength * emission.color * rho, rest.strength = 0.0;
+  if (!rest.emits()) return e;
+  const double g = 0.5 / std::sqrt(3.0);
+  for (int c = 0; c < 8; ++c)
+    e += 0.125 * emitted_radiance(rest, x + h * Vec3((c & 1) ? g : -g, (c & 2) ? g : -g, (c & 4) ? g : -g), 0.0);
+  return e;
+}
+
 int octant(const Vec3& w) { return (w.x < 0.0 ? 1 : 0) | (w.y < 0.0 ? 2 : 0) | (w.z < 0.0 ? 4 : 0); }
 
 // Cells whose centre lies within kNearCells cells of a point or spot light average its irradiance
@@ -331,7 +346,7 @@ FirstCollision Transport::first_collision(const ExtinctionVolume& volume, const 
           // Cells that scatter nothing send their emission to the camera only (render_dom's march).
           if (emits) {
             const double sigma_s = volume.albedo[channel] * sigma_t * static_cast<double>(grid.values()[c]);
-            const double emitted = emitted_radiance(volume.emission, x, grid.values()[c])[channel];
+            const double emitted = cell_emission(volume.emission, x, h, grid.values()[c])[channel];
             if (sigma_s > 0.0 && emitted > 0.0) {
               const auto value = static_cast<float>(scale_all * emitted / sigma_s);
               for (size_t t = 0; t < d; ++t) f[padded_index_[t]] += value;

@@ -132,11 +132,13 @@ void block_values(const openvdb::FloatGrid& grid, const Where& at, VolumeField::
       for (int y = b0.y(); y <= b1.y(); ++y)
         for (int x = b0.x(); x <= b1.x(); ++x) block(x, y, z) = std::max(block(x, y, z), v);
   }
-  // The world box of the index box widened by the trilinear stencil's one voxel.
+  // The world box of the index box widened by the trilinear stencil's one voxel and half a voxel
+  // more: a grid method's cells, as many as the voxels across it, then sit on the voxel centres
+  // (and its own trilinear interpolation gives back the trilinear field).
   d.bounds = {Vec3(kInfinity), Vec3(-kInfinity)};
   for (int c = 0; c < 8; ++c) {
-    const glm::dvec4 p((c & 1) ? box.max().x() + 1 : lo.x() - 1, (c & 2) ? box.max().y() + 1 : lo.y() - 1,
-                       (c & 4) ? box.max().z() + 1 : lo.z() - 1, 1.0);
+    const glm::dvec4 p((c & 1) ? box.max().x() + 1.5 : lo.x() - 1.5, (c & 2) ? box.max().y() + 1.5 : lo.y() - 1.5,
+                       (c & 4) ? box.max().z() + 1.5 : lo.z() - 1.5, 1.0);
     const Vec3 w(d.index_to_world * p);
     d.bounds.lo = glm::min(d.bounds.lo, w), d.bounds.hi = glm::max(d.bounds.hi, w);
   }
