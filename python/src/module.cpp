@@ -6,6 +6,7 @@
 #include <haze/core/method.h>
 #include <haze/core/scene.h>
 #include <haze/grids/methods.h>
+#include <haze/particles/field.h>
 #include <haze/particles/methods.h>
 #include <haze/simd/airlight_batch.h>
 #include <haze/vdb/vdb.h>
@@ -91,6 +92,37 @@ GridDensity grid_from(const py::array& array, py::object& kept) {
   return GridDensity::viewing(resolution, std::span<const float>(floats.data(), static_cast<size_t>(floats.size())));
 }
 
+// A particle medium from numpy arrays (copied: the density's spatial index is built from them),
+// keeping the material, grid resolution and emission of `current`, a scene's particles block.
+using Floats = py::array_t<float, py::array::c_style | py::array::forcecast>;
+MediumDesc particles_from(const std::optional<MediumDesc>& current, const Floats& positions, const std::optional<Floats>& density,
+                          const std::optional<Floats>& diameter) {
+  const auto* field = current ? std::get_if<FieldDensity>(&current->density) : nullptr;
+  const auto* particles = field ? dynamic_cast<const particles::ParticleDensity*>(field->field.get()) : nullptr;
+  if (!particles)
+    throw Error("particles", current ? "a medium of density type \"" + (field ? field->type : std::string("other")) + "\"" : "missing",
+                "a scene with a particles block (its sigma_t, albedo, phase; \"positions\": [] will do) whose particles to set");
+  if (positions.ndim() != 2 || positions.shape(1) != 3)
+    throw Error("particles.positions", "an array of shape " + py::str(positions.attr("shape")).cast<std::string>(), "(n, 3)");
+  particles::ParticleSet set;
+  set.material = particles->set().material;
+  const auto n = static_cast<size_t>(positions.shape(0));
+  set.positions.resize(n);
+  static_assert(sizeof(Vec3f) == 3 * sizeof(float));
+  std::copy(positions.data(), positions.data() + 3 * n, reinterpret_cast<float*>(set.positions.data()));
+  auto per_particle = [&](const std::optional<Floats>& values, const char* name, std::vector<float>& out) {
+    if (!values) return;
+    if (values->ndim() != 1) throw Error(std::string("particles.") + name, "an array of shape " + py::str(values->attr("shape")).cast<std::string>(), "(n,)");
+    out.assign(values->data(), values->data() + values->size());
+  };
+  per_particle(density, "density", set.density);
+  per_particle(diameter, "diameter", set.diameters);
+  particles::validate(set.view());
+  MediumDesc medium = particles::particle_medium(std::move(set), field->grid_resolution);
+  medium.emission = current->emission;
+  return medium;
+}
+
 struct PySolution {
   std::unique_ptr<Solution> solution;
   std::vector<py::object> keep;
@@ -149,6 +181,13 @@ PYBIND11_MODULE(haze, m) {
           },
           py::arg("density"), py::arg("bounds") = std::nullopt,
           "The medium's density from a (nz, ny, nx) array over its bounds: viewed in place when float32 and C-contiguous")
+      .def(
+          "set_particles",
+          [](PyScene& s, const Floats& positions, const std::optional<Floats>& density, const std::optional<Floats>& diameter) {
+            s.scene.medium = particles_from(s.scene.medium, positions, density, diameter);
+          },
+          py::arg("positions"), py::arg("density") = std::nullopt, py::arg("diameter") = std::nullopt,
+          "The particles of the scene's particles block from arrays: positions (n, 3), density and diameter (n,) (copied)")
       .def_property_readonly("width", [](const PyScene& s) { return s.scene.camera.width_px; })
       .def_property_readonly("height", [](const PyScene& s) { return s.scene.camera.height_px; });
 
@@ -167,14 +206,18 @@ PYBIND11_MODULE(haze, m) {
           py::arg("threads") = 0, py::arg("progress") = std::nullopt)
       .def(
           "update",
-          [](PySolution& s, const std::optional<py::array>& density, int threads, const std::optional<py::function>& progress) {
+          [](PySolution& s, const std::optional<py::array>& density, const std::optional<Floats>& positions,
+             const std::optional<Floats>& particle_density, const std::optional<Floats>& diameter, int threads,
+             const std::optional<py::function>& progress) {
             SceneChange change;
             py::object kept;
+            if (density && positions) throw Error("update", "density and particles", "one of them: a grid density or particles");
             if (density) {
               MediumDesc medium = *s.solution->scene().medium;
               medium.density = grid_from(*density, kept);
               change.medium = medium;
             }
+            if (positions) change.medium = particles_from(s.solution->scene().medium, *positions, particle_density, diameter);
             UpdateReport report;
             {
               py::gil_scoped_release release;
@@ -188,8 +231,10 @@ PYBIND11_MODULE(haze, m) {
             d["stats"] = to_python(report.stats);
             return d;
           },
-          py::arg("density") = std::nullopt, py::arg("threads") = 0, py::arg("progress") = std::nullopt,
-          "Applies a new density (same shape and bounds) and redoes what it reaches")
+          py::arg("density") = std::nullopt, py::arg("positions") = std::nullopt, py::arg("particle_density") = std::nullopt,
+          py::arg("diameter") = std::nullopt, py::arg("threads") = 0, py::arg("progress") = std::nullopt,
+          "Applies a new grid density (same shape and bounds) or new particles (positions (n, 3), particle_density and diameter "
+          "(n,)) and redoes what they reach")
       .def(
           "fluence",
           [](const PySolution& s, const py::array_t<double, py::array::c_style | py::array::forcecast>& points) {

@@ -96,3 +96,50 @@ def test_progress_is_reported_and_can_cancel():
     with pytest.raises(haze.Cancelled):
         haze.render(scene, "reference", {"spp": 4096}, progress=lambda f: False)
     assert "dom" in haze.methods() and "reference" in haze.methods()
+
+
+def particle_ball(count, seed=3):
+    rng = np.random.default_rng(seed)
+    points = rng.uniform(-1, 1, size=(4 * count, 3))
+    return points[np.einsum("ij,ij->i", points, points) < 1][:count].astype(np.float32)
+
+
+def test_particles_from_numpy_render_and_update():
+    # A particles block with no positions yet, filled from numpy: the same image as the block
+    # written out in the dict; moved particles through update() give the image of a new solution.
+    positions = particle_ball(300)
+    scene = {
+        "camera": {"position": [0, 0.4, 4.0], "look_at": [0, 0, 0], "fov_y_deg": 38, "width_px": 16, "height_px": 12},
+        "particles": {"positions": [], "sigma_t": 4.0, "albedo": 0.9},
+        "lights": [{"type": "directional", "direction": [-0.5, -0.7, -0.5], "irradiance": 1.0}],
+    }
+    from_numpy = haze.Scene.from_dict(scene)
+    from_numpy.set_particles(positions)
+    scene["particles"]["positions"] = positions.tolist()
+    in_dict = haze.Scene.from_dict(scene)
+    a = haze.render(from_numpy, "network", {"directions": 32})["radiance"]
+    b = haze.render(in_dict, "network", {"directions": 32})["radiance"]
+    assert a.mean() > 0.01
+    np.testing.assert_allclose(a, b, rtol=1e-6, atol=1e-7)
+
+    moved = positions.copy()
+    moved[:20] += np.float32(0.05)
+    solution = haze.prepare(from_numpy, "network", {"directions": 32})
+    report = solution.update(positions=moved)
+    assert not report["rebuilt"]
+    from_numpy.set_particles(moved)
+    fresh = haze.render(from_numpy, "network", {"directions": 32})["radiance"]
+    np.testing.assert_allclose(solution.render()["radiance"], fresh, rtol=2e-3, atol=1e-5)
+
+    with pytest.raises(haze.Error) as e:
+        from_numpy.set_particles(positions[:, :2])
+    assert e.value.field == "particles.positions" and "(n, 3)" in e.value.expected
+    bad = positions.copy()
+    bad[7, 1] = np.nan
+    with pytest.raises(haze.Error, match=r"particles.positions\[7\]"):
+        from_numpy.set_particles(bad)
+    with pytest.raises(haze.Error, match=r"particles.density"):
+        from_numpy.set_particles(positions, density=np.ones(5, dtype=np.float32))
+    with pytest.raises(haze.Error) as e:
+        fog().set_particles(positions)
+    assert e.value.field == "particles"
