@@ -318,6 +318,7 @@ DomFields dom_fields(const Scene& scene, const RenderOptions& options) {
   dom.max_iterations = static_cast<int>(settings.integer("iterations"));
   dom.tolerance = settings.number("tolerance");
   dom.delta_m = settings.integer("delta_m") != 0;
+  dom.diffusion_acceleration = settings.integer("dsa") != 0;
   dom.storage = dom_storage_from_name(settings.choice("storage"));
   dom.threads = options.threads;
   DepthOptions depth;
@@ -448,6 +449,7 @@ MethodInfo dom_info() {
       SettingInfo::integer("iterations", d.max_iterations, 1, 100000, "transport sweeps per channel at most"),
       SettingInfo::number("tolerance", d.tolerance, 1e-9, 1.0, "stop when an iteration changes the moments by less (relative)"),
       SettingInfo::integer("delta_m", 1, 0, 1, "delta-M scaling of the phase function when N < D"),
+      SettingInfo::integer("dsa", 1, 0, 1, "diffusion synthetic acceleration of source iteration (warm updates with a sweep budget)"),
       SettingInfo::choice("storage", "float32", {"float32", "float16"}, "float16 halves the first-collision source and GMRES basis"),
       SettingInfo::choice("optical_depth", "exact", {"exact", "paper", "sweep"}, "how the depth to each light is computed"),
       SettingInfo::number("step", 0.5, 0.01, 4.0, "camera gather's ray-march step in cells"),

@@ -88,6 +88,10 @@ struct DomSettings {
   // has moments (b_k - f) / (1 - f), k < M, which N terms represent well. The first-collision
   // source keeps the exact phase function.
   bool delta_m = true;
+  // Source iteration (accelerator none, and warm updates with a sweep budget) corrects each sweep
+  // by diffusion synthetic acceleration (grids/src/dom_diffusion.h): the slow, diffusive part of
+  // the error that each sweep reduces only by the scattering ratio.
+  bool diffusion_acceleration = true;
   DomStorage storage = DomStorage::float32;
   bool scalar_kernel = false;  // sweep: the scalar reference kernel instead of the SIMD one (tests, benchmarks)
   ProgressCallback progress;  // once per iteration, with the fraction of max_iterations done
