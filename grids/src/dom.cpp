@@ -256,7 +256,7 @@ class DomMethodSolution final : public GridSolution {
       DomSettings warm = settings_;
       warm.progress = options.progress;
       // A budget of sweeps: source iteration, each sweep with the first-collision source in it.
-      if (warm_iterations_ > 0) warm.max_iterations = warm_iterations_, warm.accelerator = DomAccelerator::none;
+      if (warm_iterations_ > 0) warm.max_iterations = warm_iterations_, warm.accelerator = DomAccelerator::none, warm.fold_first_collision = true;
       SurfaceSolve next = solve_with_surfaces(scene, volume_, depths_, warm, &solution_, surface_passes_, step_cells_);
       report.redone.push_back("moments: first-collision source and " + to_text(next.iterations) + " sweeps over " +
                               to_text(next.solution.channels) + " channel(s) from the previous solution" +
@@ -453,7 +453,7 @@ MethodInfo dom_info() {
       SettingInfo::choice("storage", "float32", {"float32", "float16"}, "float16 halves the first-collision source and GMRES basis"),
       SettingInfo::choice("optical_depth", "exact", {"exact", "paper", "sweep"}, "how the depth to each light is computed"),
       SettingInfo::number("step", 0.5, 0.01, 4.0, "camera gather's ray-march step in cells"),
-      SettingInfo::integer("warm_iterations", 0, 0, 100000, "source-iteration sweeps per update, after a first-collision sweep with spatial diamond (0: GMRES to the tolerance)"),
+      SettingInfo::integer("warm_iterations", 0, 0, 100000, "source-iteration sweeps per update, the first-collision source in each (0: GMRES to the tolerance)"),
       SettingInfo::integer("surface_passes", 2, 0, 100, "solves with the light surfaces reflect into the medium, one more bounce each (scheme sweep)"),
       SettingInfo::choice("surface_view", "rays", {"rays", "texels"},
                           "visible surfaces' scattered light: 64 rays per pixel, or the surfaces' texels (what the GL display shows)")};

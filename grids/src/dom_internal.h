@@ -28,6 +28,9 @@ struct Channel {
   // moments in) where a leaving radiance would go below 0 (simd/dom_sweep.h): the single-scattered
   // light's sharp edges.
   std::uint8_t* bounded = nullptr;
+  // Mark in every sweep with the first-collision source, moments in or not (warm updates'
+  // combined sweeps): where the first-collision and scattered light together would go below 0.
+  bool mark_with_moments = false;
 };
 Channel make_channel(const ExtinctionVolume& volume, const std::vector<Light>& lights, int channel, double delta_m_fraction);
 

@@ -389,19 +389,19 @@ DomSolution solve_dom(const ExtinctionVolume& volume, const std::vector<Light>& 
     }
     const IterationProgress progress{settings, c, out.channels, out.iterations};
     if (warm_fits && settings.accelerator == DomAccelerator::none) {
-      // Source iteration from the warm moments, x <- b + K x: with the first-collision source in
-      // every sweep, where forming b apart would take one more; with the diamond's fix-up, b
-      // apart (its sweep sets the marks, as in a cold solve, the moving light's edges with them),
-      // one sweep more than the budget.
+      // Source iteration from the warm moments, x <- b + K x, each sweep with the first-collision
+      // source in it (forming b apart would take one more). With the diamond's fix-up, b apart
+      // (its sweep sets the marks, as in a cold solve), unless fold_first_collision sets them in
+      // the sweeps of b + K x (DomSettings).
       x = warm->moments[static_cast<size_t>(c)];
       std::vector<float> next(size), b;
-      if (channel.bounded) {
+      channel.mark_with_moments = channel.bounded && settings.fold_first_collision;
+      if (channel.bounded && !settings.fold_first_collision) {
         b.resize(size);
         transport.sweep(channel, &first, nullptr, channel.sky, b.data(), settings.threads, entering);
         ++out.iterations;
       }
-      const int budget = settings.max_iterations + (b.empty() ? 0 : 1);
-      while (out.iterations - progress.start < budget) {
+      while (out.iterations - progress.start < settings.max_iterations + (b.empty() ? 0 : 1)) {
         if (b.empty()) {
           transport.sweep(channel, &first, x.data(), channel.sky, next.data(), settings.threads, entering);
         } else {

@@ -186,7 +186,7 @@ void Transport::sweep(const Channel& ch, const FirstCollision* first, const floa
         if (first && !first->slope.empty()) row.first_slope = first->slope.data();
         row.first_stride = padded_;
         row.m_in = m_in, row.m_out = out;
-        if (ch.bounded) row.bounded = ch.bounded + o, row.mark = first && !m_in;
+        if (ch.bounded) row.bounded = ch.bounded + o, row.mark = first && (!m_in || ch.mark_with_moments);
         row.x_run = x_run.data(), row.y_row = y_row.data(), row.scratch = scratch.data();
         for (int kk = 0; kk < nz; ++kk) {
           const int k = o & 4 ? nz - 1 - kk : kk;
