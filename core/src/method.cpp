@@ -142,7 +142,7 @@ std::string settings_markdown(const MethodInfo& info) {
 }
 
 Settings::Settings(const nlohmann::json& settings, const std::string& method) : settings_(settings), method_(method_info(method)) {
-  if (!settings_.is_object()) throw Error("method", settings_.dump(), "an object of " + method + " settings");
+  if (!settings_.is_object()) throw Error("method", json_text(settings_), "an object of " + method + " settings");
 }
 
 const SettingInfo& Settings::info(const std::string& key, SettingInfo::Type type) {
@@ -158,7 +158,7 @@ long long Settings::integer(const std::string& key, long long fallback) {
   auto it = settings_.find(key);
   if (it == settings_.end()) return fallback;
   if (!it->is_number_integer() || static_cast<double>(it->get<long long>()) < s.min || static_cast<double>(it->get<long long>()) > s.max)
-    throw Error("method." + key, it->dump(), range(s));
+    throw Error("method." + key, json_text(*it), range(s));
   return it->get<long long>();
 }
 
@@ -167,7 +167,7 @@ double Settings::number(const std::string& key, double fallback) {
   const SettingInfo& s = info(key, SettingInfo::Type::number);
   auto it = settings_.find(key);
   if (it == settings_.end()) return fallback;
-  if (!it->is_number() || !(it->get<double>() >= s.min && it->get<double>() <= s.max)) throw Error("method." + key, it->dump(), range(s));
+  if (!it->is_number() || !(it->get<double>() >= s.min && it->get<double>() <= s.max)) throw Error("method." + key, json_text(*it), range(s));
   return it->get<double>();
 }
 
@@ -177,7 +177,7 @@ std::string Settings::choice(const std::string& key, const std::string& fallback
   auto it = settings_.find(key);
   if (it == settings_.end()) return fallback;
   if (it->is_string() && std::find(s.choices.begin(), s.choices.end(), it->get<std::string>()) != s.choices.end()) return it->get<std::string>();
-  throw Error("method." + key, it->dump(), range(s));
+  throw Error("method." + key, json_text(*it), range(s));
 }
 
 std::vector<int> Settings::cells(const std::string& key) {
@@ -188,7 +188,7 @@ std::vector<int> Settings::cells(const std::string& key) {
   if (in_range(value)) return {value.get<int>()};
   if (value.is_array() && value.size() == 3 && std::all_of(value.begin(), value.end(), in_range))
     return {value[0].get<int>(), value[1].get<int>(), value[2].get<int>()};
-  throw Error("method." + key, value.dump(), range(s));
+  throw Error("method." + key, json_text(value), range(s));
 }
 
 void Settings::reject_unknown() const {
@@ -196,7 +196,7 @@ void Settings::reject_unknown() const {
     if (key == "name" || std::find(known_.begin(), known_.end(), key) != known_.end()) continue;
     std::string names;
     for (const auto& k : method_.settings) names += (names.empty() ? "" : ", ") + k.name;
-    throw Error("method." + key, value.dump(), "a setting of " + method_.name + ": " + (names.empty() ? "none" : names));
+    throw Error("method." + key, json_text(value), "a setting of " + method_.name + ": " + (names.empty() ? "none" : names));
   }
 }
 

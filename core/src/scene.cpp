@@ -11,7 +11,9 @@
 #include <initializer_list>
 #include <iterator>
 #include <map>
+#include <memory>
 #include <mutex>
+#include <set>
 #include <new>
 #include <string_view>
 #include <utility>
@@ -45,14 +47,47 @@ std::string join(std::initializer_list<std::string_view> names, std::string_view
   return out;
 }
 
-// The offending value as text. nlohmann dumps NaN and inf as null, so those are written by hand;
-// long values are cut so that a bad 1000-entry array does not flood the message.
-std::string text(const json& v) {
-  if (v.is_number_float() && !std::isfinite(v.get<double>())) return to_text(v.get<double>());
-  std::string s = v.dump(-1, ' ', false, json::error_handler_t::replace);
+// A string as JSON, at most `most` of its characters.
+std::string quoted(const std::string& s, size_t most) {
+  return json(s.substr(0, most)).dump(-1, ' ', false, json::error_handler_t::replace) + (s.size() > most ? "..." : "");
+}
+
+// Appends v as JSON text until `out` holds `limit` characters, no deeper than 16 levels: a value
+// may be megabytes long or nested 100,000 deep, so it is never dumped whole.
+void brief(const json& v, std::string& out, size_t limit, int depth) {
+  if (out.size() >= limit) return;
+  if (v.is_string()) {
+    out += quoted(v.get_ref<const std::string&>(), limit - out.size());
+  } else if (v.is_number_float() && !std::isfinite(v.get<double>())) {
+    out += to_text(v.get<double>());  // nlohmann dumps NaN and inf as null
+  } else if (!v.is_structured()) {
+    out += v.dump();
+  } else if (depth >= 16) {
+    out += v.is_array() ? "[...]" : "{...}";
+  } else {
+    out += v.is_array() ? '[' : '{';
+    for (auto it = v.begin(); it != v.end(); ++it) {
+      if (it != v.begin()) out += ", ";
+      if (out.size() >= limit) return;
+      if (v.is_object()) out += quoted(it.key(), limit) + ": ";
+      brief(*it, out, limit, depth + 1);
+    }
+    out += v.is_array() ? ']' : '}';
+  }
+}
+
+}  // namespace
+
+std::string json_text(const nlohmann::json& v) {
+  std::string s;
+  brief(v, s, 81, 0);
   if (s.size() > 80) s = s.substr(0, 77) + "...";
   return s;
 }
+
+namespace {
+
+std::string text(const json& v) { return json_text(v); }
 
 // A number check: the predicate and the words for the error message.
 struct Check {
@@ -672,6 +707,62 @@ Scene Scene::from_json(const nlohmann::json& json, const std::filesystem::path& 
   }
 }
 
+namespace {
+
+// The scene file's JSON, checked as it is parsed (nlohmann's parser callback): arrays and objects
+// nested at most kMaxJsonDepth deep (a million-deep file would overflow a recursive reader), and no
+// key twice in one object (nlohmann keeps the last silently). Errors name the JSON path.
+constexpr std::size_t kMaxJsonDepth = 256;
+struct JsonChecks {
+  struct Level {
+    bool array = false;
+    long index = -1;      // an array's element being read
+    std::string key;      // an object's key being read
+    std::set<std::string> keys;
+  };
+  std::string file;
+  std::shared_ptr<std::vector<Level>> levels = std::make_shared<std::vector<Level>>();  // the callback is copied
+
+  std::string where() const {
+    std::string out;
+    for (const Level& l : *levels) out += l.array ? "[" + std::to_string(l.index) + "]" : (out.empty() ? "" : ".") + l.key;
+    return out.empty() ? "(scene)" : out;
+  }
+  bool operator()(int, json::parse_event_t event, json& parsed) const {
+    using Event = json::parse_event_t;
+    std::vector<Level>& stack = *levels;
+    const auto element = [&] {
+      if (!stack.empty() && stack.back().array) ++stack.back().index;
+    };
+    switch (event) {
+      case Event::object_start:
+      case Event::array_start:
+        element();
+        if (stack.size() >= kMaxJsonDepth)
+          throw Error(file, "arrays and objects nested deeper than " + std::to_string(kMaxJsonDepth) + " at " + where(),
+                      "at most " + std::to_string(kMaxJsonDepth) + " levels");
+        stack.push_back({event == Event::array_start, -1, {}, {}});
+        break;
+      case Event::key: {
+        Level& object = stack.back();
+        object.key = parsed.get<std::string>();
+        if (!object.keys.insert(object.key).second) throw Error(where(), "given twice", "each key once in an object");
+        break;
+      }
+      case Event::value:
+        element();
+        break;
+      case Event::object_end:
+      case Event::array_end:
+        stack.pop_back();
+        break;
+    }
+    return true;
+  }
+};
+
+}  // namespace
+
 Scene Scene::load(const std::filesystem::path& path) {
   std::error_code ec;
   if (!fs::is_regular_file(path, ec)) throw Error(path.string(), "missing", "an existing scene file");
@@ -680,22 +771,31 @@ Scene Scene::load(const std::filesystem::path& path) {
   if (!in.good() && !in.eof()) throw Error(path.string(), "unreadable", "a readable scene file");
 
   nlohmann::json j;
+  // Line and column of byte `pos` (0-based) of the file.
+  auto place = [&](std::size_t pos) {
+    pos = std::min(pos, content.size());
+    const std::string_view head = std::string_view(content).substr(0, pos);
+    const std::size_t last_newline = head.rfind('\n');
+    return "line " + std::to_string(1 + std::count(head.begin(), head.end(), '\n')) + ", column " +
+           std::to_string(pos - (last_newline == std::string_view::npos ? 0 : last_newline + 1) + 1);
+  };
   try {
-    j = nlohmann::json::parse(content);
+    j = nlohmann::json::parse(content, JsonChecks{path.string()});
+  } catch (const nlohmann::json::out_of_range& e) {
+    // A number beyond a double's range ("number overflow parsing '1e999'"): where it is.
+    std::string detail = e.what();
+    const std::size_t open = detail.find('\''), close = detail.rfind('\'');
+    const std::string token = open != std::string::npos && close > open ? detail.substr(open + 1, close - open - 1) : std::string();
+    const std::size_t at = token.empty() ? std::string::npos : content.find(token);
+    throw Error(path.string(), (at == std::string::npos ? std::string() : "at " + place(at) + ": ") + "the number " + token,
+                "numbers within a double's range (up to about 1.8e308)");
   } catch (const nlohmann::json::parse_error& e) {
-    // nlohmann's byte is 1-based: the character where parsing failed.
-    std::size_t pos = std::min<std::size_t>(e.byte > 0 ? e.byte - 1 : 0, content.size());
-    std::string_view head = std::string_view(content).substr(0, pos);
-    auto line = 1 + std::count(head.begin(), head.end(), '\n');
-    std::size_t last_newline = head.rfind('\n');
-    std::size_t column = pos - (last_newline == std::string_view::npos ? 0 : last_newline + 1) + 1;
     // Drop nlohmann's "[json.exception.parse_error.101] " tag: the rest is the useful part.
     std::string detail = e.what();
     if (auto tag_end = detail.find("] "); detail.starts_with("[json.exception") && tag_end != std::string::npos)
       detail.erase(0, tag_end + 2);
-    throw Error(path.string(),
-                "invalid JSON at line " + std::to_string(line) + ", column " + std::to_string(column) + " (byte " +
-                    std::to_string(e.byte) + ")",
+    // nlohmann's byte is 1-based: the character where parsing failed.
+    throw Error(path.string(), "invalid JSON at " + place(e.byte > 0 ? e.byte - 1 : 0) + " (byte " + std::to_string(e.byte) + ")",
                 "valid JSON (" + detail + ")");
   }
   fs::path base = path.parent_path();

@@ -141,7 +141,7 @@ RenderResult Solution::render(const View& view, const RenderOptions& options) co
     throw Error("view", view.layers ? "layers" : "a depth buffer",
                 "a method that renders layers and takes a depth buffer (every built-in method does; " + s.info.name + " does not)");
   if (!options.settings.is_null() && (!options.settings.is_object() || !options.settings.empty()))
-    throw Error("settings", options.settings.dump(), "none when rendering a solution (settings are given to haze::prepare)");
+    throw Error("settings", json_text(options.settings), "none when rendering a solution (settings are given to haze::prepare)");
   if (s.options.single_view && !(view.camera == s.scene.camera))
     throw Error("view.camera", "another camera than the scene's", "the scene's camera for a solution prepared with single_view");
   RenderOptions o = s.options;
@@ -251,7 +251,7 @@ Solution prepare(const Scene& scene, const std::string& method_name, RenderOptio
   nlohmann::json settings = nlohmann::json::object();
   if (scene.method_name() == name) settings = scene.method;
   if (!options.settings.is_null() && !options.settings.is_object())
-    throw Error("settings", options.settings.dump(), "an object of " + name + " settings");
+    throw Error("settings", json_text(options.settings), "an object of " + name + " settings");
   for (const auto& [key, value] : options.settings.items()) settings[key] = value;
   settings.erase("name");
   const ProgressCallback progress = std::move(options.progress);

@@ -16,11 +16,11 @@ using nlohmann::json;
 std::vector<float> per_particle(const json& j, const std::string& field, size_t count) {
   if (j.is_number()) return std::vector<float>(count, j.get<float>());
   if (!j.is_array() || j.size() != count)
-    throw Error("particles." + field, j.is_array() ? to_text(j.size()) + " values" : j.dump(),
+    throw Error("particles." + field, j.is_array() ? to_text(j.size()) + " values" : json_text(j),
                 "a number, or an array of " + to_text(count) + " numbers (one per particle)");
   std::vector<float> out;
   for (size_t i = 0; i < j.size(); ++i) {
-    if (!j[i].is_number()) throw Error("particles." + field + "[" + std::to_string(i) + "]", j[i].dump(), "a number");
+    if (!j[i].is_number()) throw Error("particles." + field + "[" + std::to_string(i) + "]", json_text(j[i]), "a number");
     out.push_back(j[i].get<float>());
   }
   return out;
@@ -72,10 +72,10 @@ ParticleSet ParticleSet::from_json(const json& j, const std::filesystem::path& b
     read_csv(scene_fields::existing_file(j, "particles", base_dir, "a CSV file name (relative to the scene file's folder)"), set);
   } else {
     const json& p = j["positions"];
-    if (!p.is_array()) throw Error("particles.positions", p.dump(), "an array of [x, y, z]");
+    if (!p.is_array()) throw Error("particles.positions", json_text(p), "an array of [x, y, z]");
     for (size_t i = 0; i < p.size(); ++i) {
       if (!p[i].is_array() || p[i].size() != 3 || !p[i][0].is_number() || !p[i][1].is_number() || !p[i][2].is_number())
-        throw Error("particles.positions[" + std::to_string(i) + "]", p[i].dump(), "[x, y, z]");
+        throw Error("particles.positions[" + std::to_string(i) + "]", json_text(p[i]), "[x, y, z]");
       set.positions.emplace_back(p[i][0].get<float>(), p[i][1].get<float>(), p[i][2].get<float>());
     }
   }

@@ -460,5 +460,68 @@ TEST_F(SceneFiles, LoadSyntaxErrorNamesFileAndLine) {
   }
 }
 
+// Hostile files (issue 26): nesting a million deep, a number past a double, a key given twice and
+// values of megabytes each get a haze::Error naming where, and no message floods the terminal.
+TEST_F(SceneFiles, HostileJsonGetsClearErrors) {
+  auto error_of = [](const fs::path& file) -> Error {
+    try {
+      Scene::load(file);
+    } catch (const Error& e) {
+      return e;
+    }
+    return Error("(no error)");
+  };
+  const fs::path deep = test_dir() / "deep.json";
+  write_text(deep, "{\"medium\": " + std::string(100000, '[') + std::string(100000, ']') + "}");
+  Error e = error_of(deep);
+  EXPECT_EQ(e.field(), deep.string());
+  EXPECT_NE(e.value().find("nested deeper than 256 at medium[0]"), std::string::npos) << e.what();
+
+  const fs::path huge = test_dir() / "huge.json";
+  write_text(huge, "{\n  \"camera\": {\"position\": [0, 0, 5],\n    \"look_at\": [0, 1e999, 0]}\n}\n");
+  e = error_of(huge);
+  EXPECT_EQ(e.field(), huge.string());
+  EXPECT_EQ(e.value(), "at line 3, column 20: the number 1e999") << e.what();
+  write_text(huge, "{\"background\": 1" + std::string(1000000, '0') + "}");
+  e = error_of(huge);
+  EXPECT_NE(e.value().find("at line 1, column 16"), std::string::npos) << e.value().substr(0, 300);
+  EXPECT_LT(std::string(e.what()).size(), 600u);
+
+  const fs::path twice = test_dir() / "twice.json";
+  write_text(twice, R"({"camera": {"position": [0, 0, 5], "look_at": [0, 0, 0]},
+    "lights": [{"type": "point", "position": [0, 1, 0], "intensity": 1},
+               {"type": "point", "position": [0, 2, 0], "intensity": 1, "position": [0, 3, 0]}]})");
+  e = error_of(twice);
+  EXPECT_EQ(e.field(), "lights[1].position");
+  EXPECT_EQ(e.value(), "given twice");
+
+  const fs::path long_key = test_dir() / "long_key.json";
+  write_text(long_key, "{\"camera\": {\"position\": [0, 0, 5], \"look_at\": [0, 0, 0]}, \"" + std::string(50'000'000, 'k') + "\": 1}");
+  e = error_of(long_key);
+  EXPECT_LT(std::string(e.what()).size(), 1000u);
+  EXPECT_NE(e.field().find("(50000000 characters)"), std::string::npos) << e.field().substr(0, 300);
+}
+
+// A value nested 100,000 deep handed over through the API (not a file): its error message shows
+// its first levels only.
+TEST(Scene, DeepValueThroughTheApiIsShownBriefly) {
+  json deep = 1.0;
+  for (int i = 0; i < 100000; ++i) {
+    json outer = json::array();
+    outer.push_back(std::move(deep));
+    deep = std::move(outer);
+  }
+  const json scene = {{"camera", {{"position", {0, 0, 5}}, {"look_at", {0, 0, 0}}}}, {"background", std::move(deep)}};
+  try {
+    Scene::from_json(scene);
+    FAIL() << "no haze::Error";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.field(), "background");
+    EXPECT_TRUE(e.value().starts_with("[[[[")) << e.value();
+    EXPECT_LE(e.value().size(), 80u);
+  }
+  EXPECT_EQ(json_text(json::array({1, 2, std::nan(""), "x"})), "[1, 2, nan, \"x\"]");
+}
+
 }  // namespace
 }  // namespace haze

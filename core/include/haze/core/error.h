@@ -11,7 +11,8 @@
 namespace haze {
 
 // An error a caller can act on: it names the field (a JSON path such as "medium.albedo[1]" or an
-// API parameter), the offending value and what was expected.
+// API parameter), the offending value and what was expected. A field or value longer than 240
+// characters is cut to its first 200 and its length.
 class Error : public std::runtime_error {
  public:
   explicit Error(const std::string& message) : std::runtime_error(message) {}
@@ -22,6 +23,7 @@ class Error : public std::runtime_error {
   const std::string& expected() const { return expected_; }
 
  private:
+  Error(std::string field, std::string value, std::string expected, int);  // already shortened
   std::string field_, value_, expected_;
 };
 

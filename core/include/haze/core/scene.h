@@ -34,6 +34,10 @@ MaterialDesc read_material(const nlohmann::json& j, const std::string& path);
 // the medium's emission (MediumDesc::emission); their `grid`s are siblings of `density`'s field.
 Emission read_emission(const nlohmann::json& j, const std::string& path, const Density& density);
 
+// A JSON value as an error message shows it: at most 80 characters, never dumped whole (it may be
+// megabytes long or nested 100,000 deep); NaN and infinities by name.
+std::string json_text(const nlohmann::json& value);
+
 // For modules reading their own blocks with the scene reader's checks and messages (each throws
 // haze::Error naming path.key, the value shortened to 80 characters, and what was expected):
 namespace scene_fields {
