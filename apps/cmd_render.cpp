@@ -8,6 +8,7 @@
 #include <haze/vdb/vdb.h>
 
 #include <optional>
+#include <tuple>
 #include <iostream>
 
 namespace haze::app {
@@ -67,16 +68,28 @@ nlohmann::json parse_settings(const std::vector<std::string>& pairs) {
 
 int run(const RenderArgs& a) {
   Scene scene = Scene::load(a.scene);
+  // Where the image goes: an EXR (its PNG preview beside it), neither of them the scene itself.
+  const std::filesystem::path out =
+      a.out.empty() ? std::filesystem::path(a.scene).stem().string() + "_" + (a.method.empty() ? scene.method_name() : a.method) + ".exr" : a.out;
+  if (out.extension() != ".exr") throw Error("--out", out.string(), "an .exr file name (the PNG preview is written beside it)");
+  std::error_code ec;
+  for (const auto& written : {out, std::filesystem::path(out).replace_extension(".png")})
+    if (std::filesystem::equivalent(written, a.scene, ec))
+      throw Error("--out", out.string(), "a file other than the scene " + a.scene + " (writing " + written.string() + " would replace it)");
   std::string method = a.method.empty() ? scene.method_name() : a.method;
   if (method.empty()) create_method("");  // the error lists the available methods
   RenderOptions options;
   options.threads = a.threads;
   options.settings = parse_settings(a.set);
   if (!a.no_cache) options.cache_dir = default_cache_dir();
-  if (a.spp) options.settings["spp"] = *a.spp;
-  if (a.max_scattering) options.settings["max_scattering"] = *a.max_scattering;
-  if (a.max_bounces) options.settings["max_bounces"] = *a.max_bounces;
-  if (a.seed) options.settings["seed"] = *a.seed;
+  // The reference's shortcuts, each given once: with --set as well, which would win is unclear.
+  for (const auto& [flag, key, value] : {std::tuple{"--spp", "spp", a.spp}, {"--max-scattering", "max_scattering", a.max_scattering},
+                                         {"--max-bounces", "max_bounces", a.max_bounces}, {"--seed", "seed", a.seed}}) {
+    if (!value) continue;
+    if (options.settings.contains(key))
+      throw Error(std::string("--set ") + key, json_text(options.settings[key]), std::string("not given with ") + flag + " (one of them)");
+    options.settings[key] = *value;
+  }
   if (a.tolerance) {
     if (method != "auto") throw Error("--tolerance", std::to_string(*a.tolerance), "--method auto (the only method that takes a tolerance)");
     options.settings["tolerance"] = *a.tolerance;
@@ -126,7 +139,6 @@ int run(const RenderArgs& a) {
   for (const nlohmann::json* stats : {&result.stats, result.stats.contains("method_stats") ? &result.stats["method_stats"] : nullptr})
     if (stats && stats->contains("warnings") && (*stats)["warnings"].is_array())
       for (const auto& line : (*stats)["warnings"]) std::cerr << "warning: " << line.get<std::string>() << "\n";
-  std::filesystem::path out = a.out.empty() ? std::filesystem::path(a.scene).stem().string() + "_" + method + ".exr" : a.out;
   auto summary = save_result(result, method, seconds, out, !a.no_png);
   summary["scene"] = a.scene;
   if (!a.fields.empty()) summary["fields"] = {{"output", a.fields}, {"grids", fields}, {"resolution", a.fields_resolution}};

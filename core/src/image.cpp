@@ -90,6 +90,12 @@ void write_exr(const std::filesystem::path& path, const Image& image, const std:
 Image read_exr(const std::filesystem::path& path, std::optional<Image>* std_error) {
   try {
     Imf::InputFile file(path.string().c_str());
+    // Missing channels would read as zeros: an image of other channels (a 1-channel Y or Z) is refused.
+    std::string channels;
+    for (auto c = file.header().channels().begin(); c != file.header().channels().end(); ++c) channels += (channels.empty() ? "" : ", ") + std::string(c.name());
+    for (const char* name : {"R", "G", "B"})
+      if (!file.header().channels().findChannel(name))
+        throw Error("exr input " + path.string(), "channels " + (channels.empty() ? std::string("(none)") : channels), "channels R, G and B");
     auto window = file.header().dataWindow();
     Image image(window.max.x - window.min.x + 1, window.max.y - window.min.y + 1);
     bool has_error = file.header().channels().findChannel("stderr.R") != nullptr;

@@ -298,7 +298,10 @@ void check_grid_values(const GridDensity& grid, const std::string& path, const f
 // The existing file o.file names, relative to the scene's folder, as an absolute path (so that
 // messages say exactly where Haze looked).
 fs::path existing_file(const Object& o, const fs::path& base_dir, const std::string& expected) {
-  fs::path file = read_string(o.need("file", expected), o.at("file"), expected);
+  const std::string name = read_string(o.need("file", expected), o.at("file"), expected);
+  // A NUL would end the name early for the C library: "a.raw\u0000.vdb" is not "a.raw".
+  if (name.find('\0') != std::string::npos) throw Error(o.at("file"), text(o.need("file", expected)), "a file name without NUL characters");
+  fs::path file = name;
   if (file.is_relative()) file = base_dir / file;
   std::error_code ec;
   if (fs::path absolute = fs::absolute(file, ec); !ec) file = absolute;

@@ -68,6 +68,14 @@ TEST(Image, ExrLayersAndDepthChannel) {
     EXPECT_EQ(read_exr_depth(path, w, h), z) << name;
     EXPECT_EQ(w, 3);
     EXPECT_EQ(h, 2);
+    // Read as an image (haze compare), its missing R, G, B would be zeros: refused, naming what it has.
+    try {
+      read_exr(path);
+      FAIL() << "read a " << name << "-only EXR as RGB";
+    } catch (const Error& e) {
+      EXPECT_EQ(e.value(), std::string("channels ") + name) << e.what();
+      EXPECT_EQ(e.expected(), "channels R, G and B");
+    }
   }
   write_exr(path, img);
   try {

@@ -500,6 +500,15 @@ TEST_F(SceneFiles, HostileJsonGetsClearErrors) {
   e = error_of(long_key);
   EXPECT_LT(std::string(e.what()).size(), 1000u);
   EXPECT_NE(e.field().find("(50000000 characters)"), std::string::npos) << e.field().substr(0, 300);
+
+  // A NUL inside a file name would cut it short for the C library ("cube.raw" would be read).
+  const fs::path nul = test_dir() / "nul.json";
+  write_text(nul, R"({"camera": {"position": [0, 0, 5], "look_at": [0, 0, 0]},
+    "medium": {"bounds": [[-1, -1, -1], [1, 1, 1]], "sigma_t": 1,
+               "density": {"type": "grid", "resolution": [2, 2, 2], "file": "cube.raw\u0000.vdb"}}})");
+  e = error_of(nul);
+  EXPECT_EQ(e.field(), "medium.density.file");
+  EXPECT_EQ(e.expected(), "a file name without NUL characters");
 }
 
 // A value nested 100,000 deep handed over through the API (not a file): its error message shows
