@@ -252,6 +252,22 @@ TEST(VdbScene, ReadsTheDensityBlockAndRefusesWhatDoesNotFit) {
 // The same cloud as a VDB renders with every method that takes a heterogeneous density, the
 // reference and the DOM agreeing within the DOM's documented error (METHODS.md: 0.7% to 1.2% rms;
 // the test allows 3%, as tests/grids/dom_test.cpp); analytic and network refuse it by name.
+// The DOM's image of `scene` against the reference's at `spp`: the lit-pixel error, printed; the
+// two renders are left in reference_out and dom_out where given.
+LitPixelError dom_against_reference(const Scene& scene, int spp, int seed, const char* what, RenderResult* reference_out = nullptr,
+                                    RenderResult* dom_out = nullptr) {
+  RenderOptions reference_options;
+  reference_options.settings = {{"spp", spp}, {"seed", seed}};
+  RenderResult reference = render(scene, "reference", reference_options);
+  RenderResult dom = render(scene, "dom");
+  const LitPixelError e = lit_pixel_error(dom.radiance, reference.radiance, &*reference.std_error);
+  std::printf("%s, dom against the reference: %d lit pixels, rms without the noise %.4f (noise %.4f), signed mean %+.4f +- %.4f\n", what,
+              e.pixels, e.rms_noise_removed, e.noise_rms, e.signed_mean, e.signed_mean_error);
+  if (reference_out) *reference_out = std::move(reference);
+  if (dom_out) *dom_out = std::move(dom);
+  return e;
+}
+
 TEST(VdbScene, RendersWithEveryMethod) {
   grids::register_methods();
   particles::register_methods();
@@ -261,13 +277,7 @@ TEST(VdbScene, RendersWithEveryMethod) {
   write(file, {cloud_grid(std::get<RbfDensity>(scene.medium->density), 0.04)});
   scene.medium->density = volume_density(VolumeField::read(file));
 
-  RenderOptions reference_options;
-  reference_options.settings = {{"spp", 16384}, {"seed", 7}};
-  const RenderResult reference = render(scene, "reference", reference_options);
-  const RenderResult dom = render(scene, "dom");
-  const LitPixelError e = lit_pixel_error(dom.radiance, reference.radiance, &*reference.std_error);
-  std::printf("vdb cloud, dom against the reference: %d lit pixels, rms without the noise %.4f (noise %.4f), signed mean %+.4f +- %.4f\n",
-              e.pixels, e.rms_noise_removed, e.noise_rms, e.signed_mean, e.signed_mean_error);
+  const LitPixelError e = dom_against_reference(scene, 16384, 7, "vdb cloud");
   ASSERT_GT(e.pixels, 80);
   EXPECT_LT(e.rms_noise_removed, 0.03);
   EXPECT_LT(std::abs(e.signed_mean), 0.01 + 3.0 * e.signed_mean_error);
@@ -299,13 +309,8 @@ TEST(VdbScene, MantaflowBakeFromBlender) {
   scene.camera.width_px = scene.camera.height_px = 32;
   const auto& info = dynamic_cast<const VolumeField&>(*std::get<FieldDensity>(scene.medium->density).field).info();
   EXPECT_EQ(info.voxels, (std::array<int, 3>{30, 30, 30}));
-  RenderOptions reference_options;
-  reference_options.settings = {{"spp", 2048}, {"seed", 11}};
-  const RenderResult reference = render(scene, "reference", reference_options);
-  const RenderResult dom = render(scene, "dom");
-  const LitPixelError e = lit_pixel_error(dom.radiance, reference.radiance, &*reference.std_error);
-  std::printf("mantaflow fire, dom against the reference: %d lit pixels, rms without the noise %.4f (noise %.4f), signed mean %+.4f +- %.4f\n",
-              e.pixels, e.rms_noise_removed, e.noise_rms, e.signed_mean, e.signed_mean_error);
+  RenderResult reference, dom;
+  const LitPixelError e = dom_against_reference(scene, 2048, 11, "mantaflow fire", &reference, &dom);
   EXPECT_GT(e.pixels, 32 * 32 / 2);
   EXPECT_LT(e.rms_noise_removed, 0.03);
   EXPECT_LT(std::abs(e.signed_mean), 0.02 + 3.0 * e.signed_mean_error);
