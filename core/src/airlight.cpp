@@ -637,6 +637,7 @@ SurfaceAirlightTable SurfaceAirlightTable::cached(const AirlightTable& airlight,
 }
 
 double SurfaceAirlightTable::eval(double optical_depth, double angle) const {
+  if (!(optical_depth >= 0.0 && optical_depth < kInfinity && angle == angle)) return 0.0;  // no index from NaN
   double m = optical_depth / (1.0 + optical_depth);
   double fi = std::clamp(m, 0.0, 1.0) * (nt_ - 1), fk = std::clamp(angle / kPi, 0.0, 1.0) * (na_ - 1);
   int i = std::min(static_cast<int>(fi), nt_ - 2), k = std::min(static_cast<int>(fk), na_ - 2);

@@ -83,8 +83,10 @@ void Camera::row_rays_at(double py, const double* px, int count, Ray* out) const
     for (int i = 0; i < count; ++i) out[i] = generate_ray(px[i], py);
     return;
   }
-  const Vec3 forward = glm::normalize(look_at - position);
-  const Vec3 right = glm::normalize(glm::cross(forward, up));
+  Vec3 forward = look_at - position, right;
+  make_unit(forward);  // check_scene refuses a camera whose view or up gives no frame
+  right = glm::cross(forward, up);
+  make_unit(right);
   const Vec3 true_up = glm::cross(right, forward);
   // Film coordinates in [-1, 1] vertically, aspect-scaled horizontally; row 0 at the top.
   const double aspect = static_cast<double>(width_px) / height_px;

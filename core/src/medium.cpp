@@ -1,6 +1,7 @@
 #include <haze/core/blackbody.h>
 #include <haze/core/error.h>
 #include <haze/core/grid_walk.h>
+#include <haze/core/limits.h>
 #include <haze/core/majorant.h>
 #include <haze/core/medium.h>
 #include <haze/core/progress.h>
@@ -218,6 +219,9 @@ Aabb medium_bounds(const MediumDesc& desc) {
 namespace {
 bool finite(const Vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 bool finite_non_negative(const Rgb& c) { return finite(c) && c.r >= 0.0 && c.g >= 0.0 && c.b >= 0.0; }
+bool in_reach(const Vec3& p) { return std::max({std::abs(p.x), std::abs(p.y), std::abs(p.z)}) <= kMaxCoordinate; }
+bool radiometric(const Rgb& c) { return finite_non_negative(c) && std::max({c.r, c.g, c.b}) <= kMaxRadiometric; }
+double largest(const Rgb& c) { return std::max({c.r, c.g, c.b}); }
 std::string text(const Vec3& v) {
   std::ostringstream out;
   out << '[' << v.x << ", " << v.y << ", " << v.z << ']';
@@ -228,36 +232,54 @@ std::string text(const Vec3& v) {
 void check_medium(const MediumDesc& desc, const std::string& path) {
   const Aabb& b = desc.bounds;
   const bool unbounded = b.lo == Vec3(-kInfinity) && b.hi == Vec3(kInfinity);
-  if (!unbounded && !(finite(b.lo) && finite(b.hi) && b.lo.x < b.hi.x && b.lo.y < b.hi.y && b.lo.z < b.hi.z))
-    throw Error(path + ".bounds", text(b.lo) + " to " + text(b.hi), "a finite box with lo < hi on every axis, or unbounded");
-  if (!finite_non_negative(desc.sigma_t)) throw Error(path + ".sigma_t", text(desc.sigma_t), "finite values >= 0");
+  if (!unbounded && !(in_reach(b.lo) && in_reach(b.hi) && b.lo.x < b.hi.x && b.lo.y < b.hi.y && b.lo.z < b.hi.z))
+    throw Error(path + ".bounds", text(b.lo) + " to " + text(b.hi),
+                "a box with lo < hi on every axis within 1e9 of the origin (haze::kMaxCoordinate), or unbounded");
+  if (!(finite_non_negative(desc.sigma_t) && largest(desc.sigma_t) <= kMaxExtinction))
+    throw Error(path + ".sigma_t", text(desc.sigma_t), "values in [0, 1e9] (haze::kMaxExtinction)");
   if (!(finite_non_negative(desc.albedo) && desc.albedo.r <= 1.0 && desc.albedo.g <= 1.0 && desc.albedo.b <= 1.0))
     throw Error(path + ".albedo", text(desc.albedo), "values in [0, 1]");
   const Emission& e = desc.emission;
   auto check = [&](double v, const std::string& field, double max, const char* expected) {
     if (!(std::isfinite(v) && v >= 0.0 && v <= max)) throw Error(path + field, to_text(v), expected);
   };
-  check(e.strength, ".emission.strength", kInfinity, "a finite strength >= 0");
-  if (!finite_non_negative(e.color)) throw Error(path + ".emission.color", text(e.color), "finite values >= 0");
-  check(e.blackbody_intensity, ".blackbody.intensity", kInfinity, "a finite intensity >= 0");
-  if (!finite_non_negative(e.blackbody_tint)) throw Error(path + ".blackbody.tint", text(e.blackbody_tint), "finite values >= 0");
+  check(e.strength, ".emission.strength", kMaxRadiometric, "a strength in [0, 1e15] (haze::kMaxRadiometric)");
+  if (!(radiometric(e.color) && largest(e.color) * e.strength <= kMaxRadiometric))
+    throw Error(path + ".emission.color", text(e.color), "values >= 0 whose product with the strength is at most 1e15 (haze::kMaxRadiometric)");
+  check(e.blackbody_intensity, ".blackbody.intensity", kMaxRadiometric, "an intensity in [0, 1e15] (haze::kMaxRadiometric)");
+  if (!(radiometric(e.blackbody_tint) && largest(e.blackbody_tint) * e.blackbody_intensity <= kMaxRadiometric))
+    throw Error(path + ".blackbody.tint", text(e.blackbody_tint), "values >= 0 whose product with the intensity is at most 1e15 (haze::kMaxRadiometric)");
   check(e.temperature, ".blackbody.temperature", 1e6, "kelvin in [0, 1e6]");
   if (e.emits() && unbounded && !(desc.sigma_t.r > 0.0 && desc.sigma_t.g > 0.0 && desc.sigma_t.b > 0.0) &&
       !std::holds_alternative<RbfDensity>(desc.density) && !std::holds_alternative<FieldDensity>(desc.density))
     throw Error(path + ".sigma_t", text(desc.sigma_t), "> 0 in every channel for an unbounded medium that emits (else its radiance is infinite)");
+  // Extinction sigma_t rho past kMaxExtinction, blamed on the density value that reaches it.
+  const double sigma_max = largest(desc.sigma_t);
+  auto extinction = [&](double density, const std::string& field) {
+    if (sigma_max * density > kMaxExtinction)
+      throw Error(field, to_text(density), "a density whose product with sigma_t (" + to_text(sigma_max) +
+                                               ") is at most 1e9 (haze::kMaxExtinction: extinction per unit length)");
+  };
   if (const auto* c = std::get_if<ConstantDensity>(&desc.density)) {
     if (!(std::isfinite(c->value) && c->value >= 0.0)) throw Error(path + ".density.value", to_text(c->value), "a finite density >= 0");
+    extinction(c->value, path + ".density.value");
   } else if (const auto* rbf = std::get_if<RbfDensity>(&desc.density)) {
     if (rbf->blobs.empty()) throw Error(path + ".density.blobs", "[]", "at least one blob");
     for (size_t i = 0; i < rbf->blobs.size(); ++i) {
       const RbfBlob& blob = rbf->blobs[i];
       const std::string at = path + ".density.blobs[" + std::to_string(i) + "]";
-      if (!finite(blob.center)) throw Error(at + ".center", text(blob.center), "a finite point");
+      if (!in_reach(blob.center)) throw Error(at + ".center", text(blob.center), "a point within 1e9 of the origin (haze::kMaxCoordinate)");
       if (!(std::isfinite(blob.weight) && blob.weight >= 0.0)) throw Error(at + ".weight", to_text(blob.weight), "a finite weight >= 0");
+      extinction(blob.weight, at + ".weight");
       if (!(std::isfinite(blob.sharpness) && blob.sharpness > 0.0)) throw Error(at + ".sharpness", to_text(blob.sharpness), "a finite sharpness > 0");
     }
   } else if (const auto* f = std::get_if<FieldDensity>(&desc.density)) {
     if (!f->field) throw Error(path + ".density", "a " + f->type + " field without data", "a density field");
+    const Aabb fb = f->field->bounds();
+    if (!(in_reach(fb.lo) && in_reach(fb.hi)))
+      throw Error(path + ".density", "a " + f->type + " field from " + text(fb.lo) + " to " + text(fb.hi),
+                  "a field within 1e9 of the origin (haze::kMaxCoordinate)");
+    extinction(f->field->max_density(fb), path + ".density");
   } else {
     const auto& grid = std::get<GridDensity>(desc.density);
     if (unbounded) throw Error(path + ".bounds", "unbounded", "bounds for a grid density");
@@ -276,6 +298,8 @@ void check_medium(const MediumDesc& desc, const std::string& path) {
     for (size_t i = 0; i < samples.size(); ++i)
       if (!(std::isfinite(samples[i]) && samples[i] >= 0.0f))
         throw Error(field + "[" + std::to_string(i) + "]", to_text(samples[i]), "a finite density >= 0");
+      else if (sigma_max * static_cast<double>(samples[i]) > kMaxExtinction)
+        extinction(static_cast<double>(samples[i]), field + "[" + std::to_string(i) + "]");
   }
 }
 

@@ -1,7 +1,9 @@
 #include <haze/core/error.h>
+#include <haze/core/limits.h>
 #include <haze/core/mesh.h>
 
 #include <embree3/rtcore.h>
+#include <glm/common.hpp>
 #include <glm/ext/matrix_transform.hpp>
 #include <tiny_obj_loader.h>
 
@@ -34,6 +36,24 @@ bool finite(const glm::dmat4& m) {
 float near_limit(const Ray& ray, double t_min) {
   const double scale = 1.0 + std::max({std::abs(ray.origin.x), std::abs(ray.origin.y), std::abs(ray.origin.z)});
   return static_cast<float>(std::max(t_min, TriangleMesh::kSelfHit * scale));
+}
+
+// Embree refuses rays whose origin lies past 1.8e18 (its FLT_LARGE): rays from farther than
+// kLargest start near the mesh's bounds instead (vertices lie within kMaxCoordinate).
+constexpr double kLargest = 1e15;
+
+// The ray, or for a far origin the same line from where it meets `bounds` (t_min and t_max moved
+// with it); false when a far ray misses the bounds.
+bool near_start(const Ray& ray, const Aabb& bounds, Ray& local, double& t_min, double& t_max) {
+  local = ray;
+  if (std::max({std::abs(ray.origin.x), std::abs(ray.origin.y), std::abs(ray.origin.z)}) <= kLargest) return true;
+  const Vec3 pad(1e-3 * (1.0 + glm::length(bounds.extent())));
+  double t0 = t_min, t1 = t_max;
+  if (!Aabb{bounds.lo - pad, bounds.hi + pad}.clip(ray, t0, t1)) return false;
+  // Clamped: origin + t0 direction cancels to within the origin's rounding, which may be far.
+  local.origin = glm::clamp(ray.origin + t0 * ray.direction, bounds.lo - pad, bounds.hi + pad);
+  t_min -= t0, t_max -= t0;
+  return true;
 }
 
 RTCRay embree_ray(const Ray& ray, double t_min, double t_max) {
@@ -114,9 +134,9 @@ std::shared_ptr<const TriangleMesh> TriangleMesh::from_buffers(const MeshBuffers
     float p[3];
     std::memcpy(p, bytes + i * b.stride_bytes, sizeof p);
     const Vec3 world = Vec3(transform * glm::dvec4(p[0], p[1], p[2], 1.0));
-    if (!std::isfinite(world.x + world.y + world.z))
+    if (!(std::max({std::abs(world.x), std::abs(world.y), std::abs(world.z)}) <= kMaxCoordinate))
       throw Error(field + ".positions[" + std::to_string(i) + "]", to_text(p[0]) + ", " + to_text(p[1]) + ", " + to_text(p[2]),
-                  "finite coordinates");
+                  "finite coordinates within 1e9 of the origin once placed (haze::kMaxCoordinate)");
     mesh->positions_[i] = Vec3f(world);
   }
   mesh->indices_.assign(b.indices.begin(), b.indices.end());
@@ -155,8 +175,11 @@ std::shared_ptr<const TriangleMesh> TriangleMesh::load_obj(const std::filesystem
 bool TriangleMesh::intersect(const Ray& ray, double t_min, double t_max, double& t, Vec3& normal, std::uint32_t* triangle) const {
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
+  Ray local;
+  double near = t_min, far = t_max;
+  if (!near_start(ray, bounds_, local, near, far)) return false;
   RTCRayHit hit;
-  hit.ray = embree_ray(ray, t_min, t_max);
+  hit.ray = embree_ray(local, near, far);
   if (!(hit.ray.tfar > hit.ray.tnear)) return false;
   hit.hit.geomID = RTC_INVALID_GEOMETRY_ID;
   hit.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
@@ -169,7 +192,7 @@ bool TriangleMesh::intersect(const Ray& ray, double t_min, double t_max, double&
   if (!(area2 > 0.0)) return false;  // degenerate in double: no face to hit
   const Vec3 n = c / area2;
   const double denom = glm::dot(n, ray.direction);
-  const double th = std::abs(denom) > 1e-12 ? glm::dot(a - ray.origin, n) / denom : static_cast<double>(hit.ray.tfar);
+  const double th = std::abs(denom) > 1e-12 ? glm::dot(a - ray.origin, n) / denom : static_cast<double>(hit.ray.tfar) + (t_min - near);
   if (!(th > t_min && th < t_max)) return false;
   t = th;
   normal = denom < 0.0 ? n : -n;
@@ -180,7 +203,9 @@ bool TriangleMesh::intersect(const Ray& ray, double t_min, double t_max, double&
 bool TriangleMesh::occluded(const Ray& ray, double t_min, double t_max) const {
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
-  RTCRay r = embree_ray(ray, t_min, t_max);
+  Ray local;
+  if (!near_start(ray, bounds_, local, t_min, t_max)) return false;
+  RTCRay r = embree_ray(local, t_min, t_max);
   if (!(r.tfar > r.tnear)) return false;
   rtcOccluded1(embree_->scene, &context, &r);
   return r.tfar == -std::numeric_limits<float>::infinity();

@@ -129,18 +129,9 @@ Vec3 read_vec3(const json& v, const std::string& path) {
   return out;
 }
 
-// Unit vector along d, or false for a zero (or overflowing) vector. Scaling by the largest
-// component first keeps huge and tiny inputs from overflowing or underflowing the length.
-bool normalize(Vec3& d) {
-  double m = std::max({std::abs(d.x), std::abs(d.y), std::abs(d.z)});
-  if (!(m > 0.0) || !std::isfinite(m)) return false;
-  d = glm::normalize(d / m);
-  return true;
-}
-
 Vec3 read_direction(const json& v, const std::string& path) {
   Vec3 d = read_vec3(v, path);
-  if (!normalize(d)) throw Error(path, text(v), kDirectionText);
+  if (!make_unit(d)) throw Error(path, text(v), kDirectionText);
   return d;
 }
 
@@ -257,10 +248,10 @@ Camera read_camera(const Object& o) {
   c.height_px = o.integer("height_px", 64, 1, kMaxImagePx);
 
   Vec3 view = c.look_at - c.position;
-  if (!normalize(view))
+  if (!make_unit(view))
     throw Error(o.at("look_at"), text(*o.find("look_at")), "a point different from camera.position");
   const std::string up_text = o.find("up") ? text(*o.find("up")) : "[0, 1, 0] (the default)";
-  if (!normalize(c.up)) throw Error(o.at("up"), up_text, kDirectionText);
+  if (!make_unit(c.up)) throw Error(o.at("up"), up_text, kDirectionText);
   if (glm::length(glm::cross(view, c.up)) < 1e-6)
     throw Error(o.at("up"), up_text, "a vector not parallel to the view direction (look_at - position)");
   return c;

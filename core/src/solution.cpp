@@ -237,7 +237,7 @@ Rgb Solution::inscattered(const Vec3& x, const Vec3& w) const {
 Solution prepare(const Scene& scene, const std::string& method_name, RenderOptions options) {
   const std::string name = method_name.empty() ? scene.method_name() : method_name;
   if (name.empty()) throw Error("method.name", "missing", "a method named by the scene or the caller");
-  if (scene.medium) check_medium(*scene.medium);
+  check_scene(scene);
   auto state = std::make_unique<Solution::State>();
   state->info = method_info(name);
   if (scene.medium && scene.medium->emission.emits() && !state->info.emission) {

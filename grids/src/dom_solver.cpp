@@ -246,7 +246,9 @@ void solve_moments(const dom::Transport& t, const dom::Channel& channel, const s
       v.subtract(w, projections, j + 1, th);
       for (int i = 0; i <= j; ++i) h(i, j) = projections[static_cast<size_t>(i)];
       h(j + 1, j) = norm(w, th);
-      if (h(j + 1, j) > 0.0) v.store(j + 1, w, 1.0 / h(j + 1, j), th);
+      const bool breakdown = !(h(j + 1, j) > 1e-300);  // w in the Krylov space: x_j solves the system there
+      if (!breakdown) v.store(j + 1, w, 1.0 / h(j + 1, j), th);
+      else h(j + 1, j) = 0.0;
       for (int i = 0; i < j; ++i) {
         const double a = cs(i) * h(i, j) + sn(i) * h(i + 1, j);
         h(i + 1, j) = -sn(i) * h(i, j) + cs(i) * h(i + 1, j);
@@ -259,7 +261,7 @@ void solve_moments(const dom::Transport& t, const dom::Channel& channel, const s
       g(j) = cs(j) * g(j);
       out.changes.push_back(std::abs(g(j + 1)) / x_norm);
       progress(out.iterations);
-      if (std::abs(g(j + 1)) / x_norm < tolerance) {
+      if (breakdown || std::abs(g(j + 1)) / x_norm < tolerance) {
         ++j;
         estimated = true;
         break;

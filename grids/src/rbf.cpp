@@ -38,8 +38,10 @@ size_t inject_box(const std::vector<RbfBlob>& blobs, DenseGrid& grid, double cut
     for (int a = 0; a < 3; ++a) {
       // Cells whose centre lies within r of the blob's centre along this axis.
       double first = std::ceil((b.center[a] - r - origin[a]) / h[a] - 0.5), last = std::floor((b.center[a] + r - origin[a]) / h[a] - 0.5);
-      c0[static_cast<size_t>(a)] = static_cast<int>(std::max<double>(first, lo[static_cast<size_t>(a)]));
-      c1[static_cast<size_t>(a)] = static_cast<int>(std::min<double>(last + 1.0, hi[static_cast<size_t>(a)]));
+      // Clamped in double: a blob far outside the grid is billions of cells away, past int.
+      const double l = lo[static_cast<size_t>(a)], u = hi[static_cast<size_t>(a)];
+      c0[static_cast<size_t>(a)] = static_cast<int>(std::clamp(first, l, u));
+      c1[static_cast<size_t>(a)] = static_cast<int>(std::clamp(last + 1.0, l, u));
       empty |= c0[static_cast<size_t>(a)] >= c1[static_cast<size_t>(a)];
     }
     if (empty) continue;

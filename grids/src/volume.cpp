@@ -107,11 +107,22 @@ ExtinctionVolume make_extinction_volume(const Scene& scene, const CellCount& cel
       // Unbounded: the blobs' supports at the injection cutoff.
       bounds = {Vec3(kInfinity), Vec3(-kInfinity)};
       const double c = injection_cutoff(rbf->blobs, cutoff);
+      double widest = 0.0;
       for (const auto& b : rbf->blobs) {
         Aabb support = blob_support(b, c);
         bounds.lo = glm::min(bounds.lo, support.lo), bounds.hi = glm::max(bounds.hi, support.hi);
+        if (support.bounded()) widest = std::max(widest, support.extent().x);
       }
       if (!bounds.bounded()) throw Error("medium.density.blobs", "weights all below the cutoff", "a blob above the injection cutoff");
+      // Blobs spread far apart (one 1e9 away) make cells wider than any blob: every blob would
+      // fall between cell centres and the medium would vanish.
+      const Vec3 e = bounds.extent();
+      const std::array<int, 3> n = cells_for(bounds, cells);
+      const double cell = std::max({e.x / n[0], e.y / n[1], e.z / n[2]});
+      if (cell > widest)
+        throw Error("medium.bounds", "unbounded, with blobs spread over " + to_text(std::max({e.x, e.y, e.z})),
+                    "bounds around the blobs to solve: the grid's cells (" + to_text(cell) + ") would be wider than the widest blob (" +
+                        to_text(widest) + ")");
     }
     bounds = clip_to_planes(bounds, scene);
     InjectionReport injected;

@@ -54,6 +54,25 @@ TEST(Mesh, ObjCubeHitsWhereTheBoxIs) {
     }
 }
 
+// Embree refuses rays from past 1.8e18 (an assertion in Debian's build aborted the process); such
+// rays start at the mesh's bounds and still report t from their own origin.
+TEST(Mesh, RaysFromFarAwayStillHit) {
+  const auto cube = TriangleMesh::load_obj(kCube);
+  for (double far : {1e16, 1e19, 1e300}) {
+    const Ray ray{Vec3(0.1, -0.2, far), Vec3(0.0, 0.0, -1.0)};
+    double t;
+    Vec3 n;
+    ASSERT_TRUE(cube->intersect(ray, 0.0, kInfinity, t, n)) << far;
+    EXPECT_NEAR(t, far - 0.5, 1e-12 * far);
+    EXPECT_NEAR(n.z, 1.0, 1e-12);
+    EXPECT_TRUE(cube->occluded(ray, 0.0, kInfinity));
+    EXPECT_FALSE(cube->occluded(ray, 0.0, 0.5 * far));
+    EXPECT_FALSE(cube->intersect({Vec3(3.0, -0.2, far), ray.direction}, 0.0, kInfinity, t, n));
+  }
+  // Vertices are kept within haze::kMaxCoordinate.
+  EXPECT_EQ(field_of([] { TriangleMesh::load_obj(kCube, placement(Vec3(0.0), Vec3(0.0), Vec3(1e10))); }), "file.positions[0]");
+}
+
 TEST(Mesh, PlacementScalesRotatesAndMoves) {
   // Scale 2 along x, a quarter turn about y (x -> -z), then up by 1: the cube spans x, y, z in
   // [-0.5, 0.5] x [0.5, 1.5] x [-1, 1].

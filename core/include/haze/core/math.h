@@ -29,6 +29,15 @@ struct Ray {
   Vec3 at(double t) const { return origin + t * direction; }
 };
 
+// d scaled to unit length, or false (d unchanged) for a zero or non-finite vector. Dividing by the
+// largest component first keeps huge and tiny vectors (1e-300, 1e200) from under- or overflowing.
+inline bool make_unit(Vec3& d) {
+  const double m = std::max({std::abs(d.x), std::abs(d.y), std::abs(d.z)});
+  if (!(m > 0.0) || !std::isfinite(m)) return false;
+  d = glm::normalize(d / m);
+  return true;
+}
+
 // Axis-aligned box; the default box is unbounded (all of space).
 struct Aabb {
   Vec3 lo{-kInfinity};

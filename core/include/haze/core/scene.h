@@ -86,6 +86,12 @@ struct Scene {
   static Scene load(const std::filesystem::path& path);
 };
 
+// Checks a scene however it was made (haze::prepare calls it): finite values within the limits of
+// limits.h (coordinates, radiometric quantities, extinction), a camera that is not degenerate,
+// non-zero directions; the medium through check_medium. Throws haze::Error naming the field as the
+// JSON path would ("lights[2].position").
+void check_scene(const Scene& scene);
+
 }  // namespace haze
 
 #pragma GCC visibility pop

@@ -1,0 +1,17 @@
+// The ranges a scene's values must lie in, so that every method's float32 and double arithmetic
+// stays finite (docs/SCENES.md, "Limits"). check_scene (scene.h) enforces them.
+#pragma once
+
+namespace haze {
+
+// |x|, |y| and |z| of any point: camera, lights, bounds, blob centres, surfaces (a farther light is
+// a directional light). Float32 keeps 1e-7 of a coordinate: at 1e9, a hundred units.
+inline constexpr double kMaxCoordinate = 1e9;
+// Light intensity, irradiance and radiance, emission, background and the surfaces' kd and ks.
+inline constexpr double kMaxRadiometric = 1e15;
+// sigma_t times the density's largest value: extinction per unit length.
+inline constexpr double kMaxExtinction = 1e9;
+// A Phong exponent.
+inline constexpr double kMaxShininess = 1e5;
+
+}  // namespace haze
