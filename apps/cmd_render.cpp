@@ -1,5 +1,6 @@
 // haze render: one scene with one method, to EXR (+ PNG preview), with a JSON summary.
 #include "commands.h"
+#include "deadline.h"
 #include "progress_bar.h"
 
 #include <haze/core/auto.h>
@@ -46,6 +47,7 @@ namespace {
 struct RenderArgs {
   std::string scene, method, out, display = "cpu", depth, fields;
   int threads = 0, fields_resolution = 64;
+  double timeout = 0.0, max_memory_mib = 0.0;
   bool json = false, no_png = false, no_cache = false, explain = false, layers = false;
   std::optional<double> tolerance;
   std::vector<std::string> set;
@@ -66,7 +68,7 @@ nlohmann::json parse_settings(const std::vector<std::string>& pairs) {
   return settings;
 }
 
-int run(const RenderArgs& a) {
+int render_scene(const RenderArgs& a, const Deadline& deadline) {
   Scene scene = Scene::load(a.scene);
   // Where the image goes: an EXR (its PNG preview beside it), neither of them the scene itself.
   const std::filesystem::path out =
@@ -80,6 +82,7 @@ int run(const RenderArgs& a) {
   if (method.empty()) create_method("");  // the error lists the available methods
   RenderOptions options;
   options.threads = a.threads;
+  options.max_memory = static_cast<std::size_t>(a.max_memory_mib * 1024.0 * 1024.0);
   options.settings = parse_settings(a.set);
   if (!a.no_cache) options.cache_dir = default_cache_dir();
   // The reference's shortcuts, each given once: with --set as well, which would win is unclear.
@@ -107,7 +110,7 @@ int run(const RenderArgs& a) {
     std::cout << std::flush;
   }
   ProgressBar bar(method);
-  options.progress = bar.callback();
+  options.progress = deadline.wrap(bar.callback());
   const Stopwatch watch;
   // A host's depth buffer and the layers it composites (View).
   std::vector<float> depth;
@@ -152,6 +155,16 @@ int run(const RenderArgs& a) {
   return 0;
 }
 
+int run(const RenderArgs& a) {
+  const Deadline deadline(a.timeout);
+  try {
+    return render_scene(a, deadline);
+  } catch (const Cancelled&) {
+    if (!deadline.passed()) throw;
+    throw Error("--timeout", to_text(a.timeout) + " s", "enough time for the render (it was cancelled at its first progress report past that)");
+  }
+}
+
 }  // namespace
 
 Command add_render(CLI::App& app) {
@@ -178,6 +191,11 @@ Command add_render(CLI::App& app) {
                                        "(R/G/B = inscatter + transmittance * surface)");
   sub->add_option("--fields", a->fields, "Also write the solution's fields (fluence, transmittance per light) as OpenVDB grids to this .vdb file");
   sub->add_option("--fields-resolution", a->fields_resolution, "Voxels along the medium's longest side for --fields (default 64)")->check(CLI::Range(2, 1024));
+  sub->add_option("--timeout", a->timeout, "Give up after this many seconds: a haze::Error at the work's next progress report (exit code 2)")
+      ->check(CLI::PositiveNumber);
+  sub->add_option("--max-memory", a->max_memory_mib, "MiB the method may allocate for its solution (default: the memory available); "
+                                                     "a solution that would need more is refused before it is made")
+      ->check(CLI::PositiveNumber);
   sub->add_flag("--json", a->json, "Print a JSON summary");
   sub->add_flag("--no-png", a->no_png, "Do not write the PNG preview");
   sub->add_flag("--no-cache", a->no_cache, "Rebuild precomputed tables instead of reading them from the cache");

@@ -4,6 +4,7 @@
 #include <haze/core/error.h>
 
 #include <iostream>
+#include <new>
 
 int main(int argc, char** argv) {
   CLI::App app{"Haze: light transport in participating media (fog, haze, smoke, clouds)"};
@@ -20,6 +21,10 @@ int main(int argc, char** argv) {
       if (command.sub->parsed()) return command.run();
   } catch (const haze::Error& e) {
     std::cerr << "haze: error: " << e.what() << "\n";
+    return 2;
+  } catch (const std::bad_alloc&) {  // what check_memory's estimates missed
+    std::cerr << "haze: error: memory: got an allocation the system refused, expected work that fits "
+                 "(lower the resolution, directions, particles or lights, or give --max-memory)\n";
     return 2;
   } catch (const std::exception& e) {
     std::cerr << "haze: unexpected error: " << e.what() << "\n";

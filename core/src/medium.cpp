@@ -123,6 +123,26 @@ class RbfMedium final : public Medium {
     return std::min(bound, max_);
   }
   double feature_size() const override { return feature_; }
+  // Exact: along the segment each Gaussian is w e^(-s^2 d^2) e^(-s^2 (t - tc)^2), d the centre's
+  // distance from the line and tc its foot, whose integral is an erf difference (taken as an erfc
+  // difference on either tail, where the erfs cancel). O(blobs), where Simpson's steps of 1/4 of
+  // the sharpest blob took seconds per ray past sharpness 1000.
+  double density_integral(const Vec3& a, const Vec3& b) const override {
+    const double length = glm::length(b - a);
+    if (!(length > 0.0)) return 0.0;
+    const Ray ray{a, (b - a) / length};
+    double t0 = 0.0, t1 = length;
+    if (!bounds_.clip(ray, t0, t1) || !(t1 > t0)) return 0.0;
+    double sum = 0.0;
+    for (const auto& blob : blobs_) {
+      const double tc = glm::dot(blob.center - a, ray.direction), s = blob.sharpness;
+      const Vec3 off = blob.center - ray.at(tc);
+      const double u0 = s * (t0 - tc), u1 = s * (t1 - tc);
+      const double span = u0 >= 0.0 ? std::erfc(u0) - std::erfc(u1) : u1 <= 0.0 ? std::erfc(-u1) - std::erfc(-u0) : std::erf(u1) - std::erf(u0);
+      sum += blob.weight * std::exp(-s * s * glm::dot(off, off)) * (0.5 * std::sqrt(kPi) / s) * span;
+    }
+    return sum;
+  }
 
  private:
   std::vector<RbfBlob> blobs_;

@@ -4,8 +4,38 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdint>
+#include <fstream>
 
 namespace haze {
+
+std::size_t memory_budget(std::size_t cap) {
+  std::size_t available = SIZE_MAX;
+  std::ifstream in("/proc/meminfo");
+  std::string key, unit;
+  std::size_t kb = 0;
+  while (in >> key >> kb >> unit)
+    if (key == "MemAvailable:") {
+      available = kb * 1024;
+      break;
+    }
+  if (available == SIZE_MAX) {
+    const long pages = sysconf(_SC_AVPHYS_PAGES), page = sysconf(_SC_PAGE_SIZE);
+    if (pages > 0 && page > 0) available = static_cast<std::size_t>(pages) * static_cast<std::size_t>(page);
+  }
+  return cap > 0 ? std::min(cap, available) : available;
+}
+
+void check_memory(std::size_t bytes, std::size_t cap, const std::string& field, const std::string& what, const std::string& fewer) {
+  const std::size_t budget = memory_budget(cap);
+  if (bytes <= budget) return;
+  const std::string limit = cap > 0 && cap <= budget ? " of the memory cap (RenderOptions::max_memory, haze --max-memory)" : " available";
+  auto mib = [](std::size_t b) { return to_text(std::round(static_cast<double>(b) / (1 << 20) * 10.0) / 10.0) + " MiB"; };
+  throw Error(field, mib(bytes) + " for " + what, "work that fits in the " + mib(budget) + limit + " (" + fewer + ")");
+}
 
 ProgressTracker::ProgressTracker(ProgressCallback callback, long long total)
     : callback_(std::move(callback)), total_(std::max(1LL, total)) {}

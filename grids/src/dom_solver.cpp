@@ -12,9 +12,7 @@
 
 #include <algorithm>
 #include <cmath>
-#include <fstream>
 #include <iterator>
-#include <unistd.h>
 
 namespace haze::grids {
 
@@ -50,16 +48,6 @@ DomStorage dom_storage_from_name(const std::string& name) {
 const char* name(DomStorage storage) { return storage == DomStorage::float32 ? "float32" : "float16"; }
 
 namespace {
-
-size_t available_memory() {
-  std::ifstream in("/proc/meminfo");
-  std::string key, unit;
-  size_t kb = 0;
-  while (in >> key >> kb >> unit)
-    if (key == "MemAvailable:") return kb * 1024;
-  const long pages = sysconf(_SC_AVPHYS_PAGES), page = sysconf(_SC_PAGE_SIZE);
-  return pages > 0 && page > 0 ? static_cast<size_t>(pages) * static_cast<size_t>(page) : SIZE_MAX;
-}
 
 int kept_terms(const DomSettings& s) { return s.terms == 0 ? s.directions : s.terms; }
 constexpr int kGmresRestart = 12;
@@ -335,10 +323,9 @@ DomSolution solve_dom(const ExtinctionVolume& volume, const std::vector<Light>& 
   out.channels = grey ? 1 : 3;
   out.resolution = volume.density.resolution();
   out.bytes = dom_memory_bytes(out.resolution, out.channels, settings);
-  if (const size_t free = available_memory(); out.bytes > free)
-    throw Error("dom grid", to_text(out.bytes >> 20) + " MiB for " + to_text(volume.density.cell_count()) + " cells x " +
-                                to_text(settings.directions) + " directions",
-                "a solve that fits in the " + to_text(free >> 20) + " MiB available (fewer cells, directions or terms)");
+  check_memory(out.bytes, settings.max_memory, "dom grid",
+               to_text(volume.density.cell_count()) + " cells x " + to_text(settings.directions) + " directions",
+               "fewer cells, directions or terms");
 
   out.directions = std::make_shared<DirectionSet>(DirectionSet::fibonacci(settings.directions));
   out.phase = volume.phase;

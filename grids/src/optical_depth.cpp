@@ -301,6 +301,14 @@ DenseGrid optical_depth(const DenseGrid& density, const Light& light, const Dept
   return out;
 }
 
+void check_depth_memory(const DenseGrid& density, const std::vector<Light>& lights, std::size_t max_memory) {
+  const auto volumes = static_cast<std::size_t>(std::count_if(lights.begin(), lights.end(), [](const Light& l) { return !std::holds_alternative<SkyLight>(l); }));
+  const auto r = density.resolution();
+  check_memory(volumes * density.cell_count() * sizeof(float), max_memory, "lights",
+               to_text(volumes) + " optical-depth volumes of " + to_text(r[0]) + " x " + to_text(r[1]) + " x " + to_text(r[2]) + " cells",
+               "fewer lights or a lower resolution");
+}
+
 std::vector<DenseGrid> optical_depths(const DenseGrid& density, const std::vector<Light>& lights, const DepthOptions& options,
                                       DepthStats* stats) {
   for (const auto& light : lights) geometry(light);  // errors before any work

@@ -99,6 +99,7 @@ PropagationFields propagation_fields(const Scene& scene, const RenderOptions& op
   PropagationFields fields{make_extinction_volume(scene, resolution, cutoff, options.threads, &report), {}, MarchSettings{step_cells, false, surface_light}, {}};
   const double inject_seconds = watch.lap();
   DepthStats depth_stats;
+  check_depth_memory(fields.volume.density, scene.lights, options.max_memory);
   fields.depths = optical_depths(fields.volume.density, scene.lights, depth, &depth_stats);
   fields.stats = {{"cells", fields.volume.density.resolution()},
                   {"optical_depth", name(depth.scheme)},

@@ -227,6 +227,11 @@ NetworkSolution solve_network(const ParticleField& field, const std::vector<Ligh
   out.directions = std::make_shared<DirectionSet>(DirectionSet::fibonacci(settings.directions));
   out.matrix = std::make_shared<PhaseMatrix>(material.phase, *out.directions);
   const auto n = field.size(), d = static_cast<size_t>(out.directions->size());
+  // The networks (upstream, depth, order) and per channel the source, incoming radiance and
+  // transmittance, plus the in-scattered light: 4 bytes each per particle and direction.
+  const std::size_t network_bytes = 4 * n * d * (3 + 1 + 3 * (settings.max_iterations > 0 ? 3 : 1));
+  check_memory(network_bytes, settings.max_memory, "particles", to_text(n) + " particles x " + to_text(d) + " directions",
+               "fewer particles or directions");
   out.rho = field.density_at_particles(settings.threads);
   out.visibility = build_visibility(field, out.rho, *out.directions, network_window(field, settings.window ? settings.window : default_window(field)),
                                     settings.threads);
@@ -234,7 +239,14 @@ NetworkSolution solve_network(const ParticleField& field, const std::vector<Ligh
 
   start.restart();
   const std::vector<const Light*> delta = delta_lights(lights, out.sky);
-  for (const Light* l : delta) out.light_maps.emplace_back(field, *l, settings.threads);
+  std::size_t map_bytes = 0;
+  for (const Light* l : delta) {  // a map is at most 64 MB: checked as they are made
+    out.light_maps.emplace_back(field, *l, settings.threads);
+    map_bytes += out.light_maps.back().bytes();
+    check_memory(network_bytes + map_bytes, settings.max_memory, "lights", to_text(out.light_maps.size()) + " of " + to_text(delta.size()) +
+                 " light depth maps and the networks", "fewer lights, particles or directions");
+    if (settings.progress && !settings.progress(0.0)) throw Cancelled();
+  }
   out.channels = grey_scene(material, emission, out.sky, delta) ? 1 : 3;
   out.emission = emission;
   emission_source(out, field);

@@ -374,6 +374,7 @@ class NetworkMethod final : public Method {
       throw Error("method.terms", to_text(network.terms), "at most method.directions (" + to_text(network.directions) + ")");
     const int neighbours = static_cast<int>(settings.integer("neighbours"));
     network.threads = options.threads;
+    network.max_memory = options.max_memory;
     settings.reject_unknown();
     const auto* field = scene.medium ? std::get_if<FieldDensity>(&scene.medium->density) : nullptr;
     const auto* particles = field ? dynamic_cast<const ParticleDensity*>(field->field.get()) : nullptr;

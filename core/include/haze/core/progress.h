@@ -1,9 +1,11 @@
-// Progress reporting and cancellation for long work, and the thread-count cap.
+// Progress reporting and cancellation for long work, the thread-count cap and the memory budget.
 #pragma once
 
 #include <atomic>
+#include <cstddef>
 #include <functional>
 #include <mutex>
+#include <string>
 
 #pragma GCC visibility push(default)  // the public API: exported from shared builds
 
@@ -35,6 +37,13 @@ class ProgressTracker {
 // Runs body(begin, end) over [0, count) in chunks of `grain` on oneTBB, capped at `threads`
 // (0: no cap). Chunk boundaries do not depend on the thread count, so neither do results.
 void parallel_for(long long count, int threads, long long grain, const std::function<void(long long, long long)>& body);
+
+// The bytes one computation may allocate: the system's available memory (MemAvailable), or `cap`
+// (RenderOptions::max_memory) when that is set and smaller.
+std::size_t memory_budget(std::size_t cap = 0);
+// Before allocating memory in proportion to the input: throws haze::Error naming `field` when
+// `bytes` exceed memory_budget(cap); `what` says what they hold, `fewer` what would need less.
+void check_memory(std::size_t bytes, std::size_t cap, const std::string& field, const std::string& what, const std::string& fewer);
 
 }  // namespace haze
 

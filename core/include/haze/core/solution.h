@@ -35,6 +35,9 @@ struct RenderOptions {
   // single-scattering method may then leave out the lights that camera cannot see, and rendering
   // another camera is an error.
   bool single_view = false;
+  // Bytes a method may allocate for its solution, checked before it allocates (a haze::Error
+  // naming what would not fit); 0: the memory the system has available.
+  std::size_t max_memory = 0;
 };
 
 // $HAZE_CACHE_DIR, else $XDG_CACHE_HOME/haze, else $HOME/.cache/haze, else the temporary directory.

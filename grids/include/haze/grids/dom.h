@@ -101,6 +101,7 @@ struct DomSettings {
   DomStorage storage = DomStorage::float32;
   bool scalar_kernel = false;  // sweep: the scalar reference kernel instead of the SIMD one (tests, benchmarks)
   ProgressCallback progress;  // once per iteration, with the fraction of max_iterations done
+  std::size_t max_memory = 0;  // bytes the solve may take (RenderOptions::max_memory); 0: what is available
 };
 
 // The irradiance E_s the DOM solution's scattered light, the sky through the medium and (after the

@@ -43,6 +43,10 @@ struct DepthStats {
 // direction. The result does not depend on the thread count.
 DenseGrid optical_depth(const DenseGrid& density, const Light& light, const DepthOptions& options = {}, DepthStats* stats = nullptr);
 
+// Before making the depth volumes of `lights` (the sky's excepted) over `density`: a haze::Error
+// naming `lights` when they would not fit in memory_budget(max_memory) (progress.h).
+void check_depth_memory(const DenseGrid& density, const std::vector<Light>& lights, std::size_t max_memory);
+
 // Every light's volume, the lights spread over threads (the paper packs four lights per texture
 // and pass; here each light is one pass over its own volume, lights in parallel).
 std::vector<DenseGrid> optical_depths(const DenseGrid& density, const std::vector<Light>& lights, const DepthOptions& options = {},

@@ -69,6 +69,7 @@ struct NetworkSettings {
   double tolerance = 1e-3;  // relative L2 change of I between iterations
   int threads = 0;
   ProgressCallback progress;
+  std::size_t max_memory = 0;  // bytes the networks and light maps may take (RenderOptions::max_memory); 0: what is available
 };
 
 struct NetworkSolution {
