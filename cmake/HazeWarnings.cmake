@@ -7,7 +7,7 @@ if(HAZE_WERROR)
 endif()
 if(HAZE_SANITIZE)
   # GCC 12 reports false -Wmaybe-uninitialized through std::variant under the sanitizers.
-  target_compile_options(haze_warnings INTERFACE -fsanitize=address,undefined -fno-omit-frame-pointer -Wno-maybe-uninitialized)
+  target_compile_options(haze_warnings INTERFACE -fsanitize=address,undefined -fno-omit-frame-pointer $<$<CXX_COMPILER_ID:GNU>:-Wno-maybe-uninitialized>)
   target_link_options(haze_warnings INTERFACE -fsanitize=address,undefined)
 endif()
 

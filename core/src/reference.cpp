@@ -25,6 +25,19 @@ constexpr int kRouletteDepth = 4;
 // With target_noise: the first round's spp (at fewer samples the noise estimate misses the heavy
 // tails; docs/REFERENCE.md) and the default cap.
 constexpr long long kFirstRound = 1024;
+// Tentative collisions one path may take, its shadow rays' included: about a tenth of a second.
+// Past it the tracking would take hours (channels of sigma_t far apart make nearly every collision
+// of the thin channels a null one: [1e6, 2.5, 2.9] took a million per unit length), so it stops
+// with an error.
+constexpr long long kMaxTentative = 1'000'000;
+
+thread_local long long path_tentative = 0;  // the current path's, on this thread
+
+[[noreturn]] void too_many_collisions(const Rgb& sigma_t) {
+  throw Error("medium.sigma_t", "[" + to_text(sigma_t.r) + ", " + to_text(sigma_t.g) + ", " + to_text(sigma_t.b) + "]",
+              "extinction the reference can track: a path passed 1e6 tentative collisions (channels far apart, or a dense "
+              "medium around thin parts, make nearly all of them null; render such channels as separate grey scenes)");
+}
 constexpr long long kProgressiveCap = 1LL << 20;
 
 double mean3(const Rgb& c) { return (c.r + c.g + c.b) / 3.0; }
@@ -82,6 +95,7 @@ struct Tracer {
       for (double s = seg.t0;;) {
         s -= std::log1p(-rng.uniform()) / sigma_bar;
         if (s >= seg.t1) break;
+        if (++path_tentative > kMaxTentative) too_many_collisions(medium->sigma_t_scale());
         T *= Rgb(1.0) - medium->sigma_t(ray.at(s)) / sigma_bar;
         // Russian roulette on small transmittance keeps the estimate unbiased and the walk short.
         if (max3(T) < 0.05) {
@@ -176,6 +190,7 @@ struct Tracer {
       return L;
     };
     int volume_events = 0, bounces = 0;  // medium scattering events and surface reflections so far
+    path_tentative = 0;
     for (int depth = 0;; ++depth) {
       Vec3 normal;
       double t_surface;
@@ -202,6 +217,7 @@ struct Tracer {
           for (double s = seg.t0;;) {
             s -= std::log1p(-rng.uniform()) / sigma_bar;
             if (s >= seg.t1) break;
+            if (++path_tentative > kMaxTentative) too_many_collisions(medium->sigma_t_scale());
             x = ray.at(s);
             // Emission's collision estimator over every tentative collision (pbrt-v4's volpath):
             // E[sum beta L_e / sigma_bar] = integral T L_e ds.

@@ -139,6 +139,20 @@ TEST(Extremes, EdgesOfTheAllowedRenderFinitely) {
   for (const char* method : {"analytic", "quadrature"}) expect_finite(near_light, method, "camera 2e-9 from the light");
 }
 
+// Channels of sigma_t a million apart make nearly every tentative collision of the thin channels a
+// null one (the reference ran for hours): it stops at 1e6 per path with an error naming sigma_t.
+TEST(Extremes, ReferenceStopsARunawayTracking) {
+  Scene scene = fog_box();
+  scene.medium->density = RbfDensity{{{Vec3(0.0), 1.2, 2.2}, {Vec3(0.4, 0.2, 0.0), 0.8, 3.0}}};
+  scene.medium->sigma_t = Rgb(1e6, 2.5, 2.9);
+  try {
+    render(scene, "reference", cheap_for("reference"));
+    ADD_FAILURE() << "no error";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.field(), "medium.sigma_t");
+  }
+}
+
 // A blob 1e9 outside a bounded medium (propagation and dom looped over 2^31 cells: the blob's first
 // cell overflowed int) adds nothing; unbounded, blobs that far apart would make cells wider than
 // any blob (the medium vanished, the image was the floor's alone): a clear error instead.

@@ -26,10 +26,17 @@ namespace {
 
 namespace fs = std::filesystem;
 
+// A folder of this process's, removed when the test program ends (ctest runs each test alone).
 fs::path scratch() {
-  const fs::path dir = fs::temp_directory_path() / ("haze_vdb_test_" + std::to_string(::getpid()));
-  fs::create_directories(dir);
-  return dir;
+  static const struct Dir {
+    fs::path path = fs::temp_directory_path() / ("haze_vdb_test_" + std::to_string(::getpid()));
+    Dir() { fs::create_directories(path); }
+    ~Dir() {
+      std::error_code ec;
+      fs::remove_all(path, ec);
+    }
+  } dir;
+  return dir.path;
 }
 
 void write(const fs::path& file, const openvdb::GridPtrVec& grids) {
