@@ -98,8 +98,8 @@ constexpr Check kFinite{[](double) { return true; }, "a finite number"};
 constexpr Check kNonNegative{[](double x) { return x >= 0.0; }, "a finite number >= 0"};
 constexpr Check kPositive{[](double x) { return x > 0.0; }, "a finite number > 0"};
 constexpr Check kUnit{[](double x) { return x >= 0.0 && x <= 1.0; }, "a finite number in [0, 1]"};
-// The phase constructors check |g| < 1 themselves; this only words the type error.
-constexpr Check kG{[](double) { return true; }, "a number with |g| < 1"};
+// The phase constructors check |g| <= 0.9999 themselves; this only words the type error.
+constexpr Check kG{[](double) { return true; }, "a number with |g| <= 0.9999"};
 
 double read_number(const json& v, const std::string& path, Check check) {
   if (!v.is_number()) throw Error(path, text(v), check.expected);

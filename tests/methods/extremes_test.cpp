@@ -101,6 +101,9 @@ TEST(Extremes, ValuesPastTheLimitsNameTheirField) {
     c.change(scene);
     EXPECT_EQ(refused_field(scene), c.field);
   }
+  // A lobe narrower than 1e-4 rad (the analytic method's tables took a minute at g = 0.9999999).
+  EXPECT_THROW(PhaseFunction::henyey_greenstein(0.9999999), Error);
+  EXPECT_NO_THROW(PhaseFunction::henyey_greenstein(-kMaxAsymmetry));
   // At the limits themselves, accepted.
   Scene edge = fog_box();
   edge.lights[0] = PointLight{Vec3(0.0, kMaxCoordinate, 0.0), Rgb(kMaxRadiometric)};

@@ -13,5 +13,7 @@ inline constexpr double kMaxRadiometric = 1e15;
 inline constexpr double kMaxExtinction = 1e9;
 // A Phong exponent.
 inline constexpr double kMaxShininess = 1e5;
+// |g| of the Henyey-Greenstein and Cornette-Shanks lobes: 1e-4 rad wide at the limit.
+inline constexpr double kMaxAsymmetry = 0.9999;
 
 }  // namespace haze

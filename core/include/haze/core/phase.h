@@ -23,9 +23,9 @@ class PhaseFunction {
   static PhaseFunction isotropic();
   // p = 3/(16 pi) (1 + mu^2).
   static PhaseFunction rayleigh();
-  // p = (1 - g^2) / (4 pi (1 + g^2 - 2 g mu)^(3/2)) (seed 000 eq. 3), |g| < 1.
+  // p = (1 - g^2) / (4 pi (1 + g^2 - 2 g mu)^(3/2)) (seed 000 eq. 3), |g| <= 0.9999 (kMaxAsymmetry).
   static PhaseFunction henyey_greenstein(double g);
-  // p = 3/(8 pi) (1 - g^2)(1 + mu^2) / ((2 + g^2)(1 + g^2 - 2 g mu)^(3/2)), |g| < 1 (seed 001's
+  // p = 3/(8 pi) (1 - g^2)(1 + mu^2) / ((2 + g^2)(1 + g^2 - 2 g mu)^(3/2)), |g| <= 0.9999 (seed 001's
   // Mie approximation).
   static PhaseFunction cornette_shanks(double g);
   // w HG(g1) + (1 - w) HG(g2), w in [0, 1].
