@@ -1,0 +1,43 @@
+// What the fuzz targets share: each input goes to a file of the reader's kind in a per-process
+// temporary folder, and only haze::Error may come out of a reader (anything else escapes to
+// libFuzzer, which reports it as a crash, as it does sanitizer findings, hangs and out-of-memory).
+#pragma once
+
+#include <haze/core/error.h>
+
+#include <unistd.h>
+
+#include <cstddef>
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+namespace haze::fuzz {
+
+inline const std::filesystem::path& folder() {
+  static const std::filesystem::path dir = [] {
+    auto d = std::filesystem::temp_directory_path() / ("haze-fuzz-" + std::to_string(getpid()));
+    std::filesystem::create_directories(d);
+    return d;
+  }();
+  return dir;
+}
+
+// The bytes written to `name` in folder(); returns its path.
+inline std::filesystem::path write(const std::string& name, const std::uint8_t* data, std::size_t size) {
+  const auto path = folder() / name;
+  std::ofstream(path, std::ios::binary | std::ios::trunc).write(reinterpret_cast<const char*>(data), static_cast<std::streamsize>(size));
+  return path;
+}
+
+// Runs f, letting a haze::Error (a clear refusal) end it quietly.
+template <class F>
+void refused_or_fine(F f) {
+  try {
+    f();
+  } catch (const Error&) {
+  }
+}
+
+}  // namespace haze::fuzz

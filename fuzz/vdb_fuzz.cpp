@@ -1,0 +1,24 @@
+// OpenVDB and NanoVDB files through the vdb density reader: the file's grids, their values and
+// transforms, then density lookups and majorants of what is accepted.
+#include "fuzz_input.h"
+
+#include <haze/core/medium.h>
+#include <haze/core/scene.h>
+#include <haze/vdb/vdb.h>
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  static const bool registered = (haze::vdb::register_readers(), true);
+  (void)registered;
+  haze::fuzz::write("density.vdb", data, size);
+  const auto scene = nlohmann::json::parse(R"({"camera": {"position": [0, 0, 40], "look_at": [0, 0, 0]},
+    "medium": {"density": {"type": "vdb", "file": "density.vdb"}, "sigma_t": 1}, "lights": []})");
+  haze::fuzz::refused_or_fine([&] {
+    const haze::Scene s = haze::Scene::from_json(scene, haze::fuzz::folder());
+    haze::check_scene(s);
+    const auto medium = haze::make_medium(*s.medium);
+    const haze::Aabb box = medium->bounds();
+    (void)medium->density(0.5 * (box.lo + box.hi));
+    (void)medium->majorants();
+  });
+  return 0;
+}
