@@ -3,6 +3,7 @@
 // with every method that takes the scene.
 #include <haze/core/error.h>
 #include <haze/core/limits.h>
+#include <haze/core/mesh.h>
 #include <haze/core/method.h>
 #include <haze/core/scene.h>
 #include <haze/grids/methods.h>
@@ -153,6 +154,21 @@ TEST(Extremes, ReferenceStopsARunawayTracking) {
     ADD_FAILURE() << "no error";
   } catch (const Error& e) {
     EXPECT_EQ(e.field(), "medium.sigma_t");
+  }
+}
+
+// Many copies of a surface the host shades ("shaded": false, kd = ks = 0): they only block light,
+// so 31 copies render as one does (the DOM made irradiance texels for each: 31 room meshes 50 s).
+TEST(Extremes, ManyUnshadedMeshesBlockAsOne) {
+  Scene one = fog_box();
+  Surface cube{Mesh{TriangleMesh::load_obj(std::string(HAZE_SOURCE_DIR) + "/tests/data/cube.obj")}, Rgb(0.0), Rgb(0.0), 1.0};
+  one.surfaces = {cube};
+  Scene many = one;
+  many.surfaces.assign(31, cube);
+  for (const char* method : {"dom", "propagation"}) {
+    const Image a = render(one, method, cheap_for(method)).radiance, b = render(many, method, cheap_for(method)).radiance;
+    for (int y = 0; y < a.height(); ++y)
+      for (int x = 0; x < a.width(); ++x) EXPECT_EQ(a.at(x, y), b.at(x, y)) << method << " " << x << ", " << y;
   }
 }
 
