@@ -239,12 +239,16 @@ NetworkSolution solve_network(const ParticleField& field, const std::vector<Ligh
 
   start.restart();
   const std::vector<const Light*> delta = delta_lights(lights, out.sky);
+  // A map is at most 64 MB: checked as they are made, against the budget before the first (the
+  // memory available falls as the maps take it).
+  const std::size_t budget = memory_budget(settings.max_memory);
   std::size_t map_bytes = 0;
-  for (const Light* l : delta) {  // a map is at most 64 MB: checked as they are made
+  for (const Light* l : delta) {
     out.light_maps.emplace_back(field, *l, settings.threads);
     map_bytes += out.light_maps.back().bytes();
-    check_memory(network_bytes + map_bytes, settings.max_memory, "lights", to_text(out.light_maps.size()) + " of " + to_text(delta.size()) +
-                 " light depth maps and the networks", "fewer lights, particles or directions");
+    if (network_bytes + map_bytes > budget)
+      check_memory(network_bytes + map_bytes, budget, "lights", to_text(out.light_maps.size()) + " of " + to_text(delta.size()) +
+                   " light depth maps and the networks", "fewer lights, particles or directions");
     if (settings.progress && !settings.progress(0.0)) throw Cancelled();
   }
   out.channels = grey_scene(material, emission, out.sky, delta) ? 1 : 3;
