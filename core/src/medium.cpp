@@ -7,7 +7,6 @@
 #include <haze/core/progress.h>
 
 #include <algorithm>
-#include <sstream>
 
 namespace haze {
 
@@ -239,40 +238,34 @@ Aabb medium_bounds(const MediumDesc& desc) {
 namespace {
 bool finite(const Vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 bool finite_non_negative(const Rgb& c) { return finite(c) && c.r >= 0.0 && c.g >= 0.0 && c.b >= 0.0; }
-bool in_reach(const Vec3& p) { return std::max({std::abs(p.x), std::abs(p.y), std::abs(p.z)}) <= kMaxCoordinate; }
 bool radiometric(const Rgb& c) { return finite_non_negative(c) && std::max({c.r, c.g, c.b}) <= kMaxRadiometric; }
 double largest(const Rgb& c) { return std::max({c.r, c.g, c.b}); }
-std::string text(const Vec3& v) {
-  std::ostringstream out;
-  out << '[' << v.x << ", " << v.y << ", " << v.z << ']';
-  return out.str();
-}
 }  // namespace
 
 void check_medium(const MediumDesc& desc, const std::string& path) {
   const Aabb& b = desc.bounds;
   const bool unbounded = b.lo == Vec3(-kInfinity) && b.hi == Vec3(kInfinity);
-  if (!unbounded && !(in_reach(b.lo) && in_reach(b.hi) && b.lo.x < b.hi.x && b.lo.y < b.hi.y && b.lo.z < b.hi.z))
-    throw Error(path + ".bounds", text(b.lo) + " to " + text(b.hi),
+  if (!unbounded && !(within_reach(b.lo) && within_reach(b.hi) && b.lo.x < b.hi.x && b.lo.y < b.hi.y && b.lo.z < b.hi.z))
+    throw Error(path + ".bounds", to_text(b.lo) + " to " + to_text(b.hi),
                 "a box with lo < hi on every axis within 1e9 of the origin (haze::kMaxCoordinate), or unbounded");
   if (!(finite_non_negative(desc.sigma_t) && largest(desc.sigma_t) <= kMaxExtinction))
-    throw Error(path + ".sigma_t", text(desc.sigma_t), "values in [0, 1e9] (haze::kMaxExtinction)");
+    throw Error(path + ".sigma_t", to_text(desc.sigma_t), "values in [0, 1e9] (haze::kMaxExtinction)");
   if (!(finite_non_negative(desc.albedo) && desc.albedo.r <= 1.0 && desc.albedo.g <= 1.0 && desc.albedo.b <= 1.0))
-    throw Error(path + ".albedo", text(desc.albedo), "values in [0, 1]");
+    throw Error(path + ".albedo", to_text(desc.albedo), "values in [0, 1]");
   const Emission& e = desc.emission;
   auto check = [&](double v, const std::string& field, double max, const char* expected) {
     if (!(std::isfinite(v) && v >= 0.0 && v <= max)) throw Error(path + field, to_text(v), expected);
   };
   check(e.strength, ".emission.strength", kMaxRadiometric, "a strength in [0, 1e15] (haze::kMaxRadiometric)");
   if (!(radiometric(e.color) && largest(e.color) * e.strength <= kMaxRadiometric))
-    throw Error(path + ".emission.color", text(e.color), "values >= 0 whose product with the strength is at most 1e15 (haze::kMaxRadiometric)");
+    throw Error(path + ".emission.color", to_text(e.color), "values >= 0 whose product with the strength is at most 1e15 (haze::kMaxRadiometric)");
   check(e.blackbody_intensity, ".blackbody.intensity", kMaxRadiometric, "an intensity in [0, 1e15] (haze::kMaxRadiometric)");
   if (!(radiometric(e.blackbody_tint) && largest(e.blackbody_tint) * e.blackbody_intensity <= kMaxRadiometric))
-    throw Error(path + ".blackbody.tint", text(e.blackbody_tint), "values >= 0 whose product with the intensity is at most 1e15 (haze::kMaxRadiometric)");
+    throw Error(path + ".blackbody.tint", to_text(e.blackbody_tint), "values >= 0 whose product with the intensity is at most 1e15 (haze::kMaxRadiometric)");
   check(e.temperature, ".blackbody.temperature", 1e6, "kelvin in [0, 1e6]");
   if (e.emits() && unbounded && !(desc.sigma_t.r > 0.0 && desc.sigma_t.g > 0.0 && desc.sigma_t.b > 0.0) &&
       !std::holds_alternative<RbfDensity>(desc.density) && !std::holds_alternative<FieldDensity>(desc.density))
-    throw Error(path + ".sigma_t", text(desc.sigma_t), "> 0 in every channel for an unbounded medium that emits (else its radiance is infinite)");
+    throw Error(path + ".sigma_t", to_text(desc.sigma_t), "> 0 in every channel for an unbounded medium that emits (else its radiance is infinite)");
   // Extinction sigma_t rho past kMaxExtinction, blamed on the density value that reaches it.
   const double sigma_max = largest(desc.sigma_t);
   auto extinction = [&](double density, const std::string& field) {
@@ -288,7 +281,7 @@ void check_medium(const MediumDesc& desc, const std::string& path) {
     for (size_t i = 0; i < rbf->blobs.size(); ++i) {
       const RbfBlob& blob = rbf->blobs[i];
       const std::string at = path + ".density.blobs[" + std::to_string(i) + "]";
-      if (!in_reach(blob.center)) throw Error(at + ".center", text(blob.center), "a point within 1e9 of the origin (haze::kMaxCoordinate)");
+      if (!within_reach(blob.center)) throw Error(at + ".center", to_text(blob.center), "a point within 1e9 of the origin (haze::kMaxCoordinate)");
       if (!(std::isfinite(blob.weight) && blob.weight >= 0.0)) throw Error(at + ".weight", to_text(blob.weight), "a finite weight >= 0");
       extinction(blob.weight, at + ".weight");
       if (!(std::isfinite(blob.sharpness) && blob.sharpness > 0.0)) throw Error(at + ".sharpness", to_text(blob.sharpness), "a finite sharpness > 0");
@@ -296,8 +289,8 @@ void check_medium(const MediumDesc& desc, const std::string& path) {
   } else if (const auto* f = std::get_if<FieldDensity>(&desc.density)) {
     if (!f->field) throw Error(path + ".density", "a " + f->type + " field without data", "a density field");
     const Aabb fb = f->field->bounds();
-    if (!(in_reach(fb.lo) && in_reach(fb.hi)))
-      throw Error(path + ".density", "a " + f->type + " field from " + text(fb.lo) + " to " + text(fb.hi),
+    if (!(within_reach(fb.lo) && within_reach(fb.hi)))
+      throw Error(path + ".density", "a " + f->type + " field from " + to_text(fb.lo) + " to " + to_text(fb.hi),
                   "a field within 1e9 of the origin (haze::kMaxCoordinate)");
     extinction(f->field->max_density(fb), path + ".density");
   } else {

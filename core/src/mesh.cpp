@@ -34,7 +34,7 @@ bool finite(const glm::dmat4& m) {
 
 // Skip distance for a ray from `origin` (TriangleMesh::kSelfHit).
 float near_limit(const Ray& ray, double t_min) {
-  const double scale = 1.0 + std::max({std::abs(ray.origin.x), std::abs(ray.origin.y), std::abs(ray.origin.z)});
+  const double scale = 1.0 + max_abs(ray.origin);
   return static_cast<float>(std::max(t_min, TriangleMesh::kSelfHit * scale));
 }
 
@@ -46,7 +46,7 @@ constexpr double kLargest = 1e15;
 // with it); false when a far ray misses the bounds.
 bool near_start(const Ray& ray, const Aabb& bounds, Ray& local, double& t_min, double& t_max) {
   local = ray;
-  if (std::max({std::abs(ray.origin.x), std::abs(ray.origin.y), std::abs(ray.origin.z)}) <= kLargest) return true;
+  if (max_abs(ray.origin) <= kLargest) return true;
   const Vec3 pad(1e-3 * (1.0 + glm::length(bounds.extent())));
   double t0 = t_min, t1 = t_max;
   if (!Aabb{bounds.lo - pad, bounds.hi + pad}.clip(ray, t0, t1)) return false;
@@ -134,7 +134,7 @@ std::shared_ptr<const TriangleMesh> TriangleMesh::from_buffers(const MeshBuffers
     float p[3];
     std::memcpy(p, bytes + i * b.stride_bytes, sizeof p);
     const Vec3 world = Vec3(transform * glm::dvec4(p[0], p[1], p[2], 1.0));
-    if (!(std::max({std::abs(world.x), std::abs(world.y), std::abs(world.z)}) <= kMaxCoordinate))
+    if (!within_reach(world))
       throw Error(field + ".positions[" + std::to_string(i) + "]", to_text(p[0]) + ", " + to_text(p[1]) + ", " + to_text(p[2]),
                   "finite coordinates within 1e9 of the origin once placed (haze::kMaxCoordinate)");
     mesh->positions_[i] = Vec3f(world);

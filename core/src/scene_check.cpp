@@ -5,32 +5,25 @@
 
 #include <algorithm>
 #include <cmath>
-#include <sstream>
 #include <string>
 
 namespace haze {
 
 namespace {
 
-std::string text(const Vec3& v) {
-  std::ostringstream out;
-  out << '[' << v.x << ", " << v.y << ", " << v.z << ']';
-  return out.str();
-}
-
 void point(const Vec3& p, const std::string& field, const char* hint = "") {
-  if (!(std::max({std::abs(p.x), std::abs(p.y), std::abs(p.z)}) <= kMaxCoordinate))
-    throw Error(field, text(p), std::string("a point within 1e9 of the origin on every axis (haze::kMaxCoordinate)") + hint);
+  if (!within_reach(p))
+    throw Error(field, to_text(p), std::string("a point within 1e9 of the origin on every axis (haze::kMaxCoordinate)") + hint);
 }
 
 void direction(const Vec3& d, const std::string& field) {
   Vec3 unit = d;
-  if (!make_unit(unit)) throw Error(field, text(d), "a non-zero vector of finite numbers");
+  if (!make_unit(unit)) throw Error(field, to_text(d), "a non-zero vector of finite numbers");
 }
 
 void radiometric(const Rgb& c, const std::string& field) {
   if (!(std::isfinite(c.r + c.g + c.b) && std::min({c.r, c.g, c.b}) >= 0.0 && std::max({c.r, c.g, c.b}) <= kMaxRadiometric))
-    throw Error(field, text(c), "values in [0, 1e15] (haze::kMaxRadiometric)");
+    throw Error(field, to_text(c), "values in [0, 1e15] (haze::kMaxRadiometric)");
 }
 
 void number(double x, const std::string& field, double lo, double hi, const char* expected) {
@@ -46,10 +39,10 @@ void check_camera(const Camera& c) {
   point(c.position, "camera.position");
   point(c.look_at, "camera.look_at");
   Vec3 view = c.look_at - c.position, up = c.up;
-  if (!make_unit(view)) throw Error("camera.look_at", text(c.look_at), "a point different from camera.position");
-  if (!make_unit(up)) throw Error("camera.up", text(c.up), "a non-zero vector of finite numbers");
+  if (!make_unit(view)) throw Error("camera.look_at", to_text(c.look_at), "a point different from camera.position");
+  if (!make_unit(up)) throw Error("camera.up", to_text(c.up), "a non-zero vector of finite numbers");
   if (glm::length(glm::cross(view, up)) < 1e-6)
-    throw Error("camera.up", text(c.up), "a vector not parallel to the view direction (look_at - position)");
+    throw Error("camera.up", to_text(c.up), "a vector not parallel to the view direction (look_at - position)");
   if (c.type == Camera::Type::pinhole && !(c.fov_y_deg > 0.0 && c.fov_y_deg < 180.0))
     throw Error("camera.fov_y_deg", to_text(c.fov_y_deg), "an angle in degrees in (0, 180)");
   else number(c.height, "camera.height", 1e-9, 2.0 * kMaxCoordinate, "a height in [1e-9, 2e9]");
@@ -58,9 +51,9 @@ void check_camera(const Camera& c) {
 // A point or spot light at `position` seen from the eye: its in-scattered radiance grows as 1 / d
 // (from 1e5 I sigma_s at d = 1e-5 to NaN at 1e-100), so it keeps a distance from the eye.
 void apart_from_eye(const Vec3& position, const Vec3& eye, const std::string& field) {
-  const double scale = 1.0 + std::max({std::abs(eye.x), std::abs(eye.y), std::abs(eye.z)});
+  const double scale = 1.0 + max_abs(eye);
   if (glm::length(position - eye) < 1e-9 * scale)
-    throw Error(field, text(position), "a point at least 1e-9 (1 + |camera.position|) from the camera (the radiance at a point light is infinite)");
+    throw Error(field, to_text(position), "a point at least 1e-9 (1 + |camera.position|) from the camera (the radiance at a point light is infinite)");
 }
 
 void check_light(const Light& light, const Vec3& eye, const std::string& at) {

@@ -9,6 +9,8 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <sstream>
+#include <string>
 
 #pragma GCC visibility push(default)  // the public API: exported from shared builds
 
@@ -29,10 +31,20 @@ struct Ray {
   Vec3 at(double t) const { return origin + t * direction; }
 };
 
+// The largest |component|: the max norm.
+inline double max_abs(const Vec3& v) { return std::max({std::abs(v.x), std::abs(v.y), std::abs(v.z)}); }
+
+// "[x, y, z]", for error messages (error.h's to_text for points and directions).
+inline std::string to_text(const Vec3& v) {
+  std::ostringstream out;
+  out << '[' << v.x << ", " << v.y << ", " << v.z << ']';
+  return out.str();
+}
+
 // d scaled to unit length, or false (d unchanged) for a zero or non-finite vector. Dividing by the
 // largest component first keeps huge and tiny vectors (1e-300, 1e200) from under- or overflowing.
 inline bool make_unit(Vec3& d) {
-  const double m = std::max({std::abs(d.x), std::abs(d.y), std::abs(d.z)});
+  const double m = max_abs(d);
   if (!(m > 0.0) || !std::isfinite(m)) return false;
   d = glm::normalize(d / m);
   return true;
