@@ -5,10 +5,17 @@ target_compile_options(haze_warnings INTERFACE -Wall -Wextra -Wdouble-promotion)
 if(HAZE_WERROR)
   target_compile_options(haze_warnings INTERFACE -Werror)
 endif()
-if(HAZE_SANITIZE)
+# HAZE_SANITIZE: ON or "address" for AddressSanitizer and UndefinedBehaviorSanitizer, "thread"
+# for ThreadSanitizer (haze::parallel_for then runs on std::threads: core/src/progress.cpp).
+if(HAZE_SANITIZE STREQUAL "thread")
+  set(sanitizers thread)
+elseif(HAZE_SANITIZE)
+  set(sanitizers address,undefined)
+endif()
+if(sanitizers)
   # GCC 12 reports false -Wmaybe-uninitialized through std::variant under the sanitizers.
-  target_compile_options(haze_warnings INTERFACE -fsanitize=address,undefined -fno-omit-frame-pointer $<$<CXX_COMPILER_ID:GNU>:-Wno-maybe-uninitialized>)
-  target_link_options(haze_warnings INTERFACE -fsanitize=address,undefined)
+  target_compile_options(haze_warnings INTERFACE -fsanitize=${sanitizers} -fno-omit-frame-pointer $<$<CXX_COMPILER_ID:GNU>:-Wno-maybe-uninitialized>)
+  target_link_options(haze_warnings INTERFACE -fsanitize=${sanitizers})
 endif()
 
 # haze_module(NAME folder-target SOURCES ... DEPS ...): one library per top-level folder (static,

@@ -11,7 +11,20 @@
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
+#include <new>
 #include <string>
+
+// Allocation failure as a plain build has it: std::bad_alloc, which the readers turn into a
+// haze::Error. ASan's throwing operator new ends the process instead (allocator_may_return_null
+// only reaches the nothrow forms), and a 1 KB VDB header may ask OpenVDB for 100 TB.
+void* operator new(std::size_t n) {
+  if (void* p = ::operator new(n, std::nothrow)) return p;
+  throw std::bad_alloc();
+}
+void* operator new[](std::size_t n) {
+  if (void* p = ::operator new[](n, std::nothrow)) return p;
+  throw std::bad_alloc();
+}
 
 namespace haze::fuzz {
 

@@ -14,6 +14,8 @@ namespace {
 
 constexpr int kTile = 16;
 constexpr int kSurfaceDirections = 64;  // over the sphere: a surface point's hemisphere gets about half
+// The span of the phase matrix's raw row sums past which the network warns (docs/NETWORKS.md).
+constexpr double kRowSumRange[2] = {0.8, 1.25};
 
 // Camera::generate_ray inverted: the pixel position and footprint radius (pixels) of a sphere.
 struct Projection {
@@ -350,6 +352,16 @@ class NetworkMethodSolution final : public MethodSolution {
              {"build_seconds", solution_.build_seconds},
              {"direct_seconds", solution_.direct_seconds},
              {"iterate_seconds", solution_.iterate_seconds}};
+    // No silent failure at strong peaks: the D directions' quadrature of the phase function (the
+    // phase matrix's raw row sums, 1 for a lobe they resolve; the rows are then rescaled to 1).
+    const Eigen::VectorXd& sums = solution_.matrix->raw_row_sums();
+    const double lo = sums.minCoeff(), hi = sums.maxCoeff();
+    stats["phase_row_sums"] = {lo, hi};
+    stats["warnings"] = nlohmann::json::array();
+    if (lo < kRowSumRange[0] || hi > kRowSumRange[1])
+      stats["warnings"].push_back("network: the phase function's peak is too narrow for " + to_text(settings_.directions) +
+                                  " directions (their quadrature of it gives " + to_text(lo) + " to " + to_text(hi) +
+                                  " instead of 1): errors of 10% and more are likely (docs/NETWORKS.md); use more directions or the reference");
   }
 
   Scene scene_;

@@ -102,7 +102,7 @@ Cell one_cell(std::array<float, 3> a, std::array<float, 3> in, float sigma_t, fl
               std::array<float, 3> slope = {0.0f, 0.0f, 0.0f}, std::uint8_t* bounded = nullptr, bool mark = false) {
   const float octant_a[5 * 8] = {a[0], 0, 0, 0, 0, 0, 0, 0, a[1], 0, 0, 0, 0, 0, 0, 0, a[2], 0, 0, 0, 0, 0, 0, 0,
                                  a[0] + a[1] + a[2], 1, 1, 1, 1, 1, 1, 1, 0, 1, 1, 1, 1, 1, 1, 1};
-  const float lq[8] = {}, q[8] = {};
+  const float lq[8] = {}, q[8 * 8] = {};  // lq [k * P + d], q [d * terms_padded + k] (ASan caught q[8])
   const DomOctant octant{8, 1, 8, octant_a, lq, q, diamond};
   float density = sigma_t, first[8] = {s}, m_out = 0.0f, x[8] = {in[0]}, y[8] = {in[1]}, z[8] = {in[2]}, scratch[40];
   DomRow row;

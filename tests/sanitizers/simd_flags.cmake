@@ -1,0 +1,13 @@
+# The sanitizer builds compile one Highway target (HWY_COMPILE_ONLY_STATIC): AVX2 (-march=haswell)
+# where this machine has it, the target the main build's dispatch runs here, else the baseline
+# EMU128, whose emulated lanes run 10 to 100 times slower under the sanitizers. No contraction
+# into FMAs outside the kernels, as in the main build. Sets simd_flags and avx2.
+file(READ /proc/cpuinfo cpuinfo)
+set(avx2 OFF)
+if(cpuinfo MATCHES " avx2" AND cpuinfo MATCHES " fma" AND cpuinfo MATCHES " f16c" AND cpuinfo MATCHES " bmi2")
+  set(avx2 ON)
+endif()
+set(simd_flags "-DHWY_COMPILE_ONLY_STATIC=1")
+if(avx2)
+  string(APPEND simd_flags " -march=haswell -ffp-contract=off")
+endif()
