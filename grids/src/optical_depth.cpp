@@ -89,7 +89,8 @@ int compute_paper(const DenseGrid& density, const LightGeometry& g, DenseGrid& o
   // The light's own cell, when it is inside: the exact distance from its centre.
   int light_cell[3] = {-1, -1, -1};
   if (!g.directional && density.bounds().contains(g.position))
-    for (int a = 0; a < 3; ++a) light_cell[a] = std::clamp(static_cast<int>((g.position[a] - lo[a]) / h[a]), 0, n[static_cast<size_t>(a)] - 1);
+    for (int a = 0; a < 3; ++a)
+      light_cell[a] = static_cast<int>(std::clamp((g.position[a] - lo[a]) / h[a], 0.0, n[static_cast<size_t>(a)] - 1.0));
   DenseGrid next = out;
   int iterations = 0;
   const int max_iterations = n[0] + n[1] + n[2] + 1;
@@ -201,8 +202,16 @@ class Sweeper {
 void compute_sweep(const DenseGrid& density, const LightGeometry& g, DenseGrid& out, int layers, bool scalar, int threads) {
   const auto& n = density.resolution();
   const Vec3 h = density.cell_size(), lo = density.bounds().lo;
-  int lc[3];  // the point light's cell (perhaps outside the grid)
-  for (int a = 0; a < 3; ++a) lc[a] = g.directional ? 0 : static_cast<int>(std::floor((g.position[a] - lo[a]) / h[a]));
+  // The point light's cell (perhaps outside the grid). A light farther than 2^28 cells from the
+  // grid's centre is moved toward it along the same line (its rings keep their order, and int
+  // arithmetic on them stays in range: a light 1e9 away was 8e9 cells, past int).
+  int lc[3] = {0, 0, 0};
+  if (!g.directional) {
+    const Vec3 centre = 0.5 * Vec3(n[0], n[1], n[2]);
+    Vec3 cell = (g.position - lo) / h - centre;
+    if (const double far = max_abs(cell); far > 0x1p28) cell *= 0x1p28 / far;
+    for (int a = 0; a < 3; ++a) lc[a] = static_cast<int>(std::floor(centre[a] + cell[a]));
+  }
   Sweeper sweeper(density, g, out, layers, scalar, g.directional ? -1 : layers, lc);
   std::vector<Sweeper::Run> runs;
   if (g.directional) {

@@ -1,6 +1,6 @@
 # The sanitizer builds compile one Highway target (HWY_COMPILE_ONLY_STATIC): AVX2 (-march=haswell)
-# where this machine has it, the target the main build's dispatch runs here, else the baseline
-# EMU128, whose emulated lanes run 10 to 100 times slower under the sanitizers. No contraction
+# where this machine has it (the main build's dispatch runs AVX2 or AVX-512 there), else the
+# baseline EMU128, whose emulated lanes run 10 to 100 times slower under the sanitizers. No contraction
 # into FMAs outside the kernels, as in the main build. Sets simd_flags and avx2.
 file(READ /proc/cpuinfo cpuinfo)
 set(avx2 OFF)
