@@ -41,7 +41,7 @@ ParticleDensity::ParticleDensity(ParticleSet set, int neighbours) : set_(std::mo
   std::vector<size_t> count;
   for (double side = field_.mean_h();; side *= 1.5) {
     for (int a = 0; a < 3; ++a) {
-      n_[static_cast<size_t>(a)] = std::clamp(static_cast<int>(std::ceil(extent[a] / side)), 1, kMaxCells);
+      n_[static_cast<size_t>(a)] = static_cast<int>(std::clamp(std::ceil(extent[a] / side), 1.0, static_cast<double>(kMaxCells)));
       cell_[a] = extent[a] / n_[static_cast<size_t>(a)];
     }
     count.assign(static_cast<size_t>(n_[0]) * static_cast<size_t>(n_[1]) * static_cast<size_t>(n_[2]), 0);

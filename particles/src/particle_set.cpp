@@ -1,5 +1,6 @@
 // The `particles` block of a scene, and validation of particle arrays.
 #include <haze/core/error.h>
+#include <haze/core/limits.h>
 #include <haze/particles/particle_set.h>
 
 #include <cmath>
@@ -95,6 +96,9 @@ void validate(const ParticleView& p) {
     const Vec3f& x = p.positions[i];
     if (!std::isfinite(x.x) || !std::isfinite(x.y) || !std::isfinite(x.z))
       throw Error("particles.positions[" + std::to_string(i) + "]", "not finite", "finite coordinates");
+    // Before anything is built from them (a particle 8.9e10 away overflowed the density's cell count).
+    if (!within_reach(Vec3(x)))
+      throw Error("particles.positions[" + std::to_string(i) + "]", to_text(Vec3(x)), "a point within 1e9 of the origin (haze::kMaxCoordinate)");
     if (!p.density.empty() && !(p.density[i] >= 0.0f && std::isfinite(p.density[i])))
       throw Error("particles.density[" + std::to_string(i) + "]", to_text(p.density[i]), "a finite density >= 0");
     if (!p.diameters.empty() && !(p.diameters[i] > 0.0f && std::isfinite(p.diameters[i])))
