@@ -6,12 +6,18 @@
 #include <haze/core/scene.h>
 #include <haze/vdb/vdb.h>
 
+#include <cstring>
+
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   static const bool registered = (haze::vdb::register_readers(), true);
   (void)registered;
-  haze::fuzz::write("density.vdb", data, size);
-  const auto scene = nlohmann::json::parse(R"({"camera": {"position": [0, 0, 40], "look_at": [0, 0, 0]},
-    "medium": {"density": {"type": "vdb", "file": "density.vdb"}, "sigma_t": 1}, "lights": []})");
+  // NanoVDB files by their magic number ("NanoVDB0"), the rest as OpenVDB files.
+  const bool nano = size >= 8 && std::memcmp(data, "NanoVDB0", 8) == 0;
+  const std::string name = nano ? "density.nvdb" : "density.vdb";
+  haze::fuzz::write(name, data, size);
+  auto scene = nlohmann::json::parse(R"({"camera": {"position": [0, 0, 40], "look_at": [0, 0, 0]},
+    "medium": {"density": {"type": "vdb"}, "sigma_t": 1}, "lights": []})");
+  scene["medium"]["density"]["file"] = name;
   haze::fuzz::refused_or_fine([&] {
     const haze::Scene s = haze::Scene::from_json(scene, haze::fuzz::folder());
     haze::check_scene(s);

@@ -13,6 +13,8 @@ namespace haze::internal {
 
 // The value of the haze::Error a MethodSolution without lighting fields throws.
 inline constexpr const char* kNoField = "not kept by this method";
+// How far a ray leaving a surface starts off it, along the normal.
+inline constexpr double kSurfaceOffset = 1e-7;
 
 // Deterministic single scattering by numerical quadrature (quadrature.cpp).
 MethodInfo quadrature_info();

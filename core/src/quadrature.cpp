@@ -17,7 +17,6 @@ namespace haze::internal {
 namespace {
 
 constexpr int kNodesPerPanel = 8;
-constexpr double kEpsilon = 1e-7;
 
 struct Context {
   const Scene& scene;
@@ -52,7 +51,7 @@ struct Context {
   }
 
   Rgb surface_radiance(const Surface& s, const Vec3& p, const Vec3& n, const Vec3& to_viewer) const {
-    Vec3 origin = p + n * kEpsilon;
+    Vec3 origin = p + n * kSurfaceOffset;
     Rgb sum(0.0);
     LightArrival a;
     for (const auto& light : scene.lights) {

@@ -19,7 +19,6 @@ namespace haze::internal {
 
 namespace {
 
-constexpr double kEpsilon = 1e-7;
 constexpr long long kSamplesPerBlock = 1024;  // a work item: one pixel's samples in blocks of this size
 constexpr int kRouletteDepth = 4;
 // With target_noise: the first round's spp (at fewer samples the noise estimate misses the heavy
@@ -258,7 +257,7 @@ struct Tracer {
       } else {
         if (max_bounces >= 0 && bounces + 1 > max_bounces) return done();
         ++bounces;
-        Vec3 p = ray.at(t_surface) + normal * kEpsilon, wo = -ray.direction;
+        Vec3 p = ray.at(t_surface) + normal * kSurfaceOffset, wo = -ray.direction;
         L += beta * surface_nee(*surface, p, normal, wo, rng);
         if (volume_events == max_scattering && bounces == max_bounces) return done();
         Vec3 w = sample_cosine(normal, rng);

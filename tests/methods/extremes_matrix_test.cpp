@@ -30,7 +30,7 @@ using nlohmann::json;
 // Fog in [-1, 1]^3 lit by a point light inside it, just above the view (a light in view makes a
 // glow that the reference's jittered samples average over each pixel and the other methods sample
 // at its centre); 8 x 8 pixels.
-json fog_box() {
+json fog_box_json() {
   return {{"camera", {{"position", {0.0, 0.3, 4.0}}, {"look_at", {0.0, 0.0, 0.0}}, {"fov_y_deg", 16.0}, {"width_px", 8}, {"height_px", 8}}},
           {"medium", {{"bounds", {{-1.0, -1.0, -1.0}, {1.0, 1.0, 1.0}}}, {"density", {{"type", "constant"}, {"value", 1.0}}},
                       {"sigma_t", {1.0, 1.2, 1.4}}, {"albedo", 0.9}, {"phase", {{"type", "hg"}, {"g", 0.5}}}}},
@@ -42,7 +42,7 @@ json fog_box() {
 json particle_ball() {
   json positions = json::array();
   for (int i = 0; i < 64; ++i) positions.push_back({-0.75 + 0.5 * (i % 4), -0.75 + 0.5 * (i / 4 % 4), -0.75 + 0.5 * (i / 16)});
-  json j = fog_box();
+  json j = fog_box_json();
   j.erase("medium");
   j["particles"] = {{"positions", positions}, {"diameter", 0.5}, {"sigma_t", 4.0}, {"albedo", 0.9}, {"phase", {{"type", "hg"}, {"g", 0.5}}}};
   return j;
@@ -187,7 +187,7 @@ TEST(ExtremesMatrix, EveryMethodFiniteAndWithinItsBound) {
     json scene;
     std::vector<std::string> methods;
   };
-  const std::vector<Family> families = {{fog_box(), {"analytic", "quadrature", "propagation", "dom", "reference"}},
+  const std::vector<Family> families = {{fog_box_json(), {"analytic", "quadrature", "propagation", "dom", "reference"}},
                                         {particle_ball(), {"network", "reference"}}};
   for (const Family& family : families)
     for (const std::string& method : family.methods) {

@@ -29,7 +29,7 @@ std::vector<float> floor_depth(const Camera& camera) {
   return depth;
 }
 
-double relative(const Rgb& a, const Rgb& b) { return glm::length(a - b) / std::max(glm::length(b), 1e-9); }
+double relative_to(const Rgb& a, const Rgb& b) { return glm::length(a - b) / std::max(glm::length(b), 1e-9); }
 
 // With one column per pixel, the froxels at a slice boundary are the layers of a render with that
 // boundary as every pixel's depth: the columns, the slices and the lookup line up, for every kind
@@ -58,7 +58,7 @@ TEST(Froxels, HoldTheLayersAtColumnsAndBoundaries) {
           const Rgb exact = r.inscatter->at(x, y);
           ASSERT_LE(glm::length(p.inscatter - exact), 2e-4 * glm::length(exact) + 1e-3 * glm::length(whole.inscatter->at(x, y)))
               << method << " slice " << k << " at " << x << ", " << y << ": " << p.inscatter.r << " against " << exact.r;
-          ASSERT_LT(relative(p.transmittance, r.transmittance->at(x, y)), 2e-4) << method << " slice " << k << " at " << x << ", " << y;
+          ASSERT_LT(relative_to(p.transmittance, r.transmittance->at(x, y)), 2e-4) << method << " slice " << k << " at " << x << ", " << y;
         }
     }
   }

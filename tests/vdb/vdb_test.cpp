@@ -18,7 +18,9 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <random>
 
 namespace haze::vdb {
@@ -72,6 +74,12 @@ openvdb::FloatGrid::Ptr cloud_grid(const RbfDensity& rbf, double h) {
         if (d >= 1e-3) accessor.setValue(openvdb::Coord(i, j, k), static_cast<float>(d));
       }
   return grid;
+}
+
+::testing::AssertionResult has(const std::string& message, std::initializer_list<const char*> parts) {
+  for (const char* p : parts)
+    if (message.find(p) == std::string::npos) return ::testing::AssertionFailure() << "\"" << p << "\" not in: " << message;
+  return ::testing::AssertionSuccess();
 }
 
 std::string message_of(const std::function<void()>& f) {
@@ -188,11 +196,6 @@ TEST(VdbVolume, MajorantsBoundTheDensityAndSkipEmptySpace) {
 
 TEST(VdbVolume, BadFilesGetClearErrors) {
   const fs::path dir = scratch();
-  auto has = [](const std::string& message, std::initializer_list<const char*> parts) {
-    for (const char* p : parts)
-      if (message.find(p) == std::string::npos) return ::testing::AssertionFailure() << "\"" << p << "\" not in: " << message;
-    return ::testing::AssertionSuccess();
-  };
   auto density = box_grid(4, 1.0, Vec3(0.0));
   auto temperature = box_grid(4, 1.0, Vec3(0.0));
   temperature->setName("temperature");
@@ -231,6 +234,107 @@ TEST(VdbVolume, BadFilesGetClearErrors) {
   EXPECT_TRUE(has(message_of([&] { VolumeField::read(dir / "junk.vdb"); }), {"medium.density.file", "junk.vdb", "a readable OpenVDB file"}));
   fs::copy_file(dir / "junk.vdb", dir / "junk.nvdb", fs::copy_options::overwrite_existing);
   EXPECT_TRUE(has(message_of([&] { VolumeField::read(dir / "junk.nvdb"); }), {"medium.density.file", "junk.nvdb", "NanoVDB"}));
+}
+
+std::string bytes_of(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+// `bytes` with `value` written over them at `at`, as bad.vdb or bad.nvdb; the reader's message.
+template <class T>
+std::string read_altered(std::string bytes, size_t at, T value, const char* name) {
+  std::memcpy(&bytes[at], &value, sizeof(T));
+  const fs::path file = scratch() / name;
+  std::ofstream(file, std::ios::binary | std::ios::trunc) << bytes;
+  return message_of([&] { VolumeField::read(file); });
+}
+
+// Lengths and offsets a file declares are checked against its bytes before OpenVDB allocates
+// them: before, a 1 KB file's metadata made OpenVDB zero-fill gigabytes (docs/RELIABILITY.md).
+TEST(VdbVolume, DeclaredLengthsAreCheckedBeforeOpenVdbReads) {
+  write(scratch() / "box.vdb", {box_grid(4, 1.0, Vec3(0.0))});
+  const std::string good = bytes_of(scratch() / "box.vdb");
+  auto at = [&](const std::string& pattern) {
+    const size_t p = good.find(pattern);
+    EXPECT_NE(p, std::string::npos) << pattern;
+    return p + pattern.size();
+  };
+  using namespace std::string_literals;
+  // The file's metadata count (after the 57-byte header of format 224): 2^32 - 1 items.
+  EXPECT_TRUE(has(read_altered(good, 57, ~uint32_t{0}, "bad.vdb"), {"medium.density.file", "bad.vdb", "a VDB file that holds what it declares"}));
+  // The grid's name metadata as a 2 GB string.
+  const size_t name = at("\x06\0\0\0string"s);
+  EXPECT_TRUE(has(read_altered(good, name, uint32_t{0x7fffffff}, "bad.vdb"), {"a metadata value at byte", "needs 2147483647 bytes"}));
+  // An int64 value declared 4000 bytes long (OpenVDB would read 8 and lose its place).
+  EXPECT_TRUE(has(read_altered(good, at("\x05\0\0\0int64"s), uint32_t{4000}, "bad.vdb"), {"int64 metadata", "is 8 bytes (it declares 4000)"}));
+  // The delayed-load metadata's leaf count, zero-filled by OpenVDB before it reads the leaves.
+  const size_t delayed = at("\x0d\0\0\0__delayedload"s);
+  EXPECT_TRUE(has(read_altered(good, delayed + 4, uint32_t{0x7fffffff}, "bad.vdb"), {"counts at most one leaf per byte"}));
+  // The grid's end offset past the file, and before its data ends.
+  const size_t offsets = at("Tree_float_5_4_3"s) + 4;  // after the (empty) instance parent name
+  int64_t block = 0;
+  std::memcpy(&block, good.data() + offsets + 8, 8);
+  EXPECT_TRUE(has(read_altered(good, offsets + 16, int64_t{1} << 40, "bad.vdb"), {"medium.density.file", "lies between its offsets"}));
+  EXPECT_TRUE(has(read_altered(good, offsets + 16, block, "bad.vdb"), {"a grid whose data lies within its offsets", "OpenVDB read past byte"}));
+  // A stream-written file (no offsets) and a future format.
+  EXPECT_TRUE(has(read_altered(good, 20, '\0', "bad.vdb"), {"grid offsets"}));
+  EXPECT_TRUE(has(read_altered(good, 8, uint32_t{225}, "bad.vdb"), {"format 219 to 224 (it has 225)"}));
+  // The tree's head: a second buffer (OpenVDB would print a warning), and a root tile active 2
+  // (OpenVDB loads the flag as a bool).
+  const size_t tree = at("\x01\0\0\0\0\0\0\0\0\0\0\0\x01\0\0\0"s) - 16;  // 1 buffer, background 0, no tiles, 1 child
+  EXPECT_TRUE(has(read_altered(good, tree, int32_t{2}, "bad.vdb"), {"one buffer per node"}));
+  auto tiled = box_grid(4, 1.0, Vec3(0.0));
+  tiled->tree().root().addTile(openvdb::Coord(8192), 2.0f, true);
+  write(scratch() / "tile.vdb", {tiled});
+  const std::string with_tile = bytes_of(scratch() / "tile.vdb");
+  const size_t active = with_tile.find("\0\0\0\x40\x01"s);
+  ASSERT_NE(active, std::string::npos);
+  EXPECT_TRUE(has(read_altered(with_tile, active + 4, '\x02', "bad.vdb"), {"is active 0 or 1"}));
+  EXPECT_EQ(message_of([&] { VolumeField::read(scratch() / "box.vdb"); }), "(no error)");
+  // A root tile (4096^3 voxels) 8192 voxels away: maxima on 64^3-voxel blocks (8^3 would take 14 GB),
+  // still bounding the density and zero between; a tile 2^24 voxels away is refused.
+  const auto field = VolumeField::read(scratch() / "tile.vdb");
+  EXPECT_NEAR(field->density(Vec3(9000.0)), 2.0, 1e-6);
+  EXPECT_GE(field->max_density(Aabb{Vec3(9000.0), Vec3(9001.0)}), 2.0);
+  EXPECT_EQ(field->max_density(Aabb{Vec3(6000.0), Vec3(6001.0)}), 0.0);
+  tiled->tree().root().addTile(openvdb::Coord(1 << 24), 1.0f, true);
+  write(scratch() / "far.vdb", {tiled});
+  EXPECT_TRUE(has(message_of([&] { VolumeField::read(scratch() / "far.vdb"); }), {"medium.density.grid", "spanning 16781312 voxels along x", "at most 16777216"}));
+}
+
+// A NanoVDB grid is a memory image whose nodes are found through the byte offsets it holds: each
+// is checked to lie within the grid before anything follows it, as are the file's lengths.
+TEST(VdbVolume, NanoVdbOffsetsAreCheckedBeforeTheyAreFollowed) {
+  const fs::path file = scratch() / "box.nvdb";
+  nanovdb::io::writeGrid(file.string(), nanovdb::openToNanoVDB(*box_grid(4, 1.0, Vec3(0.0))));
+  const std::string good = bytes_of(file);
+  const auto handle = nanovdb::io::readGrid(file.string());
+  const auto* grid = handle.grid<float>();
+  ASSERT_TRUE(grid);
+  const size_t meta = sizeof(nanovdb::io::Header), start = meta + sizeof(nanovdb::io::MetaData) + std::string("density").size() + 1;
+  ASSERT_EQ(good.size(), start + handle.size());
+  const auto* base = reinterpret_cast<const char*>(grid);
+  auto in_file = [&](const void* field) { return start + static_cast<size_t>(reinterpret_cast<const char*>(field) - base); };
+  const auto& root = grid->tree().root();
+  const auto* tile = root.data()->tile(0);
+  ASSERT_TRUE(tile->isChild());
+  const auto& upper = *root.data()->getChild(tile);
+  const auto& lower = *upper.beginChild();
+  const uint32_t leaf = *lower.data()->mChildMask.beginOn();
+  EXPECT_TRUE(has(read_altered(good, in_file(&grid->tree().data()->mNodeOffset[3]), uint64_t{1} << 40, "bad.nvdb"),
+                  {"medium.density.file", "a NanoVDB grid whose nodes lie within it (the root at byte"}));
+  EXPECT_TRUE(has(read_altered(good, in_file(&root.data()->mTableSize), uint32_t{1} << 30, "bad.nvdb"), {"the root's tile table"}));
+  EXPECT_TRUE(has(read_altered(good, in_file(&tile->child), int64_t{-64}, "bad.nvdb"), {"an upper node at byte"}));
+  EXPECT_TRUE(has(read_altered(good, in_file(&lower.data()->mTable[leaf].child), int64_t{1} << 20, "bad.nvdb"), {"a leaf at byte"}));
+  EXPECT_TRUE(has(read_altered(good, in_file(&lower.data()->mTable[leaf].child), int64_t{8}, "bad.nvdb"), {"a leaf at byte"}));  // misaligned
+  nanovdb::io::MetaData m;
+  auto meta_field = [&](const void* field) { return meta + static_cast<size_t>(reinterpret_cast<const char*>(field) - reinterpret_cast<const char*>(&m)); };
+  EXPECT_TRUE(has(read_altered(good, meta_field(&m.nameSize), uint32_t{0x7fffffff}, "bad.nvdb"), {"a grid name at byte", "needs 2147483647 bytes"}));
+  EXPECT_TRUE(has(read_altered(good, meta_field(&m.gridSize), uint64_t{1} << 40, "bad.nvdb"), {"grid sizes match their bytes"}));
+  EXPECT_TRUE(has(read_altered(good, meta_field(&m.gridType), uint32_t{65537}, "bad.nvdb"), {"medium.density.grid", "of value type unknown (65537)"}));
+  EXPECT_TRUE(has(read_altered(good, meta_field(&m.fileSize), uint64_t{1} << 40, "bad.nvdb"), {"a grid at byte", "needs 1099511627776 bytes"}));
+  EXPECT_EQ(message_of([&] { VolumeField::read(file); }), "(no error)");
 }
 
 TEST(VdbScene, ReadsTheDensityBlockAndRefusesWhatDoesNotFit) {

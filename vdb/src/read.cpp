@@ -1,10 +1,10 @@
 // VolumeField::read: a float grid from an OpenVDB or NanoVDB file, checked, its maxima blocked and
 // its data handed to NanoVDB for sampling. Every failure is a haze::Error naming the file and grid.
+#include "checked_read.h"
 #include "volume_data.h"
 
 #include <haze/core/error.h>
 
-#include <nanovdb/util/IO.h>
 #include <nanovdb/util/NanoToOpenVDB.h>
 #include <nanovdb/util/OpenToNanoVDB.h>
 #include <openvdb/openvdb.h>
@@ -14,67 +14,7 @@
 namespace haze::vdb {
 namespace {
 
-struct Where {
-  std::string field;  // "medium.density"
-  std::string file, grid;
-  std::string value() const { return "grid \"" + grid + "\" of " + file; }
-};
-
 bool finite(const Vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
-
-std::string listing(const std::vector<std::string>& names) {
-  if (names.empty()) return "none: the file holds no grids";
-  std::string out;
-  for (const auto& n : names) out += (out.empty() ? "\"" : ", \"") + n + "\"";
-  return out;
-}
-
-openvdb::FloatGrid::Ptr read_openvdb(const Where& at) {
-  openvdb::io::File file(at.file);
-  try {
-    file.open(false);
-  } catch (const std::exception& e) {
-    throw Error(at.field + ".file", at.file, std::string("a readable OpenVDB file (OpenVDB: ") + e.what() + ")");
-  }
-  if (!file.hasGrid(at.grid)) {
-    std::vector<std::string> names;
-    for (auto it = file.beginName(); it != file.endName(); ++it) names.push_back(it.gridName());
-    throw Error(at.field + ".grid", "\"" + at.grid + "\" in " + at.file, "a grid the file has: " + listing(names));
-  }
-  openvdb::GridBase::Ptr base;
-  try {
-    base = file.readGrid(at.grid);
-  } catch (const std::exception& e) {
-    throw Error(at.field + ".file", at.value(), std::string("a grid OpenVDB can read (OpenVDB: ") + e.what() + ")");
-  }
-  if (!base->isType<openvdb::FloatGrid>())
-    throw Error(at.field + ".grid", at.value() + " of value type " + base->valueType(), "a float grid (density values)");
-  return openvdb::gridPtrCast<openvdb::FloatGrid>(base);
-}
-
-nanovdb::GridHandle<nanovdb::HostBuffer> read_nanovdb(const Where& at) {
-  std::vector<nanovdb::io::GridMetaData> meta;
-  try {
-    meta = nanovdb::io::readGridMetaData(at.file);
-  } catch (const std::exception& e) {
-    throw Error(at.field + ".file", at.file, std::string("a readable NanoVDB file (NanoVDB: ") + e.what() + ")");
-  }
-  if (meta.empty()) throw Error(at.field + ".file", at.file, "a NanoVDB file holding grids (NanoVDB found none: not a NanoVDB file, or an empty one)");
-  std::vector<std::string> names;
-  const nanovdb::io::GridMetaData* found = nullptr;
-  for (const auto& m : meta) {
-    names.push_back(m.gridName);
-    if (m.gridName == at.grid && !found) found = &m;
-  }
-  if (!found) throw Error(at.field + ".grid", "\"" + at.grid + "\" in " + at.file, "a grid the file has: " + listing(names));
-  if (found->gridType != nanovdb::GridType::Float)
-    throw Error(at.field + ".grid", at.value() + " of value type " + nanovdb::toStr(found->gridType), "a float grid (density values)");
-  try {
-    return nanovdb::io::readGrid<nanovdb::HostBuffer>(at.file, at.grid);
-  } catch (const std::exception& e) {
-    throw Error(at.field + ".file", at.value(), std::string("a grid NanoVDB can read (NanoVDB: ") + e.what() + ")");
-  }
-}
 
 // The transform as glm matrices (OpenVDB's row-vector Mat4: world_j = sum_i index_i m[i][j] + m[3][j]).
 void set_transform(const openvdb::FloatGrid& grid, const Where& at, VolumeField::Data& d) {
@@ -112,11 +52,23 @@ void block_values(const openvdb::FloatGrid& grid, const Where& at, VolumeField::
     d.info.max_value = std::max(d.info.max_value, static_cast<double>(v));
   }
   if (box.empty()) throw Error(at.field + ".grid", at.value() + " with no value above 0", "a grid with some density");
-  const openvdb::Coord lo = box.min(), dim = box.dim();
+  // At most 2^24 voxels along each axis (OpenVDB's int32 coordinates overflow in a span past
+  // 2^31), and at most 2^24 blocks (64 MB of maxima): blocks of 8^3 voxels, or 16^3, 32^3, ...
+  // where large tiles make a grid span more.
+  const openvdb::Coord lo = box.min();
+  std::array<int64_t, 3> span{};
   for (int a = 0; a < 3; ++a) {
-    d.info.voxels[a] = dim[a];
+    span[a] = int64_t{box.max()[a]} - lo[a] + 1;
+    if (span[a] > kMaxSpan)
+      throw Error(at.field + ".grid", at.value() + " spanning " + std::to_string(span[a]) + " voxels along " + "xyz"[a],
+                  "a grid whose non-zero values span at most " + std::to_string(kMaxSpan) + " voxels along each axis");
+  }
+  auto blocks = [&](int a) { return (span[a] + d.block - 1) / d.block; };
+  while (blocks(0) * blocks(1) * blocks(2) > kMaxBlocks) d.block *= 2;
+  for (int a = 0; a < 3; ++a) {
+    d.info.voxels[a] = static_cast<int>(span[a]);
     d.origin[a] = lo[a];
-    d.blocks[a] = (dim[a] + kBlock - 1) / kBlock;
+    d.blocks[a] = static_cast<int>(blocks(a));
   }
   d.block_max.assign(static_cast<size_t>(d.blocks[0]) * static_cast<size_t>(d.blocks[1]) * static_cast<size_t>(d.blocks[2]), 0.0f);
   auto block = [&](int x, int y, int z) -> float& {
@@ -127,10 +79,11 @@ void block_values(const openvdb::FloatGrid& grid, const Where& at, VolumeField::
     if (v == 0.0f) continue;
     openvdb::CoordBBox b = it.isVoxelValue() ? openvdb::CoordBBox(it.getCoord(), it.getCoord()) : it.getBoundingBox();
     b.intersect(box);
-    const openvdb::Coord b0 = (b.min() - lo) >> 3, b1 = (b.max() - lo) >> 3;
-    for (int z = b0.z(); z <= b1.z(); ++z)
-      for (int y = b0.y(); y <= b1.y(); ++y)
-        for (int x = b0.x(); x <= b1.x(); ++x) block(x, y, z) = std::max(block(x, y, z), v);
+    std::array<int, 3> b0{}, b1{};
+    for (int a = 0; a < 3; ++a) b0[a] = (b.min()[a] - lo[a]) / d.block, b1[a] = (b.max()[a] - lo[a]) / d.block;
+    for (int z = b0[2]; z <= b1[2]; ++z)
+      for (int y = b0[1]; y <= b1[1]; ++y)
+        for (int x = b0[0]; x <= b1[0]; ++x) block(x, y, z) = std::max(block(x, y, z), v);
   }
   // The world box of the index box widened by the trilinear stencil's one voxel and half a voxel
   // more: a grid method's cells, as many as the voxels across it, then sit on the voxel centres
@@ -158,10 +111,10 @@ std::shared_ptr<const VolumeField> VolumeField::read(const std::filesystem::path
   try {
     openvdb::FloatGrid::Ptr open;
     if (file.extension() == ".nvdb") {
-      d->handle = read_nanovdb(at);
+      d->handle = read_nanovdb_grid(at);
       open = openvdb::gridPtrCast<openvdb::FloatGrid>(nanovdb::nanoToOpenVDB(d->handle));
     } else {
-      open = read_openvdb(at);
+      open = read_openvdb_grid(at);
     }
     set_transform(*open, at, *d);
     block_values(*open, at, *d);

@@ -43,7 +43,7 @@ double VolumeField::max_density(const Aabb& region) const {
   }
   std::array<int, 3> b0{}, b1{};
   for (int a = 0; a < 3; ++a) {
-    const double first = std::floor((lo[a] - 1.0 - d.origin[a]) / kBlock), last = std::floor((hi[a] + 1.0 - d.origin[a]) / kBlock);
+    const double first = std::floor((lo[a] - 1.0 - d.origin[a]) / d.block), last = std::floor((hi[a] + 1.0 - d.origin[a]) / d.block);
     if (last < 0.0 || first >= d.blocks[a]) return 0.0;
     b0[a] = static_cast<int>(std::max(first, 0.0));
     b1[a] = static_cast<int>(std::min(last, d.blocks[a] - 1.0));
