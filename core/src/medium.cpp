@@ -285,6 +285,10 @@ void check_medium(const MediumDesc& desc, const std::string& path) {
       if (!(std::isfinite(blob.weight) && blob.weight >= 0.0)) throw Error(at + ".weight", to_text(blob.weight), "a finite weight >= 0");
       extinction(blob.weight, at + ".weight");
       if (!(std::isfinite(blob.sharpness) && blob.sharpness > 0.0)) throw Error(at + ".sharpness", to_text(blob.sharpness), "a finite sharpness > 0");
+      // Unbounded, the medium reaches 6 / sharpness past each centre (medium_bounds): a blob of
+      // sharpness 1e-300 made quadrature's steps 1e298 long and its image NaN.
+      if (unbounded && 6.0 / blob.sharpness > kMaxCoordinate)
+        throw Error(at + ".sharpness", to_text(blob.sharpness), "a sharpness >= 6e-9 (the blob reaching 6 / sharpness, at most 1e9), or medium.bounds");
     }
   } else if (const auto* f = std::get_if<FieldDensity>(&desc.density)) {
     if (!f->field) throw Error(path + ".density", "a " + f->type + " field without data", "a density field");

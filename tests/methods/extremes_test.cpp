@@ -94,6 +94,13 @@ TEST(Extremes, ValuesPastTheLimitsNameTheirField) {
       {"medium.density.blobs[1].weight",
        [](Scene& s) { s.medium->density = RbfDensity{{{Vec3(0.0), 1.0, 2.0}, {Vec3(0.5), 1e19, 3.0}}}; }},
       {"medium.density.blobs[0].center", [](Scene& s) { s.medium->density = RbfDensity{{{Vec3(1e10, 0.0, 0.0), 1.0, 2.0}}}; }},
+      // Unbounded, a blob of sharpness 1e-300 reached 6e300 away: quadrature's image was NaN
+      // (the campaign's case 53948).
+      {"medium.density.blobs[0].sharpness",
+       [](Scene& s) {
+         s.medium->density = RbfDensity{{{Vec3(0.0), 1.0, 1e-300}}};
+         s.medium->bounds = Aabb{Vec3(-kInfinity), Vec3(kInfinity)};
+       }},
       {"medium.bounds", [](Scene& s) { s.medium->bounds.hi.y = 1e19; }},
       {"medium.emission.strength", [](Scene& s) { s.medium->emission.strength = 1e300; }},
   };
