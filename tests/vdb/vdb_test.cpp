@@ -276,10 +276,10 @@ TEST(VdbVolume, DeclaredLengthsAreCheckedBeforeOpenVdbReads) {
   int64_t block = 0;
   std::memcpy(&block, good.data() + offsets + 8, 8);
   EXPECT_TRUE(has(read_altered(good, offsets + 16, int64_t{1} << 40, "bad.vdb"), {"medium.density.file", "lies between its offsets"}));
-  EXPECT_TRUE(has(read_altered(good, offsets + 16, block, "bad.vdb"), {"a grid whose data lies within its offsets", "OpenVDB read past byte"}));
+  EXPECT_TRUE(has(read_altered(good, offsets + 16, block, "bad.vdb"), {"a VDB file that holds what it declares (a leaf's value mask at byte"}));
   // A stream-written file (no offsets) and a future format.
   EXPECT_TRUE(has(read_altered(good, 20, '\0', "bad.vdb"), {"grid offsets"}));
-  EXPECT_TRUE(has(read_altered(good, 8, uint32_t{225}, "bad.vdb"), {"format 219 to 224 (it has 225)"}));
+  EXPECT_TRUE(has(read_altered(good, 8, uint32_t{225}, "bad.vdb"), {"format 222 to 224 (it has 225)"}));
   // The tree's head: a second buffer (OpenVDB would print a warning), and a root tile active 2
   // (OpenVDB loads the flag as a bool).
   const size_t tree = at("\x01\0\0\0\0\0\0\0\0\0\0\0\x01\0\0\0"s) - 16;  // 1 buffer, background 0, no tiles, 1 child
@@ -301,6 +301,63 @@ TEST(VdbVolume, DeclaredLengthsAreCheckedBeforeOpenVdbReads) {
   tiled->tree().root().addTile(openvdb::Coord(1 << 24), 1.0f, true);
   write(scratch() / "far.vdb", {tiled});
   EXPECT_TRUE(has(message_of([&] { VolumeField::read(scratch() / "far.vdb"); }), {"medium.density.grid", "spanning 16781312 voxels along x", "at most 16777216"}));
+}
+
+// Node values are walked before OpenVDB reads them: OpenVDB 10 copies an uncompressed chunk's
+// declared length into its node before comparing it with the node's size, allocates a
+// compressed chunk's declared length, and Blosc trusts the lengths in its header (fuzz_vdb found
+// the first two).
+TEST(VdbVolume, NodeValuesAreCheckedBeforeOpenVdbReadsThem) {
+  using namespace std::string_literals;
+  auto write_with = [](const fs::path& file, openvdb::FloatGrid::Ptr grid, uint32_t compression) {
+    openvdb::initialize();
+    openvdb::io::File out(file.string());
+    out.setCompression(compression);
+    out.write({grid});
+    return bytes_of(file);
+  };
+  // One active voxel: zip leaves its 4 bytes raw, behind a length of -4.
+  auto one = openvdb::FloatGrid::create(0.0f);
+  one->setName("density");
+  one->tree().setValue(openvdb::Coord(0), 0.75f);
+  const std::string zip = write_with(scratch() / "zip.vdb", one, openvdb::io::COMPRESS_ZIP | openvdb::io::COMPRESS_ACTIVE_MASK);
+  const size_t raw = zip.find("\xfc\xff\xff\xff\xff\xff\xff\xff\x00\x00\x40\x3f"s);
+  ASSERT_NE(raw, std::string::npos);
+  EXPECT_TRUE(has(read_altered(zip, raw, int64_t{-1247}, "bad.vdb"), {"medium.density.file", "uncompressed chunk at byte", "holds its node's 4 bytes of values (it declares 1247)"}));
+  EXPECT_EQ(message_of([&] { VolumeField::read(scratch() / "zip.vdb"); }), "(no error)");
+
+  // 64 active voxels Blosc-compressed: its header (version 2, typesize 4, 256 bytes) behind the
+  // chunk's length, the leaf's layout byte before that.
+  const std::string blosc = write_with(scratch() / "blosc.vdb", box_grid(4, 1.0, Vec3(0.0)), openvdb::io::COMPRESS_BLOSC | openvdb::io::COMPRESS_ACTIVE_MASK);
+  size_t header = std::string::npos;
+  for (size_t p = 9; p + 16 <= blosc.size() && header == std::string::npos; ++p) {
+    uint32_t nbytes = 0;
+    std::memcpy(&nbytes, blosc.data() + p + 4, 4);
+    if (blosc[p] == 2 && blosc[p + 3] == 4 && nbytes == 256) header = p;
+  }
+  ASSERT_NE(header, std::string::npos);
+  int64_t length = 0;
+  std::memcpy(&length, blosc.data() + header - 8, 8);
+  EXPECT_TRUE(has(read_altered(blosc, header - 8, int64_t{1} << 40, "bad.vdb"), {"a compressed chunk at byte", "needs 1099511627776 bytes"}));
+  EXPECT_TRUE(has(read_altered(blosc, header + 12, static_cast<uint32_t>(length + 1000), "bad.vdb"), {"Blosc chunk at byte", "holds its node's 256 bytes"}));
+  EXPECT_TRUE(has(read_altered(blosc, header + 4, uint32_t{1} << 30, "bad.vdb"), {"Blosc chunk at byte"}));
+  EXPECT_TRUE(has(read_altered(blosc, header - 9, '\x07', "bad.vdb"), {"have a layout of 0 to 6 (7)"}));
+  EXPECT_EQ(message_of([&] { VolumeField::read(scratch() / "blosc.vdb"); }), "(no error)");
+
+  // Two root children, the second moved onto the first (OpenVDB would leak one and read the
+  // leaves' values out of step with the topology).
+  auto two = openvdb::FloatGrid::create(0.0f);
+  two->setName("density");
+  two->tree().setValue(openvdb::Coord(0), 1.0f);
+  two->tree().setValue(openvdb::Coord(4096, 0, 0), 1.0f);
+  const std::string pair = write_with(scratch() / "two.vdb", two, openvdb::io::COMPRESS_BLOSC | openvdb::io::COMPRESS_ACTIVE_MASK);
+  const size_t root = pair.find("\x01\0\0\0\0\0\0\0\0\0\0\0\x02\0\0\0"s);  // 1 buffer, background 0, no tiles, 2 children
+  ASSERT_NE(root, std::string::npos);
+  const size_t second = pair.find("\0\x10\0\0\0\0\0\0\0\0\0\0"s, root + 28);
+  ASSERT_NE(second, std::string::npos);
+  EXPECT_TRUE(has(read_altered(pair, second, int32_t{0}, "bad.vdb"), {"root children are in increasing order"}));
+  EXPECT_TRUE(has(read_altered(pair, second, int32_t{100}, "bad.vdb"), {"root child's origin at byte", "is a multiple of 4096"}));
+  EXPECT_EQ(message_of([&] { VolumeField::read(scratch() / "two.vdb"); }), "(no error)");
 }
 
 // A NanoVDB grid is a memory image whose nodes are found through the byte offsets it holds: each

@@ -33,12 +33,13 @@ std::string read_file(const Where& at, const char* kind);
 // haze::Errors on at.field + ".file".
 class Walk {
  public:
-  Walk(const std::string& bytes, const Where& at) : bytes_(bytes), at_(at) {}
+  Walk(const std::string& bytes, const Where& at) : end(bytes.size()), bytes_(bytes), at_(at) {}
 
   size_t pos = 0;
+  size_t end;  // where the bytes being walked end
 
   size_t size() const { return bytes_.size(); }
-  size_t left() const { return bytes_.size() - pos; }
+  size_t left() const { return end - pos; }
   const char* here() const { return bytes_.data() + pos; }
   [[noreturn]] void refuse(const std::string& expected) const { throw Error(at_.field + ".file", at_.file, expected); }
   void need(uint64_t n, const char* what) const {
@@ -84,7 +85,7 @@ class MemoryBuffer : public std::streambuf {
 // The names, sorted and quoted, for "a grid the file has: ...".
 std::string grid_listing(std::vector<std::string> names);
 
-// The named float grid of an OpenVDB file (format 219 to 224), read by OpenVDB from the grid's
+// The named float grid of an OpenVDB file (format 222 to 224), read by OpenVDB from the grid's
 // checked bytes alone, in memory, through a stream that throws at their end.
 openvdb::FloatGrid::Ptr read_openvdb_grid(const Where& at);
 

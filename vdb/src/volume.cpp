@@ -7,6 +7,13 @@
 #include <cmath>
 
 namespace haze::vdb {
+namespace {
+
+// ceil(x) held to [lo, hi] before it becomes an int: x is a world length over a voxel's, which a
+// sheared or very anisotropic transform makes huge (fuzz_vdb: 4.8e29), and NaN for zero over zero.
+int count(double x, int lo, int hi) { return x >= hi ? hi : x > lo ? static_cast<int>(std::ceil(x)) : lo; }
+
+}  // namespace
 
 VolumeField::VolumeField(std::unique_ptr<Data> data) : data_(std::move(data)) {}
 VolumeField::~VolumeField() = default;
@@ -63,7 +70,7 @@ std::shared_ptr<const MajorantGrid> VolumeField::majorants() const {
   const Aabb b = data_->bounds;
   const Vec3 e = b.extent();
   std::array<int, 3> n{};
-  for (int a = 0; a < 3; ++a) n[a] = std::clamp(static_cast<int>(std::ceil(e[a] / (kBlock * feature_size()))), 1, 64);
+  for (int a = 0; a < 3; ++a) n[a] = count(e[a] / (kBlock * feature_size()), 1, 64);
   std::vector<double> m(static_cast<size_t>(n[0]) * static_cast<size_t>(n[1]) * static_cast<size_t>(n[2]));
   const Vec3 cell = e / Vec3(n[0], n[1], n[2]);
   for (int z = 0; z < n[2]; ++z)
@@ -86,7 +93,7 @@ FieldDensity volume_density(std::shared_ptr<const VolumeField> volume, int grid_
   FieldDensity f{"vdb", volume, grid_resolution};
   if (volume) {
     const Vec3 e = volume->bounds().extent();
-    f.max_resolution = std::max(2, static_cast<int>(std::ceil(std::max({e.x, e.y, e.z}) / volume->feature_size())));
+    f.max_resolution = count(std::max({e.x, e.y, e.z}) / volume->feature_size(), 2, static_cast<int>(kMaxSpan));
   }
   return f;
 }
