@@ -16,7 +16,14 @@
 
 // Allocation failure as a plain build has it: std::bad_alloc, which the readers turn into a
 // haze::Error. ASan's throwing operator new ends the process instead (allocator_may_return_null
-// only reaches the nothrow forms), and a 1 KB VDB header may ask OpenVDB for 100 TB.
+// only reaches the nothrow forms), and a 1 KB VDB header may ask OpenVDB for 100 TB. (Only under
+// ASan: libstdc++'s own nothrow form calls the throwing one.)
+#if defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define HAZE_FUZZ_ASAN 1
+#endif
+#endif
+#ifdef HAZE_FUZZ_ASAN
 void* operator new(std::size_t n) {
   if (void* p = ::operator new(n, std::nothrow)) return p;
   throw std::bad_alloc();
@@ -25,6 +32,7 @@ void* operator new[](std::size_t n) {
   if (void* p = ::operator new[](n, std::nothrow)) return p;
   throw std::bad_alloc();
 }
+#endif
 
 namespace haze::fuzz {
 

@@ -10,8 +10,13 @@
 namespace haze::particles {
 
 namespace {
+#ifndef FUZZING_BUILD_MODE_UNSAFE_FOR_PRODUCTION
 constexpr int kMaxCells = 128;            // a side
 constexpr size_t kMaxEntries = 1u << 23;  // list entries (20 bytes each) before cells grow
+#else  // the long fuzz runs (scripts/fuzz-offline): the same code with smaller zero-fills
+constexpr int kMaxCells = 16;
+constexpr size_t kMaxEntries = 1u << 16;
+#endif
 }  // namespace
 
 ParticleDensity::ParticleDensity(ParticleSet set, int neighbours) : set_(std::move(set)), field_(set_.view(), neighbours) {

@@ -231,9 +231,18 @@ MemoryBuffer::pos_type MemoryBuffer::seekoff(off_type off, std::ios_base::seekdi
 }
 
 std::string read_file(const Where& at, const char* kind) {
-  std::ifstream in(at.file, std::ios::binary);
+  std::ifstream in(at.file, std::ios::binary | std::ios::ate);
   if (!in) throw Error(at.field + ".file", at.file, std::string("a readable ") + kind + " file (it cannot be opened)");
-  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  const std::streamoff size = in.tellg();
+  if (size < 0) {  // not seekable (a pipe): read to its end
+    in.clear();
+    return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
+  std::string bytes(static_cast<size_t>(size), '\0');
+  in.seekg(0);
+  in.read(bytes.data(), size);
+  bytes.resize(static_cast<size_t>(in.gcount()));
+  return bytes;
 }
 
 openvdb::FloatGrid::Ptr read_openvdb_grid(const Where& at) {

@@ -66,11 +66,11 @@ double VolumeField::max_density(const Aabb& region) const {
 
 std::shared_ptr<const MajorantGrid> VolumeField::majorants() const {
   // About one majorant cell per block (empty blocks give zero majorants: the tracers skip them),
-  // at most 64 per axis.
+  // at most kMaxMajorants (64) per axis.
   const Aabb b = data_->bounds;
   const Vec3 e = b.extent();
   std::array<int, 3> n{};
-  for (int a = 0; a < 3; ++a) n[a] = count(e[a] / (kBlock * feature_size()), 1, 64);
+  for (int a = 0; a < 3; ++a) n[a] = count(e[a] / (kBlock * feature_size()), 1, kMaxMajorants);
   std::vector<double> m(static_cast<size_t>(n[0]) * static_cast<size_t>(n[1]) * static_cast<size_t>(n[2]));
   const Vec3 cell = e / Vec3(n[0], n[1], n[2]);
   for (int z = 0; z < n[2]; ++z)

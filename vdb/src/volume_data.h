@@ -16,7 +16,16 @@ namespace haze::vdb {
 
 constexpr int kBlock = 8;  // voxels per coarse block along each axis (an OpenVDB leaf)
 constexpr int64_t kMaxSpan = int64_t{1} << 24;    // voxels along an axis between the first and last non-zero value
-constexpr int64_t kMaxBlocks = int64_t{1} << 24;  // coarse blocks in all
+// Coarse blocks in all, and majorant cells per axis; fewer in the long fuzz runs
+// (scripts/fuzz-offline), whose inputs reach the limits and would spend their time filling 64 MB
+// and 64^3 majorants: the same code on smaller arrays.
+#ifdef FUZZING_BUILD_MODE_UNSAFE_FOR_PRODUCTION
+constexpr int64_t kMaxBlocks = int64_t{1} << 15;
+constexpr int kMaxMajorants = 16;
+#else
+constexpr int64_t kMaxBlocks = int64_t{1} << 24;
+constexpr int kMaxMajorants = 64;
+#endif
 
 struct VolumeField::Data {
   VolumeInfo info;
