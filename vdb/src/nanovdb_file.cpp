@@ -100,6 +100,13 @@ nanovdb::GridHandle<nanovdb::HostBuffer> read_nanovdb_grid(const Where& at) {
   MemoryBuffer buffer(bytes.data(), bytes.data() + bytes.size());
   std::istream in(&buffer);
   nanovdb::GridHandle<nanovdb::HostBuffer> handle = nanovdb::io::readGrid<nanovdb::HostBuffer>(in, at.grid);
+  // The handle holds this one grid, but its header keeps the index and count it had among the
+  // file's grids, and grid<float>() walks from it by gridSize() to index 0 unchecked: past the
+  // buffer, or forever where the size is 0 (fuzz_vdb). It is the first and only grid here.
+  if (handle.size() < sizeof(nanovdb::GridData)) throw Error(at.field + ".file", at.value(), "a NanoVDB grid of at least its header's size");
+  auto* header = reinterpret_cast<nanovdb::GridData*>(handle.data());
+  header->mGridIndex = 0;
+  header->mGridCount = 1;
   const auto* grid = handle.grid<float>();
   if (!grid) throw Error(at.field + ".grid", at.value(), "a float grid (density values)");
   check_tree(*grid, handle.size(), at);
