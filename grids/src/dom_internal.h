@@ -32,7 +32,9 @@ struct Channel {
   // combined sweeps): where the first-collision and scattered light together would go below 0.
   bool mark_with_moments = false;
 };
-Channel make_channel(const ExtinctionVolume& volume, const std::vector<Light>& lights, int channel, double delta_m_fraction);
+// `density` from plane `first_plane` of the volume's grid on.
+Channel make_channel(const ExtinctionVolume& volume, const std::vector<Light>& lights, int channel, double delta_m_fraction,
+                     int first_plane = 0);
 
 // The first-collision source per cell and direction (regrouped and padded: [cell * padded + i]),
 // in float32 or, divided by a per-cell scale (the cell's largest value), in float16.
@@ -54,8 +56,9 @@ struct Faces {
 // one upwind order through the grid, with their separable-phase rows and face coefficients.
 class Transport {
  public:
+  // With an exchange, over its planes of `density` only: the sweeps trade z faces through it.
   Transport(const DenseGrid& density, const DirectionSet& directions, const PhaseMatrix& matrix, const SeparablePhase& separable,
-            DomSpatial spatial, bool scalar_kernel);
+            DomSpatial spatial, bool scalar_kernel, DomExchange* exchange = nullptr);
 
   // One upwind sweep of every direction by the spatial scheme (simd/dom_sweep.h; step:
   // L_d = (sigma_s S_d + sum_e a_e L_up,e) / (sigma_t + sum_e a_e),  a_e = |w_e| / h_e), with
@@ -91,8 +94,10 @@ class Transport {
   double skipped_fraction() const { return cells_visited_ > 0 ? static_cast<double>(cells_skipped_) / static_cast<double>(cells_visited_) : 0.0; }
 
  private:
-  std::array<int, 3> n_;
+  std::array<int, 3> n_;            // the cells solved: with an exchange, its planes'
   size_t cells_;
+  int plane0_ = 0;                  // the first of them in the volume's grid
+  DomExchange* exchange_;
   int d_, n_terms_;
   bool full_;                       // N = D: the paper scheme multiplies by the matrix itself
   std::vector<float> matrix_;       // [i * D + j]: P between regrouped directions i and j, when full_

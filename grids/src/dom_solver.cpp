@@ -67,7 +67,8 @@ double chunk_dot(const float* a, const float* b, size_t count) {  // 8 float sum
   return total;
 }
 
-double dot(const std::vector<float>& a, const std::vector<float>& b, int threads) {
+// Split over processes (DomExchange), summed over all of them.
+double dot(const std::vector<float>& a, const std::vector<float>& b, int threads, DomExchange* exchange) {
   const auto size = static_cast<long long>(a.size());
   std::vector<double> partial(static_cast<size_t>((size + kChunk - 1) / kChunk), 0.0);
   parallel_for(size, threads, kChunk, [&](long long i0, long long i1) {
@@ -75,9 +76,10 @@ double dot(const std::vector<float>& a, const std::vector<float>& b, int threads
   });
   double total = 0.0;
   for (double p : partial) total += p;
+  if (exchange) exchange->sum(&total, 1);
   return total;
 }
-double norm(const std::vector<float>& a, int threads) { return std::sqrt(dot(a, a, threads)); }
+double norm(const std::vector<float>& a, int threads, DomExchange* exchange) { return std::sqrt(dot(a, a, threads, exchange)); }
 // a += s b
 void axpy(std::vector<float>& a, double s, const std::vector<float>& b, int threads) {
   const auto fs = static_cast<float>(s);
@@ -113,7 +115,7 @@ class KrylovBasis {
   }
   // h_i = v_i . w for i < count: one pass over w and each v_i, chunk by chunk (classical
   // Gram-Schmidt's projections, where modified Gram-Schmidt passes over w twice per vector).
-  std::vector<double> dots(const std::vector<float>& w, int count, int threads) const {
+  std::vector<double> dots(const std::vector<float>& w, int count, int threads, DomExchange* exchange) const {
     const auto chunk = static_cast<size_t>(kChunk), chunks_n = (size_ + chunk - 1) / chunk, vectors = static_cast<size_t>(count);
     std::vector<double> partial(chunks_n * vectors, 0.0);
     each_chunk(0, count, threads, [&](size_t b, size_t n, int i, const float* v) {
@@ -122,6 +124,7 @@ class KrylovBasis {
     std::vector<double> h(vectors, 0.0);
     for (size_t c = 0; c < chunks_n; ++c)
       for (size_t i = 0; i < vectors; ++i) h[i] += partial[c * vectors + i];
+    if (exchange) exchange->sum(h.data(), count);
     return h;
   }
   // w -= sum_i h_i v_i for i < count, in one pass over w.
@@ -175,6 +178,7 @@ void solve_moments(const dom::Transport& t, const dom::Channel& channel, const s
   const int limit = progress.start + settings.max_iterations;
   std::vector<float> kx(x.size());
   const int th = settings.threads;
+  DomExchange* const ex = settings.exchange;
   auto residual = [&](std::vector<float>& r) {  // r = b + K x - x, one sweep
     t.sweep(channel, nullptr, x.data(), 0.0f, kx.data(), th);
     ++out.iterations;
@@ -193,7 +197,7 @@ void solve_moments(const dom::Transport& t, const dom::Channel& channel, const s
         for (size_t i = 0; i < r.size(); ++i) r[i] = corrected[i] - x[i];
       }
       axpy(x, 1.0, r, th);
-      const double change = norm(r, th) / std::max(norm(x, th), 1e-300);
+      const double change = norm(r, th, ex) / std::max(norm(x, th, ex), 1e-300);
       out.changes.push_back(change);
       progress(out.iterations);
       if (change < tolerance) return;
@@ -210,13 +214,15 @@ void solve_moments(const dom::Transport& t, const dom::Channel& channel, const s
   Eigen::MatrixXd h = Eigen::MatrixXd::Zero(m + 1, m);
   Eigen::VectorXd cs(m), sn(m), g(m + 1);
   // From x = 0 the first residual is b itself, no sweep; the first cycle measures against |b|.
-  bool from_zero = std::all_of(x.begin(), x.end(), [](float e) { return e == 0.0f; });
+  double nonzero = std::all_of(x.begin(), x.end(), [](float e) { return e == 0.0f; }) ? 0.0 : 1.0;
+  if (ex) ex->sum(&nonzero, 1);
+  bool from_zero = nonzero == 0.0;
   while (out.iterations < limit) {
     if (from_zero) w = b;
     else residual(w);
-    const double x_norm = std::max(norm(from_zero ? b : x, th), 1e-300);
+    const double x_norm = std::max(norm(from_zero ? b : x, th, ex), 1e-300);
     from_zero = false;
-    double beta = norm(w, th);
+    double beta = norm(w, th, ex);
     out.changes.push_back(beta / x_norm);
     progress(out.iterations);
     if (beta / x_norm < tolerance || beta == 0.0) return;
@@ -230,10 +236,10 @@ void solve_moments(const dom::Transport& t, const dom::Channel& channel, const s
       t.sweep(channel, nullptr, w.data(), 0.0f, kx.data(), th);  // w = (I - K) v_j
       ++out.iterations;
       axpy(w, -1.0, kx, th);
-      const std::vector<double> projections = v.dots(w, j + 1, th);
+      const std::vector<double> projections = v.dots(w, j + 1, th, ex);
       v.subtract(w, projections, j + 1, th);
       for (int i = 0; i <= j; ++i) h(i, j) = projections[static_cast<size_t>(i)];
-      h(j + 1, j) = norm(w, th);
+      h(j + 1, j) = norm(w, th, ex);
       const bool breakdown = !(h(j + 1, j) > 1e-300);  // w in the Krylov space: x_j solves the system there
       if (!breakdown) v.store(j + 1, w, 1.0 / h(j + 1, j), th);
       else h(j + 1, j) = 0.0;
@@ -304,6 +310,18 @@ DomSolution solve_dom(const ExtinctionVolume& volume, const std::vector<Light>& 
     throw Error("spatial", name(settings.spatial), "\"step\" with scheme \"paper\" (the paper's Jacobi update is the step scheme)");
   if (boundary && settings.scheme == DomScheme::paper)
     throw Error("scheme", "paper", "scheme \"sweep\" with a boundary (the paper's scheme takes only the sky's radiance)");
+  DomExchange* const exchange = settings.exchange;
+  const int nz = volume.density.resolution()[2];
+  if (exchange) {
+    if (exchange->first_plane < 0 || exchange->last_plane > nz || exchange->first_plane >= exchange->last_plane)
+      throw Error("exchange", "planes [" + to_text(exchange->first_plane) + ", " + to_text(exchange->last_plane) + ")",
+                  "a part of the grid's " + to_text(nz) + " z planes, at least one");
+    if (settings.scheme != DomScheme::sweep || settings.accelerator != DomAccelerator::gmres)
+      throw Error(settings.scheme != DomScheme::sweep ? "scheme" : "accelerator",
+                  settings.scheme != DomScheme::sweep ? name(settings.scheme) : name(settings.accelerator),
+                  settings.scheme != DomScheme::sweep ? "\"sweep\" in a solve split over processes" : "\"gmres\" in a solve split over processes");
+    if (boundary) throw Error("boundary", "surfaces or a boundary", "the sky alone in a solve split over processes (surfaces not yet)");
+  }
   std::vector<Light> delta_lights;
   std::copy_if(lights.begin(), lights.end(), std::back_inserter(delta_lights), [](const Light& l) { return !std::holds_alternative<SkyLight>(l); });
   if (delta_depths.size() != delta_lights.size())
@@ -322,10 +340,13 @@ DomSolution solve_dom(const ExtinctionVolume& volume, const std::vector<Light>& 
   DomSolution out;
   out.channels = grey ? 1 : 3;
   out.resolution = volume.density.resolution();
+  if (exchange) out.resolution[2] = exchange->last_plane - exchange->first_plane, out.first_plane = exchange->first_plane;
+  const size_t cells = static_cast<size_t>(out.resolution[0]) * static_cast<size_t>(out.resolution[1]) * static_cast<size_t>(out.resolution[2]);
   out.bytes = dom_memory_bytes(out.resolution, out.channels, settings);
   check_memory(out.bytes, settings.max_memory, "dom grid",
-               to_text(volume.density.cell_count()) + " cells x " + to_text(settings.directions) + " directions",
+               to_text(cells) + " cells x " + to_text(settings.directions) + " directions",
                "fewer cells, directions or terms");
+  if (exchange) exchange->begin();
 
   out.directions = std::make_shared<DirectionSet>(DirectionSet::fibonacci(settings.directions));
   out.phase = volume.phase;
@@ -344,8 +365,9 @@ DomSolution solve_dom(const ExtinctionVolume& volume, const std::vector<Light>& 
   }
   out.matrix = std::make_shared<PhaseMatrix>(out.phase, *out.directions);
   out.separable = std::make_shared<SeparablePhase>(*out.matrix, kept_terms(settings));
-  const dom::Transport transport(volume.density, *out.directions, *out.matrix, *out.separable, settings.spatial, settings.scalar_kernel);
-  const size_t size = volume.density.cell_count() * static_cast<size_t>(out.terms());
+  const dom::Transport transport(volume.density, *out.directions, *out.matrix, *out.separable, settings.spatial, settings.scalar_kernel,
+                                   exchange);
+  const size_t size = cells * static_cast<size_t>(out.terms());
   const std::vector<dom::Faces> faces = boundary ? transport.faces(*boundary, volume.density, out.channels, settings.threads)
                                                  : std::vector<dom::Faces>();
   // DSA needs the basis's first vector constant (the l = 0 eigenvector, eigenvalue 1): its entry q0.
@@ -353,16 +375,21 @@ DomSolution solve_dom(const ExtinctionVolume& volume, const std::vector<Light>& 
   for (long d = 0; d < out.separable->basis().rows(); ++d)
     if (std::abs(out.separable->basis()(d, 0) - q0) > 1e-6 * std::abs(q0)) q0 = 0.0;
   const bool dsa = settings.diffusion_acceleration && q0 != 0.0;
-  const bool warm_fits = warm && warm->channels == out.channels && warm->resolution == out.resolution &&
-                         warm->terms() == out.terms() && warm->directions && warm->directions->size() == settings.directions;
+  bool warm_fits = warm && warm->channels == out.channels && warm->resolution == out.resolution && warm->first_plane == out.first_plane &&
+                   warm->terms() == out.terms() && warm->directions && warm->directions->size() == settings.directions;
+  if (exchange) {  // every process starts warm or none does: their iterations must match
+    double misfits = warm_fits ? 0.0 : 1.0;
+    exchange->sum(&misfits, 1);
+    warm_fits = misfits == 0.0;
+  }
 
   out.moments.resize(static_cast<size_t>(out.channels));
   double previous_source = 0.0;  // b . x of the channel solved last
   for (int c = 0; c < out.channels; ++c) {
-    dom::Channel channel = dom::make_channel(volume, lights, c, out.delta_m_fraction);
+    dom::Channel channel = dom::make_channel(volume, lights, c, out.delta_m_fraction, out.first_plane);
     std::vector<std::uint8_t> bounded;  // the diamond's fix-up marks (dom::Channel)
     if (settings.spatial == DomSpatial::diamond) {
-      bounded.assign(volume.density.cell_count() * 8, 0);
+      bounded.assign(cells * 8, 0);
       channel.bounded = bounded.data();
     }
     const dom::Faces* entering = boundary ? &faces[static_cast<size_t>(c)] : nullptr;
@@ -400,7 +427,7 @@ DomSolution solve_dom(const ExtinctionVolume& volume, const std::vector<Light>& 
         ++out.iterations;
         if (dsa) dom::diffusion_correction(volume.density, channel, out.terms(), q0, x, next, settings.threads);
         axpy(x, -1.0, next, settings.threads);
-        const double change = norm(x, settings.threads) / std::max(norm(next, settings.threads), 1e-300);
+        const double change = norm(x, settings.threads, nullptr) / std::max(norm(next, settings.threads, nullptr), 1e-300);
         x.swap(next);
         out.changes.push_back(change);
         progress(out.iterations);
@@ -419,7 +446,7 @@ DomSolution solve_dom(const ExtinctionVolume& volume, const std::vector<Light>& 
       // The channels differ by a few percent in sigma_t and in the lights' colour: the previous
       // channel's moments, scaled as its source projects onto them, start close.
       x = out.moments[static_cast<size_t>(c - 1)];
-      const double scale = dot(b, x, settings.threads) / previous_source;
+      const double scale = dot(b, x, settings.threads, settings.exchange) / previous_source;
       for (float& m : x) m *= static_cast<float>(scale);
     } else if (settings.accelerator == DomAccelerator::gmres) {
       // GMRES from 0: the first residual is b, no sweep, and the Krylov space it builds holds what
@@ -433,7 +460,7 @@ DomSolution solve_dom(const ExtinctionVolume& volume, const std::vector<Light>& 
     // particle cloud at 48^3: 0.592% at the full tolerance, 0.580% at half, 0.576% converged).
     solve_moments(transport, channel, b, x, settings, progress, out, from_channel ? 0.5 * settings.tolerance : settings.tolerance,
                   dsa ? &volume.density : nullptr, q0);
-    previous_source = dot(b, x, settings.threads);
+    previous_source = dot(b, x, settings.threads, settings.exchange);
   }
   out.converged = !out.changes.empty() && out.changes.back() < settings.tolerance;
   out.sweep_seconds = transport.seconds();

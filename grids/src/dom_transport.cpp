@@ -82,21 +82,28 @@ double cell_mean_attenuation(const DenseGrid& depth, int i, int j, int k, double
 
 }  // namespace
 
-Channel make_channel(const ExtinctionVolume& volume, const std::vector<Light>& lights, int channel, double delta_m_fraction) {
+Channel make_channel(const ExtinctionVolume& volume, const std::vector<Light>& lights, int channel, double delta_m_fraction,
+                     int first_plane) {
   Channel c;
   c.index = channel;
   c.sigma_t_scale = static_cast<float>(delta_m_sigma_t(volume.sigma_t_scale, volume.albedo, delta_m_fraction)[channel]);
   c.albedo = static_cast<float>(delta_m_albedo(volume.albedo, delta_m_fraction)[channel]);
   for (const Light& l : lights)
     if (const auto* sky = std::get_if<SkyLight>(&l)) c.sky += static_cast<float>(sky->radiance[channel]);
-  c.density = volume.density.values().data();
+  const std::array<int, 3> n = volume.density.resolution();
+  c.density = volume.density.values().data() + static_cast<size_t>(first_plane) * static_cast<size_t>(n[0]) * static_cast<size_t>(n[1]);
   return c;
 }
 
 Transport::Transport(const DenseGrid& density, const DirectionSet& directions, const PhaseMatrix& matrix, const SeparablePhase& separable,
-                     DomSpatial spatial, bool scalar_kernel)
-    : n_(density.resolution()), cells_(density.cell_count()), d_(directions.size()), n_terms_(separable.terms()),
+                     DomSpatial spatial, bool scalar_kernel, DomExchange* exchange)
+    : n_(density.resolution()), cells_(density.cell_count()), exchange_(exchange), d_(directions.size()), n_terms_(separable.terms()),
       full_(separable.terms() == directions.size()), scalar_kernel_(scalar_kernel) {
+  if (exchange) {
+    plane0_ = exchange->first_plane;
+    n_[2] = exchange->last_plane - exchange->first_plane;
+    cells_ = static_cast<size_t>(n_[0]) * static_cast<size_t>(n_[1]) * static_cast<size_t>(n_[2]);
+  }
   std::vector<int> order(static_cast<size_t>(d_));
   for (int i = 0; i < d_; ++i) order[static_cast<size_t>(i)] = i;
   std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return octant(directions[a]) < octant(directions[b]); });
@@ -153,7 +160,9 @@ void Transport::sweep(const Channel& ch, const FirstCollision* first, const floa
   scratch_.resize(size);
   const auto row_kernel = scalar_kernel_ ? simd::dom_sweep_row_reference : simd::dom_sweep_row;
   long long skipped[2] = {0, 0};
-  parallel_for(2, threads, 1, [&](long long h0, long long h1) {
+  // Split over processes, the halves in order on this thread: each half's octants wait on the
+  // process upwind, which must be in the same half (one process per core).
+  parallel_for(2, exchange_ ? 1 : threads, 1, [&](long long h0, long long h1) {
     for (long long half = h0; half < h1; ++half) {
       float* out = half == 0 ? m_out : scratch_.data();
       std::fill(out, out + size, 0.0f);
@@ -174,10 +183,10 @@ void Transport::sweep(const Channel& ch, const FirstCollision* first, const floa
         // row): an empty cell between such faces stays dark, so a row's leading run of them is
         // skipped. Exact.
         std::vector<char> z_dark(sx * sy), y_dark(sx);
-        for (size_t c = 0; c < sx * sy; ++c) {
-          enter(2, c, z_plane.data() + c * p);
-          z_dark[c] = dark(z_plane.data() + c * p);
-        }
+        for (size_t c = 0; c < sx * sy; ++c) enter(2, c, z_plane.data() + c * p);
+        // Or, split over processes, what left the process upwind (DomExchange).
+        if (exchange_) exchange_->receive(static_cast<int>(o), z_plane.data(), z_plane.size());
+        for (size_t c = 0; c < sx * sy; ++c) z_dark[c] = dark(z_plane.data() + c * p);
         simd::DomRow row;
         row.step = o & 1 ? -1 : 1;
         row.density = ch.density, row.sigma_t_scale = ch.sigma_t_scale, row.albedo = ch.albedo;
@@ -218,6 +227,7 @@ void Transport::sweep(const Channel& ch, const FirstCollision* first, const floa
             }
           }
         }
+        if (exchange_) exchange_->send(static_cast<int>(o), z_plane.data(), z_plane.size());  // the leaving face
       }
     }
   });
@@ -311,12 +321,13 @@ FirstCollision Transport::first_collision(const ExtinctionVolume& volume, const 
     for (auto k = static_cast<int>(k0); k < k1; ++k)
       for (int j = 0; j < ny; ++j)
         for (int i = 0; i < nx; ++i) {
-          const size_t c = grid.index(i, j, k);
-          if (grid.values()[c] == 0.0f) {  // an empty cell scatters nothing: no source
+          const int kg = k + plane0_;  // the plane in the volume's grid
+          const size_t c = grid.index(i, j, k), cg = grid.index(i, j, kg);
+          if (grid.values()[cg] == 0.0f) {  // an empty cell scatters nothing: no source
             if (half) first.scale[c] = 0.0f, std::fill_n(first.half.data() + c * padded_, padded_, simd::Half(0.0f));
             continue;
           }
-          const Vec3 x = grid.cell_center(i, j, k);
+          const Vec3 x = grid.cell_center(i, j, kg);
           float* f = half ? cell.data() : first.values.data() + c * padded_;
           std::array<double, 3> slope{0.0, 0.0, 0.0};  // each light's change weighted by its share
           double total = 0.0;
@@ -332,7 +343,7 @@ FirstCollision Transport::first_collision(const ExtinctionVolume& volume, const 
               if (own) a.to_light = Vec3(0.0);  // every cosine 0: an isotropic source
             }
             std::array<double, 3> u;
-            e *= cell_mean_attenuation(depths[l], i, j, k, sigma_t, u);
+            e *= cell_mean_attenuation(depths[l], i, j, kg, sigma_t, u);
             if (!(e > 0.0)) continue;
             for (size_t axis = 0; axis < 3; ++axis) slope[axis] += e * linear_change(u[axis]);
             total += e;
@@ -345,8 +356,8 @@ FirstCollision Transport::first_collision(const ExtinctionVolume& volume, const 
           // L_e / sigma_s (and, under delta-M, the scaled sigma_s: scale_all). Not slope-weighted.
           // Cells that scatter nothing send their emission to the camera only (render_dom's march).
           if (emits) {
-            const double sigma_s = volume.albedo[channel] * sigma_t * static_cast<double>(grid.values()[c]);
-            const double emitted = cell_emission(volume.emission, x, h, grid.values()[c])[channel];
+            const double sigma_s = volume.albedo[channel] * sigma_t * static_cast<double>(grid.values()[cg]);
+            const double emitted = cell_emission(volume.emission, x, h, grid.values()[cg])[channel];
             if (sigma_s > 0.0 && emitted > 0.0) {
               const auto value = static_cast<float>(scale_all * emitted / sigma_s);
               for (size_t t = 0; t < d; ++t) f[padded_index_[t]] += value;

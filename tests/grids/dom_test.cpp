@@ -9,6 +9,7 @@
 
 #include "cloud_scene.h"
 #include "slab_scene.h"
+#include "small_cloud.h"
 
 #include <gtest/gtest.h>
 
@@ -139,33 +140,7 @@ TEST(DomCloud, MatchesTheReference) {
   }
 }
 
-// A small heterogeneous volume (16 x 12 x 10 cells) with a point light inside and a sun, for the
-// solver-level tests.
-struct Small {
-  ExtinctionVolume volume{DenseGrid({16, 12, 10}, {Vec3(-1.0, -0.75, -0.6), Vec3(1.0, 0.75, 0.6)}), Rgb(3.0), Rgb(0.9),
-                          PhaseFunction::henyey_greenstein(0.5)};
-  std::vector<Light> lights{PointLight{Vec3(0.2, 0.1, 0.05), Rgb(2.0)}, DirectionalLight{glm::normalize(Vec3(0.3, -1.0, 0.2)), Rgb(1.0)}};
-  std::vector<DenseGrid> depths;
-  Small() {
-    DenseGrid& d = volume.density;
-    for (int k = 0; k < 10; ++k)
-      for (int j = 0; j < 12; ++j)
-        for (int i = 0; i < 16; ++i) {
-          const Vec3 x = d.cell_center(i, j, k);
-          d.at(i, j, k) = static_cast<float>(std::exp(-2.0 * glm::dot(x, x)) + 0.3 * (i % 3 == 0));
-        }
-    for (const Light& l : lights) depths.push_back(optical_depth(d, l, {DepthScheme::exact}));
-  }
-};
-
-double relative_difference(const std::vector<float>& a, const std::vector<float>& b) {
-  double diff = 0.0, ref = 0.0;
-  for (size_t i = 0; i < a.size(); ++i) {
-    diff += std::pow(static_cast<double>(a[i]) - static_cast<double>(b[i]), 2);
-    ref += std::pow(static_cast<double>(b[i]), 2);
-  }
-  return std::sqrt(diff / ref);
-}
+using Small = SmallCloud;  // small_cloud.h
 
 // The paper's Jacobi scheme, source iteration and GMRES solve the same discrete equations: their
 // converged moments agree to the tolerance's order; GMRES needs fewer sweeps than source

@@ -8,7 +8,7 @@ include(${CMAKE_CURRENT_LIST_DIR}/../run_step.cmake)
 include(${CMAKE_CURRENT_LIST_DIR}/simd_flags.cmake)
 run(${CMAKE_COMMAND} -S ${SOURCE_DIR} -B ${WORK_DIR} -DCMAKE_BUILD_TYPE=RelWithDebInfo
     "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g1 -DNDEBUG" "-DCMAKE_CXX_FLAGS=${simd_flags}"
-    -DHAZE_SANITIZE=thread -DHAZE_WITH_GL=OFF -DHAZE_WITH_PYTHON=OFF -DHAZE_BUILD_BENCH=OFF ${unity})
+    -DHAZE_SANITIZE=thread -DHAZE_WITH_GL=OFF -DHAZE_WITH_PYTHON=OFF -DHAZE_WITH_MPI=OFF -DHAZE_BUILD_BENCH=OFF ${unity})
 run(${CMAKE_COMMAND} --build ${WORK_DIR} -j ${JOBS} --target core_test grids_test particles_test)
 # (Each runs 10 to 200 times slower under TSan: the DOM's other tests took 15 to 180 s each.)
 set(threaded "ThreadCount|ThreadIndependent|Cancellation|^Solution.(Update|Renders|CallerGrids)|PropagationSolution"

@@ -69,6 +69,30 @@ enum class DomStorage {
 DomStorage dom_storage_from_name(const std::string& name);  // "float32", "float16"
 const char* name(DomStorage storage);
 
+// A solve split over processes by z planes (haze::mpi implements one over MPI; docs/SCALING.md):
+// this process solves planes [first_plane, last_plane) of the volume's grid, the rest belongs to
+// others. The sweeps take the z face entering its planes from the process upwind and hand the
+// leaving one to the process downwind, octant by octant; the iteration's dot products are summed
+// over all processes. Each process calls solve_dom with the same volume, lights, depths and
+// settings, its own exchange, and (warm) its own part's solution; the solution holds its planes.
+// Scheme sweep with accelerator gmres, no boundary (refused otherwise, on every process alike).
+class DomExchange {
+ public:
+  virtual ~DomExchange() = default;
+  int first_plane = 0, last_plane = 0;
+  // Called once, after the solve's checks (memory included) passed, before anything else: where
+  // the processes meet, so that one that failed its checks (and meets them otherwise) can stop all.
+  virtual void begin() {}
+  // values[i] summed over every process, the same on each (in rank order: deterministic).
+  virtual void sum(double* values, int count) = 0;
+  // The radiance entering this part's first plane (its last, for octants going -z: octant & 4)
+  // for octant `octant`, P values per face cell as Transport's faces hold them; false where that
+  // face is the grid's own (the sky's radiance enters there).
+  virtual bool receive(int octant, float* face, std::size_t count) = 0;
+  // The radiance leaving the part's last (first) plane toward the next process for the octant.
+  virtual void send(int octant, const float* face, std::size_t count) = 0;
+};
+
 struct DomSettings {
   int directions = 128;  // D, spherical Fibonacci
   // N separable terms of the phase matrix, at most D; 0 (or D) keeps the full matrix. Eigenvalues
@@ -102,6 +126,7 @@ struct DomSettings {
   bool scalar_kernel = false;  // sweep: the scalar reference kernel instead of the SIMD one (tests, benchmarks)
   ProgressCallback progress;  // once per iteration, with the fraction of max_iterations done
   std::size_t max_memory = 0;  // bytes the solve may take (RenderOptions::max_memory); 0: what is available
+  DomExchange* exchange = nullptr;  // a part of a solve split over processes (DomExchange); null: the whole grid
 };
 
 // The irradiance E_s the DOM solution's scattered light, the sky through the medium and (after the
@@ -150,7 +175,8 @@ struct DomSolution {
   std::shared_ptr<const SeparablePhase> separable;
   PhaseFunction phase;             // the one the matrix holds: the medium's, or its delta-M remainder
   double delta_m_fraction = 0.0;   // f: 0 without delta-M scaling
-  std::array<int, 3> resolution{0, 0, 0};
+  std::array<int, 3> resolution{0, 0, 0};  // with an exchange, of this process's planes
+  int first_plane = 0;                       // with an exchange: its first plane in the whole grid
   int channels = 0;
   std::vector<std::vector<float>> moments;  // [channel][cell * N + k], cells in public x-fastest order
 

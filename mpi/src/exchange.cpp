@@ -1,0 +1,92 @@
+// MpiExchange (exchange.h).
+#include "exchange.h"
+
+#include <haze/core/error.h>
+#include <haze/core/stopwatch.h>
+
+#include <algorithm>
+#include <climits>
+
+namespace haze::mpi {
+
+int message_count(std::size_t count, const char* what) {
+  if (count > static_cast<std::size_t>(INT_MAX))
+    throw Error(what, to_text(count) + " values", "at most " + to_text(INT_MAX) + " values in one MPI message (more ranks, fewer cells per face)");
+  return static_cast<int>(count);
+}
+
+MpiExchange::MpiExchange(MPI_Comm comm, std::array<int, 2> planes) : comm_(comm) {
+  MPI_Comm_rank(comm, &rank_);
+  MPI_Comm_size(comm, &ranks_);
+  first_plane = planes[0], last_plane = planes[1];
+  requests_.fill(MPI_REQUEST_NULL);
+  stats_.ranks = ranks_;
+  stats_.planes = planes;
+}
+
+MpiExchange::~MpiExchange() { finish(); }
+
+int MpiExchange::upwind(int octant) const {
+  const int r = octant & 4 ? rank_ + 1 : rank_ - 1;
+  return r >= 0 && r < ranks_ ? r : MPI_PROC_NULL;
+}
+int MpiExchange::downwind(int octant) const {
+  const int r = octant & 4 ? rank_ - 1 : rank_ + 1;
+  return r >= 0 && r < ranks_ ? r : MPI_PROC_NULL;
+}
+
+void MpiExchange::meet(int failed) {
+  met_ = true;
+  std::vector<int> all(static_cast<std::size_t>(ranks_));
+  MPI_Allgather(&failed, 1, MPI_INT, all.data(), 1, MPI_INT, comm_);
+  const auto first = std::find(all.begin(), all.end(), 1);
+  if (!failed && first != all.end())
+    throw Error("ranks", "rank " + to_text(first - all.begin()) + " of " + to_text(ranks_) + " refusing its part",
+                "every rank's part valid and within its memory (that rank's error says why)");
+}
+void MpiExchange::begin() { meet(0); }
+void MpiExchange::fail() {
+  if (!met_) meet(1);
+}
+
+void MpiExchange::sum(double* values, int count) {
+  const Stopwatch watch;
+  gathered_.resize(static_cast<std::size_t>(count) * static_cast<std::size_t>(ranks_));
+  MPI_Allgather(values, count, MPI_DOUBLE, gathered_.data(), count, MPI_DOUBLE, comm_);
+  for (int i = 0; i < count; ++i) {
+    double total = 0.0;
+    for (int r = 0; r < ranks_; ++r) total += gathered_[static_cast<std::size_t>(r) * static_cast<std::size_t>(count) + static_cast<std::size_t>(i)];
+    values[i] = total;
+  }
+  stats_.reduce_seconds += watch.seconds();
+}
+
+bool MpiExchange::all(bool ok) {
+  double failed = ok ? 0.0 : 1.0;
+  sum(&failed, 1);
+  return failed == 0.0;
+}
+
+bool MpiExchange::receive(int octant, float* face, std::size_t count) {
+  const int from = upwind(octant);
+  if (from == MPI_PROC_NULL) return false;
+  const Stopwatch watch;
+  MPI_Recv(face, message_count(count, "face"), MPI_FLOAT, from, octant, comm_, MPI_STATUS_IGNORE);
+  stats_.wait_seconds += watch.seconds();
+  return true;
+}
+
+void MpiExchange::send(int octant, const float* face, std::size_t count) {
+  const int to = downwind(octant);
+  if (to == MPI_PROC_NULL) return;
+  const auto o = static_cast<std::size_t>(octant);
+  MPI_Wait(&requests_[o], MPI_STATUS_IGNORE);  // the last sweep's face for this octant has left
+  buffers_[o].assign(face, face + count);
+  MPI_Isend(buffers_[o].data(), message_count(count, "face"), MPI_FLOAT, to, octant, comm_, &requests_[o]);
+  stats_.messages += 1;
+  stats_.bytes_sent += count * sizeof(float);
+}
+
+void MpiExchange::finish() { MPI_Waitall(static_cast<int>(requests_.size()), requests_.data(), MPI_STATUSES_IGNORE); }
+
+}  // namespace haze::mpi

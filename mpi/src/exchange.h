@@ -1,0 +1,52 @@
+// MpiExchange: grids::DomExchange over an MPI communicator, a z slab per rank. Faces go to the
+// next rank along each octant's z direction in non-blocking sends (one buffer per octant, waited
+// on before its reuse and at finish()); sums are all-gathered and added in rank order, so every
+// rank gets the same bits and takes the same decisions.
+#pragma once
+
+#include <haze/grids/dom.h>
+#include <haze/mpi/dom.h>
+
+#include <mpi.h>
+
+#include <array>
+#include <vector>
+
+namespace haze::mpi {
+
+class MpiExchange final : public grids::DomExchange {
+ public:
+  MpiExchange(MPI_Comm comm, std::array<int, 2> planes);
+  ~MpiExchange() override;
+  MpiExchange(const MpiExchange&) = delete;
+  MpiExchange& operator=(const MpiExchange&) = delete;
+
+  void begin() override;  // haze::Error on every rank when one called fail() instead
+  void fail();            // in place of begin(), on a rank whose checks failed
+  void sum(double* values, int count) override;
+  bool receive(int octant, float* face, std::size_t count) override;
+  void send(int octant, const float* face, std::size_t count) override;
+
+  void finish();  // waits for every send
+  // True on every rank when `ok` is true on every rank (collective).
+  bool all(bool ok);
+  const DomPartStats& stats() const { return stats_; }
+
+ private:
+  // The rank the octant's directions come from and go to: z increasing for octants 0-3.
+  int upwind(int octant) const;
+  int downwind(int octant) const;
+  MPI_Comm comm_;
+  int rank_ = 0, ranks_ = 1;
+  std::array<std::vector<float>, 8> buffers_;
+  std::array<MPI_Request, 8> requests_;
+  std::vector<double> gathered_;
+  bool met_ = false;  // begin() or fail() called
+  void meet(int failed);
+  DomPartStats stats_;
+};
+
+// A face holds at most 2^31 - 1 floats per message (MPI's int counts); haze::Error past that.
+int message_count(std::size_t count, const char* what);
+
+}  // namespace haze::mpi
