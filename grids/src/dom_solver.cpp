@@ -316,10 +316,9 @@ DomSolution solve_dom(const ExtinctionVolume& volume, const std::vector<Light>& 
     if (exchange->first_plane < 0 || exchange->last_plane > nz || exchange->first_plane >= exchange->last_plane)
       throw Error("exchange", "planes [" + to_text(exchange->first_plane) + ", " + to_text(exchange->last_plane) + ")",
                   "a part of the grid's " + to_text(nz) + " z planes, at least one");
-    if (settings.scheme != DomScheme::sweep || settings.accelerator != DomAccelerator::gmres)
-      throw Error(settings.scheme != DomScheme::sweep ? "scheme" : "accelerator",
-                  settings.scheme != DomScheme::sweep ? name(settings.scheme) : name(settings.accelerator),
-                  settings.scheme != DomScheme::sweep ? "\"sweep\" in a solve split over processes" : "\"gmres\" in a solve split over processes");
+    if (settings.scheme != DomScheme::sweep) throw Error("scheme", name(settings.scheme), "\"sweep\" in a solve split over processes");
+    if (settings.accelerator != DomAccelerator::gmres)
+      throw Error("accelerator", name(settings.accelerator), "\"gmres\" in a solve split over processes");
     if (boundary) throw Error("boundary", "surfaces or a boundary", "the sky alone in a solve split over processes (surfaces not yet)");
   }
   std::vector<Light> delta_lights;
