@@ -214,9 +214,8 @@ void solve_moments(const dom::Transport& t, const dom::Channel& channel, const s
   Eigen::MatrixXd h = Eigen::MatrixXd::Zero(m + 1, m);
   Eigen::VectorXd cs(m), sn(m), g(m + 1);
   // From x = 0 the first residual is b itself, no sweep; the first cycle measures against |b|.
-  double nonzero = std::all_of(x.begin(), x.end(), [](float e) { return e == 0.0f; }) ? 0.0 : 1.0;
-  if (ex) ex->sum(&nonzero, 1);
-  bool from_zero = nonzero == 0.0;
+  bool from_zero = std::all_of(x.begin(), x.end(), [](float e) { return e == 0.0f; });
+  if (ex) from_zero = ex->all(from_zero);
   while (out.iterations < limit) {
     if (from_zero) w = b;
     else residual(w);
@@ -376,11 +375,7 @@ DomSolution solve_dom(const ExtinctionVolume& volume, const std::vector<Light>& 
   const bool dsa = settings.diffusion_acceleration && q0 != 0.0;
   bool warm_fits = warm && warm->channels == out.channels && warm->resolution == out.resolution && warm->first_plane == out.first_plane &&
                    warm->terms() == out.terms() && warm->directions && warm->directions->size() == settings.directions;
-  if (exchange) {  // every process starts warm or none does: their iterations must match
-    double misfits = warm_fits ? 0.0 : 1.0;
-    exchange->sum(&misfits, 1);
-    warm_fits = misfits == 0.0;
-  }
+  if (exchange) warm_fits = exchange->all(warm_fits);  // every process starts warm or none does: their iterations must match
 
   out.moments.resize(static_cast<size_t>(out.channels));
   double previous_source = 0.0;  // b . x of the channel solved last

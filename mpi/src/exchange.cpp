@@ -37,11 +37,11 @@ int MpiExchange::downwind(int octant) const {
 
 void MpiExchange::meet(int failed) {
   met_ = true;
-  std::vector<int> all(static_cast<std::size_t>(ranks_));
-  MPI_Allgather(&failed, 1, MPI_INT, all.data(), 1, MPI_INT, comm_);
-  const auto first = std::find(all.begin(), all.end(), 1);
-  if (!failed && first != all.end())
-    throw Error("ranks", "rank " + to_text(first - all.begin()) + " of " + to_text(ranks_) + " refusing its part",
+  std::vector<int> failures(static_cast<std::size_t>(ranks_));
+  MPI_Allgather(&failed, 1, MPI_INT, failures.data(), 1, MPI_INT, comm_);
+  const auto first = std::find(failures.begin(), failures.end(), 1);
+  if (!failed && first != failures.end())
+    throw Error("ranks", "rank " + to_text(first - failures.begin()) + " of " + to_text(ranks_) + " refusing its part",
                 "every rank's part valid and within its memory (that rank's error says why)");
 }
 void MpiExchange::begin() { meet(0); }
@@ -59,12 +59,6 @@ void MpiExchange::sum(double* values, int count) {
     values[i] = total;
   }
   stats_.reduce_seconds += watch.seconds();
-}
-
-bool MpiExchange::all(bool ok) {
-  double failed = ok ? 0.0 : 1.0;
-  sum(&failed, 1);
-  return failed == 0.0;
 }
 
 bool MpiExchange::receive(int octant, float* face, std::size_t count) {

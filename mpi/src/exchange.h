@@ -28,8 +28,6 @@ class MpiExchange final : public grids::DomExchange {
   void send(int octant, const float* face, std::size_t count) override;
 
   void finish();  // waits for every send
-  // True on every rank when `ok` is true on every rank (collective).
-  bool all(bool ok);
   const DomPartStats& stats() const { return stats_; }
 
  private:

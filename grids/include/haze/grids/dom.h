@@ -85,6 +85,12 @@ class DomExchange {
   virtual void begin() {}
   // values[i] summed over every process, the same on each (in rank order: deterministic).
   virtual void sum(double* values, int count) = 0;
+  // True on every process when `ok` is true on every process (through sum).
+  bool all(bool ok) {
+    double failed = ok ? 0.0 : 1.0;
+    sum(&failed, 1);
+    return failed == 0.0;
+  }
   // The radiance entering this part's first plane (its last, for octants going -z: octant & 4)
   // for octant `octant`, P values per face cell as Transport's faces hold them; false where that
   // face is the grid's own (the sky's radiance enters there).
