@@ -107,6 +107,13 @@ nanovdb::GridHandle<nanovdb::HostBuffer> read_nanovdb_grid(const Where& at) {
   auto* header = reinterpret_cast<nanovdb::GridData*>(handle.data());
   header->mGridIndex = 0;
   header->mGridCount = 1;
+  // Its name is the file's (checked above); a header flagging a long name sends gridName() to the
+  // blind metadata at an offset nothing checks (NanoToOpenVDB segfaulted: fuzz_vdb). Haze reads no
+  // blind data, so the grid keeps none, and its short name ends within its field.
+  header->mFlags &= ~static_cast<uint32_t>(nanovdb::GridFlags::HasLongGridName);
+  header->mBlindMetadataOffset = 0;
+  header->mBlindMetadataCount = 0;
+  header->mGridName[nanovdb::GridData::MaxNameSize - 1] = '\0';
   const auto* grid = handle.grid<float>();
   if (!grid) throw Error(at.field + ".grid", at.value(), "a float grid (density values)");
   check_tree(*grid, handle.size(), at);

@@ -1,11 +1,11 @@
 // VolumeField::read: a float grid from an OpenVDB or NanoVDB file, checked, its maxima blocked and
-// its data handed to NanoVDB for sampling. Every failure is a haze::Error naming the file and grid.
+// its data handed to NanoVDB for sampling (an OpenVDB grid converted, a NanoVDB grid as read).
+// Every failure is a haze::Error naming the file and grid.
 #include "checked_read.h"
 #include "volume_data.h"
 
 #include <haze/core/error.h>
 
-#include <nanovdb/util/NanoToOpenVDB.h>
 #include <nanovdb/util/OpenToNanoVDB.h>
 #include <openvdb/openvdb.h>
 
@@ -16,49 +16,128 @@ namespace {
 
 bool finite(const Vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
-// The transform as glm matrices (OpenVDB's row-vector Mat4: world_j = sum_i index_i m[i][j] + m[3][j]).
-void set_transform(const openvdb::FloatGrid& grid, const Where& at, VolumeField::Data& d) {
-  const openvdb::math::Transform& t = grid.transform();
-  if (!t.isLinear())
-    throw Error(at.field + ".grid", at.value() + " with a " + t.mapType() + " transform", "an affine index-to-world transform");
-  const openvdb::math::Mat4d m = t.baseMap()->getAffineMap()->getMat4();
-  for (int i = 0; i < 4; ++i)
-    for (int j = 0; j < 4; ++j) d.index_to_world[i][j] = m[i][j];
+// The world positions of the voxel centres: index_to_world (column i the world step of index axis
+// i), its inverse, and the voxel size along each axis.
+void set_transform(const glm::dmat4& index_to_world, const Where& at, VolumeField::Data& d) {
+  d.index_to_world = index_to_world;
   const double det = glm::determinant(glm::dmat3(d.index_to_world));
   if (!(std::isfinite(det) && std::abs(det) > 0.0))
     throw Error(at.field + ".grid", at.value() + " with a singular transform", "an invertible index-to-world transform");
   d.world_to_index = glm::inverse(d.index_to_world);
-  const openvdb::Vec3d v = t.voxelSize();
-  d.info.voxel_size = Vec3(v.x(), v.y(), v.z());
+  for (int a = 0; a < 3; ++a) d.info.voxel_size[a] = glm::length(glm::dvec3(d.index_to_world[a]));
 }
 
-// Checks every value (leaf voxels and tiles, active or not: the sampler reads them all), finds
-// the index box of the non-zero ones and their maxima per 8^3 block.
-void block_values(const openvdb::FloatGrid& grid, const Where& at, VolumeField::Data& d) {
-  if (grid.background() != 0.0f)
-    throw Error(at.field + ".grid", at.value() + " with background " + to_text(grid.background()),
-                "background 0 (a density that does not fill all space)");
-  openvdb::CoordBBox box;  // empty
-  for (auto it = grid.cbeginValueAll(); it; ++it) {
-    const float v = *it;
-    if (!(std::isfinite(v) && v >= 0.0f)) {
-      const openvdb::Coord c = it.getCoord();
-      throw Error(at.field + ".grid", to_text(v) + " at voxel (" + to_text(c.x()) + ", " + to_text(c.y()) + ", " + to_text(c.z()) + ") of " + at.value(),
-                  "finite density values >= 0");
-    }
-    if (v == 0.0f) continue;
-    if (it.isVoxelValue()) box.expand(it.getCoord());
-    else box.expand(it.getBoundingBox());
-    d.info.max_value = std::max(d.info.max_value, static_cast<double>(v));
+// OpenVDB's row-vector Mat4: world_j = sum_i index_i m[i][j] + m[3][j].
+glm::dmat4 index_to_world(const openvdb::FloatGrid& grid, const Where& at) {
+  const openvdb::math::Transform& t = grid.transform();
+  if (!t.isLinear())
+    throw Error(at.field + ".grid", at.value() + " with a " + t.mapType() + " transform", "an affine index-to-world transform");
+  const openvdb::math::Mat4d m = t.baseMap()->getAffineMap()->getMat4();
+  glm::dmat4 out(1.0);
+  for (int i = 0; i < 4; ++i)
+    for (int j = 0; j < 4; ++j) out[i][j] = m[i][j];
+  return out;
+}
+
+// NanoVDB's map: world_i = sum_j mat[3 i + j] index_j + vec[i] (nanovdb::matMult).
+glm::dmat4 index_to_world(const nanovdb::NanoGrid<float>& grid) {
+  const nanovdb::Map& map = grid.data()->mMap;
+  glm::dmat4 out(1.0);
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) out[j][i] = map.mMatD[3 * i + j];
+    out[3][i] = map.mVecD[i];
   }
-  if (box.empty()) throw Error(at.field + ".grid", at.value() + " with no value above 0", "a grid with some density");
+  return out;
+}
+
+// One value the sampler may read: a voxel, or a tile over the voxel box [lo, hi].
+struct Value {
+  std::array<int64_t, 3> lo, hi;
+  float v;
+};
+
+// Every value of an OpenVDB grid (leaf voxels and tiles, active or not) to fn(Value).
+template <class Fn>
+void each_value(const openvdb::FloatGrid& grid, Fn&& fn) {
+  for (auto it = grid.cbeginValueAll(); it; ++it) {
+    const openvdb::CoordBBox b = it.isVoxelValue() ? openvdb::CoordBBox(it.getCoord(), it.getCoord()) : it.getBoundingBox();
+    fn(Value{{b.min().x(), b.min().y(), b.min().z()}, {b.max().x(), b.max().y(), b.max().z()}, *it});
+  }
+}
+
+// Every value of a NanoVDB grid whose nodes check_tree has checked, placed where NanoVDB's
+// accessor finds it: by the root tiles' keys and each child's slot in its parent (not by the
+// origins the nodes store, which the accessor never reads).
+template <class Fn>
+void each_value(const nanovdb::NanoGrid<float>& grid, Fn&& fn) {
+  using Upper = nanovdb::NanoUpper<float>;
+  using Lower = nanovdb::NanoLower<float>;
+  using Leaf = nanovdb::NanoLeaf<float>;
+  auto tile = [&](const std::array<int64_t, 3>& lo, int64_t dim, float v) { fn(Value{lo, {lo[0] + dim - 1, lo[1] + dim - 1, lo[2] + dim - 1}, v}); };
+  auto child_origin = [](const std::array<int64_t, 3>& o, uint32_t n, uint32_t log2dim, uint32_t child_total) {  // InternalNode::OffsetToLocalCoord
+    const uint32_t m = n & ((1u << 2 * log2dim) - 1);
+    return std::array<int64_t, 3>{o[0] + (int64_t{n >> 2 * log2dim} << child_total), o[1] + (int64_t{m >> log2dim} << child_total),
+                                  o[2] + (int64_t{m & ((1u << log2dim) - 1)} << child_total)};
+  };
+  const auto* root = grid.tree().root().data();
+  for (uint32_t i = 0; i < root->mTableSize; ++i) {
+    const auto* t = root->tile(i);
+    const nanovdb::Coord c = t->origin();
+    const std::array<int64_t, 3> o{c[0], c[1], c[2]};
+    if (!t->isChild()) {
+      tile(o, Upper::DIM, t->value);
+      continue;
+    }
+    const auto* upper = root->getChild(t)->data();
+    for (uint32_t n = 0; n < Upper::SIZE; ++n) {
+      const auto uo = child_origin(o, n, Upper::LOG2DIM, Lower::TOTAL);
+      if (!upper->mChildMask.isOn(n)) {
+        tile(uo, Lower::DIM, upper->mTable[n].value);
+        continue;
+      }
+      const auto* lower = upper->getChild(n)->data();
+      for (uint32_t k = 0; k < Lower::SIZE; ++k) {
+        const auto lo = child_origin(uo, k, Lower::LOG2DIM, Leaf::TOTAL);
+        if (!lower->mChildMask.isOn(k)) {
+          tile(lo, Leaf::DIM, lower->mTable[k].value);
+          continue;
+        }
+        const float* values = lower->getChild(k)->data()->mValues;
+        for (uint32_t v = 0; v < Leaf::SIZE; ++v) tile(child_origin(lo, v, Leaf::LOG2DIM, 0), 1, values[v]);
+      }
+    }
+  }
+}
+
+// Checks every value (the sampler reads them all), finds the index box of the non-zero ones and
+// their maxima per 8^3 block.
+template <class Grid>
+void block_values(const Grid& grid, float background, const Where& at, VolumeField::Data& d) {
+  if (background != 0.0f)
+    throw Error(at.field + ".grid", at.value() + " with background " + to_text(background), "background 0 (a density that does not fill all space)");
+  std::array<int64_t, 3> lo{}, hi{};
+  bool empty = true;
+  each_value(grid, [&](const Value& value) {
+    const float v = value.v;
+    if (!(std::isfinite(v) && v >= 0.0f))
+      throw Error(at.field + ".grid",
+                  to_text(v) + " at voxel (" + to_text(value.lo[0]) + ", " + to_text(value.lo[1]) + ", " + to_text(value.lo[2]) + ") of " + at.value(),
+                  "finite density values >= 0");
+    if (v == 0.0f) return;
+    for (int a = 0; a < 3; ++a) {
+      lo[a] = empty ? value.lo[a] : std::min(lo[a], value.lo[a]);
+      hi[a] = empty ? value.hi[a] : std::max(hi[a], value.hi[a]);
+    }
+    empty = false;
+    d.info.max_value = std::max(d.info.max_value, static_cast<double>(v));
+  });
+  if (empty) throw Error(at.field + ".grid", at.value() + " with no value above 0", "a grid with some density");
   // At most 2^24 voxels along each axis (OpenVDB's int32 coordinates overflow in a span past
   // 2^31), and at most 2^24 blocks (64 MB of maxima): blocks of 8^3 voxels, or 16^3, 32^3, ...
   // where large tiles make a grid span more.
-  const openvdb::Coord lo = box.min();
   std::array<int64_t, 3> span{};
   for (int a = 0; a < 3; ++a) {
-    span[a] = int64_t{box.max()[a]} - lo[a] + 1;
+    span[a] = hi[a] - lo[a] + 1;
     if (span[a] > kMaxSpan)
       throw Error(at.field + ".grid", at.value() + " spanning " + std::to_string(span[a]) + " voxels along " + "xyz"[a],
                   "a grid whose non-zero values span at most " + std::to_string(kMaxSpan) + " voxels along each axis");
@@ -67,31 +146,31 @@ void block_values(const openvdb::FloatGrid& grid, const Where& at, VolumeField::
   while (blocks(0) * blocks(1) * blocks(2) > kMaxBlocks) d.block *= 2;
   for (int a = 0; a < 3; ++a) {
     d.info.voxels[a] = static_cast<int>(span[a]);
-    d.origin[a] = lo[a];
+    d.origin[a] = static_cast<int>(lo[a]);
     d.blocks[a] = static_cast<int>(blocks(a));
   }
   d.block_max.assign(static_cast<size_t>(d.blocks[0]) * static_cast<size_t>(d.blocks[1]) * static_cast<size_t>(d.blocks[2]), 0.0f);
-  auto block = [&](int x, int y, int z) -> float& {
-    return d.block_max[(static_cast<size_t>(z) * static_cast<size_t>(d.blocks[1]) + static_cast<size_t>(y)) * static_cast<size_t>(d.blocks[0]) + static_cast<size_t>(x)];
-  };
-  for (auto it = grid.cbeginValueAll(); it; ++it) {
-    const float v = *it;
-    if (v == 0.0f) continue;
-    openvdb::CoordBBox b = it.isVoxelValue() ? openvdb::CoordBBox(it.getCoord(), it.getCoord()) : it.getBoundingBox();
-    b.intersect(box);
-    std::array<int, 3> b0{}, b1{};
-    for (int a = 0; a < 3; ++a) b0[a] = (b.min()[a] - lo[a]) / d.block, b1[a] = (b.max()[a] - lo[a]) / d.block;
-    for (int z = b0[2]; z <= b1[2]; ++z)
-      for (int y = b0[1]; y <= b1[1]; ++y)
-        for (int x = b0[0]; x <= b1[0]; ++x) block(x, y, z) = std::max(block(x, y, z), v);
-  }
+  each_value(grid, [&](const Value& value) {
+    if (value.v == 0.0f) return;
+    std::array<size_t, 3> b0{}, b1{};  // the blocks of the value's box within [lo, hi]
+    for (int a = 0; a < 3; ++a) {
+      b0[a] = static_cast<size_t>((std::max(value.lo[a], lo[a]) - lo[a]) / d.block);
+      b1[a] = static_cast<size_t>((std::min(value.hi[a], hi[a]) - lo[a]) / d.block);
+    }
+    for (size_t z = b0[2]; z <= b1[2]; ++z)
+      for (size_t y = b0[1]; y <= b1[1]; ++y)
+        for (size_t x = b0[0]; x <= b1[0]; ++x) {
+          float& m = d.block_max[(z * static_cast<size_t>(d.blocks[1]) + y) * static_cast<size_t>(d.blocks[0]) + x];
+          m = std::max(m, value.v);
+        }
+  });
   // The world box of the index box widened by the trilinear stencil's one voxel and half a voxel
   // more: a grid method's cells, as many as the voxels across it, then sit on the voxel centres
   // (and its own trilinear interpolation gives back the trilinear field).
   d.bounds = {Vec3(kInfinity), Vec3(-kInfinity)};
   for (int c = 0; c < 8; ++c) {
-    const glm::dvec4 p((c & 1) ? box.max().x() + 1.5 : lo.x() - 1.5, (c & 2) ? box.max().y() + 1.5 : lo.y() - 1.5,
-                       (c & 4) ? box.max().z() + 1.5 : lo.z() - 1.5, 1.0);
+    const glm::dvec4 p(static_cast<double>((c & 1) ? hi[0] : lo[0]) + ((c & 1) ? 1.5 : -1.5), static_cast<double>((c & 2) ? hi[1] : lo[1]) + ((c & 2) ? 1.5 : -1.5),
+                       static_cast<double>((c & 4) ? hi[2] : lo[2]) + ((c & 4) ? 1.5 : -1.5), 1.0);
     const Vec3 w(d.index_to_world * p);
     d.bounds.lo = glm::min(d.bounds.lo, w), d.bounds.hi = glm::max(d.bounds.hi, w);
   }
@@ -109,16 +188,17 @@ std::shared_ptr<const VolumeField> VolumeField::read(const std::filesystem::path
   d->info.file = file;
   d->info.grid = grid;
   try {
-    openvdb::FloatGrid::Ptr open;
     if (file.extension() == ".nvdb") {
       d->handle = read_nanovdb_grid(at);
-      open = openvdb::gridPtrCast<openvdb::FloatGrid>(nanovdb::nanoToOpenVDB(d->handle));
+      const auto& nano = *d->handle.grid<float>();
+      set_transform(index_to_world(nano), at, *d);
+      block_values(nano, nano.tree().background(), at, *d);
     } else {
-      open = read_openvdb_grid(at);
+      const openvdb::FloatGrid::Ptr open = read_openvdb_grid(at);
+      set_transform(index_to_world(*open, at), at, *d);
+      block_values(*open, open->background(), at, *d);
+      d->handle = nanovdb::openToNanoVDB(*open);
     }
-    set_transform(*open, at, *d);
-    block_values(*open, at, *d);
-    if (file.extension() != ".nvdb") d->handle = nanovdb::openToNanoVDB(*open);
   } catch (const std::bad_alloc&) {
     throw Error(at.field + ".file", at.value(), "a grid that fits in memory");
   } catch (const Error&) {
