@@ -1,6 +1,7 @@
 // haze render: one scene with one method, to EXR (+ PNG preview), with a JSON summary.
 #include "commands.h"
 #include "deadline.h"
+#include "mpi_world.h"
 #include "progress_bar.h"
 
 #include <haze/core/auto.h>
@@ -109,8 +110,9 @@ int render_scene(const RenderArgs& a, const Deadline& deadline) {
     for (const auto& line : choice.why) std::cout << "  - " << line << "\n";
     std::cout << std::flush;
   }
+  const bool split = world_ranks() > 1, quiet = world_rank() != 0;  // under mpirun: rank 0 alone draws, writes and prints
   ProgressBar bar(method);
-  options.progress = deadline.wrap(bar.callback());
+  options.progress = deadline.wrap(quiet ? ProgressCallback() : bar.callback());
   const Stopwatch watch;
   // A host's depth buffer and the layers it composites (View).
   std::vector<float> depth;
@@ -125,9 +127,14 @@ int render_scene(const RenderArgs& a, const Deadline& deadline) {
     throw Error("--display", "gl", "cpu with --layers or --depth (the GL display renders the image only)");
   const View view{scene.camera, depth, a.layers};
   if (a.display == "gl" && !a.fields.empty()) throw Error("--display", "gl", "cpu with --fields");
+  if (split && (a.display == "gl" || !a.fields.empty()))
+    throw Error(a.display == "gl" ? "--display" : "--fields", a.display == "gl" ? "gl" : a.fields, "neither under mpirun (rank 0 holds the image only)");
   RenderResult result;
   std::vector<std::string> fields;
-  if (!a.fields.empty()) {  // one solution for the image and the fields (prepared for any view)
+  if (split) {
+    result = render_split(scene, method, options, view);
+    if (quiet) return 0;
+  } else if (!a.fields.empty()) {  // one solution for the image and the fields (prepared for any view)
     const Solution solution = prepare(scene, method, options);
     RenderOptions render_options;
     render_options.threads = options.threads;

@@ -1,7 +1,7 @@
 // haze_mpi_scaling: one distributed DOM solve under mpirun, each rank's time, wait and messages
 // printed by rank 0 as one JSON line (docs/SCALING.md). A cloud of Gaussian density (the DOM
 // tests' shape) on nx x ny x nz cells lit by a sun, one grey channel, one thread per rank.
-// Usage: mpirun -np R haze_mpi_scaling [nx ny nz] [directions] [terms]
+// Usage: mpirun -np R haze_mpi_scaling [nx ny nz] [directions] [terms] [rows per message: 4; ny for whole faces]
 #include <haze/grids/optical_depth.h>
 #include <haze/mpi/dom.h>
 
@@ -31,6 +31,7 @@ int main(int argc, char** argv) {
   settings.directions = arg(4, 128);
   settings.terms = arg(5, 25);
   settings.threads = 1;
+  settings.rows_per_message = arg(6, 4);
   mpi::DomPartStats stats;
   MPI_Barrier(MPI_COMM_WORLD);
   const grids::DomSolution part = mpi::solve_dom(MPI_COMM_WORLD, volume, lights, depths, settings, nullptr, &stats);
@@ -40,8 +41,8 @@ int main(int argc, char** argv) {
   std::vector<double> all(7 * static_cast<size_t>(ranks));
   MPI_Gather(mine, 7, MPI_DOUBLE, all.data(), 7, MPI_DOUBLE, 0, MPI_COMM_WORLD);
   if (rank == 0) {
-    std::printf("{\"ranks\": %d, \"cells\": [%d, %d, %d], \"directions\": %d, \"terms\": %d, \"sweeps\": %d, \"per_rank\": [", ranks, n[0], n[1], n[2],
-                settings.directions, settings.terms, part.iterations);
+    std::printf("{\"ranks\": %d, \"cells\": [%d, %d, %d], \"directions\": %d, \"terms\": %d, \"rows_per_message\": %d, \"sweeps\": %d, \"per_rank\": [", ranks, n[0], n[1],
+                n[2], settings.directions, settings.terms, settings.rows_per_message, part.iterations);
     for (int r = 0; r < ranks; ++r) {
       const double* v = all.data() + 7 * r;
       // Grind time: sweep seconds, less the waiting inside them, per cell, direction and sweep.

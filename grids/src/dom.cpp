@@ -146,12 +146,14 @@ SurfaceSolve solve_with_surfaces(const Scene& scene, const ExtinctionVolume& vol
 // solution carries its surfaces' texels (which hold the bounces between surfaces so far).
 // Per pixel of `view`: the gathered in-scatter, its transmittance and the scattered light leaving
 // the surface (not yet seen through it).
+// With `planes`, only the steps in those z planes, and no surfaces (gather_planes).
 std::vector<PixelLayers> gather_scattered(const Scene& delta, const ExtinctionVolume& volume, const std::vector<DenseGrid>& depths,
                                           const DomSolution& solution, double step_cells, const Rgb& sky, const View& view,
-                                          const RenderOptions& options) {
+                                          const RenderOptions& options, const std::array<int, 2>* planes = nullptr) {
   std::optional<dom::SurfaceLight> light;
   if (solution.surfaces) light.emplace(delta, volume, depths, *solution.surfaces, sky, solution.delta_m_fraction);
-  const dom::Gather gather(delta, volume, depths, solution, step_cells, options.threads, light ? &*light : nullptr);
+  dom::Gather gather(delta, volume, depths, solution, step_cells, options.threads, light ? &*light : nullptr);
+  if (planes) gather.only_planes((*planes)[0], (*planes)[1]);
   const Camera& camera = view.camera;
   std::vector<PixelLayers> out(static_cast<size_t>(camera.width_px) * static_cast<size_t>(camera.height_px));
   ProgressTracker progress(options.progress, camera.height_px);
@@ -192,21 +194,48 @@ Image render_dom(const Scene& scene, const ExtinctionVolume& volume, const std::
 RenderResult render_dom(const Scene& scene, const ExtinctionVolume& volume, const std::vector<DenseGrid>& delta_depths,
                         const DomSolution& solution, double step_cells, const RenderOptions& options, const View& view) {
   Rgb sky;
-  Scene delta = without_sky(scene, sky);
-  delta.background += sky;
+  const Scene delta = without_sky(scene, sky);
   if (delta_depths.size() != delta.lights.size())
     throw Error("depths", to_text(delta_depths.size()) + " volumes", "one per point, spot or directional light (" + to_text(delta.lights.size()) + ")");
+  const ProgressCallback& progress = options.progress;
+  RenderOptions gather_options = options;
+  gather_options.progress = progress ? [&](double f) { return progress(0.7 * f); } : ProgressCallback();
+  const std::vector<PixelLayers> scattered = gather_scattered(delta, volume, delta_depths, solution, step_cells, sky, view, gather_options);
+  RenderOptions march_options = options;
+  march_options.progress = progress ? [&](double f) { return progress(0.7 + 0.3 * f); } : ProgressCallback();
+  return render_dom(scene, volume, delta_depths, solution.delta_m_fraction, step_cells, march_options, view, scattered);
+}
+
+std::vector<PixelLayers> gather_planes(const Scene& scene, const ExtinctionVolume& volume, const std::vector<DenseGrid>& delta_depths,
+                                       const DomSolution& part, double step_cells, std::array<int, 2> planes, const View& view,
+                                       const RenderOptions& options) {
+  if (!scene.surfaces.empty())
+    throw Error("surfaces", to_text(scene.surfaces.size()) + " surfaces", "none (the scattered light of a part of the planes reaches no surface)");
+  const int nz = volume.density.resolution()[2];
+  const int first = part.first_plane, last = part.first_plane + part.resolution[2];
+  if (!(0 <= planes[0] && planes[0] < planes[1] && planes[1] <= nz) || first > std::max(planes[0] - 1, 0) || last < std::min(planes[1] + 1, nz))
+    throw Error("planes", "[" + to_text(planes[0]) + ", " + to_text(planes[1]) + ") of a part holding [" + to_text(first) + ", " + to_text(last) + ")",
+                "planes within the grid's " + to_text(nz) + ", the part holding one more on each side (the trilinear stencil's reach)");
+  Rgb sky;
+  const Scene delta = without_sky(scene, sky);
+  return gather_scattered(delta, volume, delta_depths, part, step_cells, sky, view, options, &planes);
+}
+
+RenderResult render_dom(const Scene& scene, const ExtinctionVolume& volume, const std::vector<DenseGrid>& delta_depths, double delta_m_fraction,
+                        double step_cells, const RenderOptions& options, const View& view, const std::vector<PixelLayers>& scattered) {
+  Rgb sky;
+  Scene delta = without_sky(scene, sky);
+  delta.background += sky;
+  const size_t pixels = static_cast<size_t>(view.camera.width_px) * static_cast<size_t>(view.camera.height_px);
+  if (delta_depths.size() != delta.lights.size())
+    throw Error("depths", to_text(delta_depths.size()) + " volumes", "one per point, spot or directional light (" + to_text(delta.lights.size()) + ")");
+  if (scattered.size() != pixels) throw Error("scattered", to_text(scattered.size()) + " pixels", "one per pixel of the view (" + to_text(pixels) + ")");
   // Unscattered light (surfaces, background): the marcher with albedo 0 and, under delta-M, the
   // scaled extinction, which counts the forward peak as unscattered (as DISORT does).
   ExtinctionVolume dark = volume;
-  dark.sigma_t_scale = dom::delta_m_sigma_t(volume.sigma_t_scale, volume.albedo, solution.delta_m_fraction);
+  dark.sigma_t_scale = dom::delta_m_sigma_t(volume.sigma_t_scale, volume.albedo, delta_m_fraction);
   dark.albedo = Rgb(0.0);
-  const ProgressCallback& progress = options.progress;
-  RenderOptions march_options = options;
-  march_options.progress = progress ? [&](double f) { return progress(0.3 * f); } : ProgressCallback();
-  const RenderResult direct = march_view(delta, dark, delta_depths, MarchSettings{step_cells}, march_options, View{view.camera, view.depth, true});
-  march_options.progress = progress ? [&](double f) { return progress(0.3 + 0.7 * f); } : ProgressCallback();
-  const std::vector<PixelLayers> scattered = gather_scattered(delta, volume, delta_depths, solution, step_cells, sky, view, march_options);
+  const RenderResult direct = march_view(delta, dark, delta_depths, MarchSettings{step_cells}, options, View{view.camera, view.depth, true});
   // One transmittance for both, the march's: the gather's own differs from it only by float
   // rounding (the same steps and extinction, in double).
   RenderResult result = RenderResult::for_view(view);
@@ -303,7 +332,7 @@ class DomMethod final : public Method {
 
 }  // namespace
 
-DomFields dom_fields(const Scene& scene, const RenderOptions& options) {
+DomFields dom_setup(const Scene& scene, const RenderOptions& options) {
   Settings settings(options.settings, "dom");
   // Cells along the longest side, at least 4 per optical depth through a thinner axis (up to 32),
   // or exactly the three counts given.
@@ -347,15 +376,21 @@ DomFields dom_fields(const Scene& scene, const RenderOptions& options) {
   check_depth_memory(volume.density, scene.lights, options.max_memory);
   for (const Light& l : scene.lights)
     if (!std::holds_alternative<SkyLight>(l)) delta_depths.push_back(optical_depth(volume.density, l, depth));
-  const double depth_seconds = watch.lap();
+  DomFields fields{std::move(volume), std::move(delta_depths), {}, step_cells, {}, cells, dom, depth, warm_iterations, surface_passes};
+  fields.solution.texel_surfaces = texel_surfaces;
+  fields.stats["depth_seconds"] = watch.seconds();
+  return fields;
+}
 
+DomFields dom_fields(const Scene& scene, const RenderOptions& options) {
+  DomFields fields = dom_setup(scene, options);
+  const Stopwatch watch;
+  DomSettings dom = fields.settings;
   dom.progress = options.progress;
-  SurfaceSolve solved_surfaces = solve_with_surfaces(scene, volume, delta_depths, dom, nullptr, surface_passes, step_cells);
-  const double solve_seconds = watch.lap();
-  dom.progress = nullptr;
-  solved_surfaces.solution.texel_surfaces = texel_surfaces;
-  DomFields fields{std::move(volume), std::move(delta_depths), std::move(solved_surfaces.solution), step_cells, {}, cells, dom, depth,
-                   warm_iterations, surface_passes};
+  SurfaceSolve solved_surfaces = solve_with_surfaces(scene, fields.volume, fields.delta_depths, dom, nullptr, fields.surface_passes, fields.step_cells);
+  const double solve_seconds = watch.seconds(), depth_seconds = fields.stats["depth_seconds"];
+  solved_surfaces.solution.texel_surfaces = fields.solution.texel_surfaces;
+  fields.solution = std::move(solved_surfaces.solution);
   const ExtinctionVolume& v = fields.volume;
   const DomSolution& solved = fields.solution;
   fields.stats = {{"cells", v.density.resolution()},

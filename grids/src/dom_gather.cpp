@@ -73,6 +73,12 @@ Gather::Gather(const Scene& delta, const ExtinctionVolume& volume, const std::ve
     }
 }
 
+void Gather::only_planes(int first, int last) {
+  const auto& n = volume_.density.resolution();
+  first_plane_ = first, last_plane_ = last;
+  moment_offset_ = static_cast<size_t>(solution_.first_plane) * static_cast<size_t>(n[0]) * static_cast<size_t>(n[1]);
+}
+
 Rgb Gather::along(const Ray& ray, double t_end, const Eigen::VectorXd& c, Rgb& transmittance, double cone) const {
   return along(ray, t_end, &c, nullptr, kAll, transmittance, cone);
 }
@@ -95,6 +101,11 @@ Rgb Gather::along(const Ray& ray, double t_end, const Eigen::VectorXd* c, const 
   LightArrival a;
   for (int s = 0; s < steps; ++s) {
     const Vec3 p = ray.at(t0 + (s + 0.5) * dt);
+    if (first_plane_ > 0 || last_plane_ < density.resolution()[2]) {
+      const double z = (p.z - density.bounds().lo.z) / density.cell_size().z;
+      const int plane = std::clamp(static_cast<int>(std::floor(z)), 0, density.resolution()[2] - 1);
+      if (plane < first_plane_ || plane >= last_plane_) continue;
+    }
     const TrilinearStencil stencil(density.bounds(), density.resolution(), p);
     const double rho = stencil.apply(density.values().data());
     if (rho <= 0.0) continue;
@@ -107,7 +118,7 @@ Rgb Gather::along(const Ray& ray, double t_end, const Eigen::VectorXd* c, const 
       std::fill(m, m + n, 0.0);
       const float* moments = solution_.moments[static_cast<size_t>(ch)].data();
       for (int e = 0; e < 8; ++e) {
-        const float* cell = moments + outer.offset[e] * n;
+        const float* cell = moments + (outer.offset[e] - moment_offset_) * n;
         for (size_t k = 0; k < n; ++k) m[k] += outer.weight[e] * static_cast<double>(cell[k]);
       }
       double j = 0.0;

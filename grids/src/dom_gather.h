@@ -5,6 +5,7 @@
 #include <haze/core/scene.h>
 #include <haze/grids/dom.h>
 
+#include <limits>
 #include <vector>
 
 namespace haze::grids::dom {
@@ -32,6 +33,11 @@ class Gather {
   // (equiangular_nodes) and a sphere it passes replaces the medium's light from its direction
   // (sphere_correction).
   Rgb along(const Ray& ray, double t_end, const Eigen::VectorXd& c, Rgb& transmittance, double cone = 0.0) const;
+
+  // From now on along() takes only the steps whose midpoints lie in z planes [first, last), the
+  // steps themselves unchanged, and reads moments from a solution holding planes from
+  // solution.first_plane on (gather_planes: a rank's part).
+  void only_planes(int first, int last);
 
   // The light arriving at a surface point from the hemisphere about `normal`, weighted:
   //   sum_j (4 pi / K) max(0, n . w_j) weight(w_j) [L_j + T_j L_e]
@@ -112,6 +118,8 @@ class Gather {
   const SurfaceLight* surfaces_;
   std::vector<DenseGrid> visibility_;
   double step_, cone_ = 0.0;
+  int first_plane_ = 0, last_plane_ = std::numeric_limits<int>::max();
+  size_t moment_offset_ = 0;  // cells before the solution's first plane
   Rgb sigma_t_, albedo_, single_albedo_;
   DirectionSet around_;
   std::vector<Eigen::VectorXd> around_weights_;

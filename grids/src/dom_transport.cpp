@@ -178,15 +178,19 @@ void Transport::sweep(const Channel& ch, const FirstCollision* first, const floa
         };
         auto dark = [&](const float* v) { return std::all_of(v, v + p, [](float e) { return e == 0.0f; }); };
         const auto sx = static_cast<size_t>(nx), sy = static_cast<size_t>(ny);
-        std::vector<float> z_plane(sx * sy * p), y_row(sx * p), x_run(p), scratch(4 * p + static_cast<size_t>(oc.view.terms_padded));
+        // Split over processes, the octant goes in blocks of y rows through all of this part's
+        // planes, each block's z face received before it and sent after it, so that the process
+        // downwind starts on a block while this one sweeps the next (KBA's pipelining). Every cell
+        // sees the same upwind faces in any block order: the result is the same bits. A block's
+        // y faces carry over to the next one, plane by plane.
+        const int rows = exchange_ ? std::clamp(exchange_->rows_per_message, 1, ny) : ny, blocks = (ny + rows - 1) / rows;
+        const size_t kept = blocks > 1 ? static_cast<size_t>(nz) : 1;  // planes whose y faces are kept between blocks
+        std::vector<float> z_plane(sx * sy * p), y_rows(kept * sx * p), x_run(p), scratch(4 * p + static_cast<size_t>(oc.view.terms_padded));
         // Which upwind faces still carry exactly zero radiance (per x of the z plane and of the y
         // row): an empty cell between such faces stays dark, so a row's leading run of them is
         // skipped. Exact.
-        std::vector<char> z_dark(sx * sy), y_dark(sx);
+        std::vector<char> z_dark(sx * sy), y_darks(kept * sx);
         for (size_t c = 0; c < sx * sy; ++c) enter(2, c, z_plane.data() + c * p);
-        // Or, split over processes, what left the process upwind (DomExchange).
-        if (exchange_) exchange_->receive(static_cast<int>(o), z_plane.data(), z_plane.size());
-        for (size_t c = 0; c < sx * sy; ++c) z_dark[c] = dark(z_plane.data() + c * p);
         simd::DomRow row;
         row.step = o & 1 ? -1 : 1;
         row.density = ch.density, row.sigma_t_scale = ch.sigma_t_scale, row.albedo = ch.albedo;
@@ -196,38 +200,51 @@ void Transport::sweep(const Channel& ch, const FirstCollision* first, const floa
         row.first_stride = padded_;
         row.m_in = m_in, row.m_out = out;
         if (ch.bounded) row.bounded = ch.bounded + o, row.mark = first && (!m_in || ch.mark_with_moments);
-        row.x_run = x_run.data(), row.y_row = y_row.data(), row.scratch = scratch.data();
-        for (int kk = 0; kk < nz; ++kk) {
-          const int k = o & 4 ? nz - 1 - kk : kk;
-          for (size_t x = 0; x < sx; ++x) {
-            enter(1, static_cast<size_t>(k) * sx + x, y_row.data() + x * p);
-            y_dark[x] = dark(y_row.data() + x * p);
-          }
-          for (int jj = 0; jj < ny; ++jj) {
-            const int j = o & 2 ? ny - 1 - jj : jj;
-            enter(0, static_cast<size_t>(k) * sy + static_cast<size_t>(j), x_run.data());
-            const size_t row_start = (static_cast<size_t>(k) * sy + static_cast<size_t>(j)) * sx;
-            char* z_dark_row = z_dark.data() + static_cast<size_t>(j) * sx;
-            int skip = 0;
-            if (dark(x_run.data()))
-              for (; skip < nx; ++skip) {
-                const auto x = static_cast<size_t>(o & 1 ? nx - 1 - skip : skip);
-                if (!(y_dark[x] && z_dark_row[x] && ch.density[row_start + x] == 0.0f)) break;
+        row.x_run = x_run.data(), row.scratch = scratch.data();
+        for (int b = 0; b < blocks; ++b) {
+          const int jj0 = b * rows, jj1 = std::min(ny, jj0 + rows);
+          const auto j_low = static_cast<size_t>(o & 2 ? ny - jj1 : jj0), block_rows = static_cast<size_t>(jj1 - jj0);
+          float* face = z_plane.data() + j_low * sx * p;
+          // Or, split over processes, what left the process upwind (DomExchange).
+          if (exchange_) exchange_->receive(static_cast<int>(o), face, block_rows * sx * p);
+          for (size_t c = j_low * sx; c < (j_low + block_rows) * sx; ++c) z_dark[c] = dark(z_plane.data() + c * p);
+          for (int kk = 0; kk < nz; ++kk) {
+            const int k = o & 4 ? nz - 1 - kk : kk;
+            const size_t plane = kept > 1 ? static_cast<size_t>(k) : 0;
+            float* y_row = y_rows.data() + plane * sx * p;
+            char* y_dark = y_darks.data() + plane * sx;
+            row.y_row = y_row;
+            if (b == 0)
+              for (size_t x = 0; x < sx; ++x) {
+                enter(1, static_cast<size_t>(k) * sx + x, y_row + x * p);
+                y_dark[x] = dark(y_row + x * p);
               }
-            skipped[half] += skip;
-            if (skip == nx) continue;
-            row.count = nx - skip;
-            row.x0 = o & 1 ? nx - 1 - skip : skip;
-            row.cell0 = row_start + static_cast<size_t>(row.x0);
-            row.z_row = z_plane.data() + static_cast<size_t>(j) * sx * p;
-            row_kernel(oc.view, row);
-            for (int m = skip; m < nx; ++m) {
-              const auto x = static_cast<size_t>(o & 1 ? nx - 1 - m : m);
-              y_dark[x] = z_dark_row[x] = 0;
+            for (int jj = jj0; jj < jj1; ++jj) {
+              const int j = o & 2 ? ny - 1 - jj : jj;
+              enter(0, static_cast<size_t>(k) * sy + static_cast<size_t>(j), x_run.data());
+              const size_t row_start = (static_cast<size_t>(k) * sy + static_cast<size_t>(j)) * sx;
+              char* z_dark_row = z_dark.data() + static_cast<size_t>(j) * sx;
+              int skip = 0;
+              if (dark(x_run.data()))
+                for (; skip < nx; ++skip) {
+                  const auto x = static_cast<size_t>(o & 1 ? nx - 1 - skip : skip);
+                  if (!(y_dark[x] && z_dark_row[x] && ch.density[row_start + x] == 0.0f)) break;
+                }
+              skipped[half] += skip;
+              if (skip == nx) continue;
+              row.count = nx - skip;
+              row.x0 = o & 1 ? nx - 1 - skip : skip;
+              row.cell0 = row_start + static_cast<size_t>(row.x0);
+              row.z_row = z_plane.data() + static_cast<size_t>(j) * sx * p;
+              row_kernel(oc.view, row);
+              for (int m = skip; m < nx; ++m) {
+                const auto x = static_cast<size_t>(o & 1 ? nx - 1 - m : m);
+                y_dark[x] = z_dark_row[x] = 0;
+              }
             }
           }
+          if (exchange_) exchange_->send(static_cast<int>(o), face, block_rows * sx * p);  // the leaving face's rows
         }
-        if (exchange_) exchange_->send(static_cast<int>(o), z_plane.data(), z_plane.size());  // the leaving face
       }
     }
   });

@@ -34,7 +34,7 @@ std::vector<double> fingerprint(const grids::ExtinctionVolume& volume, const std
   std::vector<double> f{static_cast<double>(n[0]), static_cast<double>(n[1]), static_cast<double>(n[2]),
                         static_cast<double>(s.directions), static_cast<double>(s.terms), static_cast<double>(s.max_iterations),
                         s.tolerance, static_cast<double>(s.scheme), static_cast<double>(s.spatial), static_cast<double>(s.accelerator),
-                        static_cast<double>(s.storage), s.delta_m ? 1.0 : 0.0, static_cast<double>(lights.size()),
+                        static_cast<double>(s.storage), s.delta_m ? 1.0 : 0.0, static_cast<double>(s.rows_per_message), static_cast<double>(lights.size()),
                         static_cast<double>(depths.size()), checksum(volume.density.values())};
   for (int c = 0; c < 3; ++c) f.push_back(volume.sigma_t_scale[c]), f.push_back(volume.albedo[c]);
   for (const auto& d : depths) f.push_back(checksum(d.values()));
@@ -75,6 +75,7 @@ grids::DomSolution solve_dom(MPI_Comm comm, const grids::ExtinctionVolume& volum
                   "the same volume, depths, lights and settings on every rank");
 
   MpiExchange exchange(own.comm, split_planes(volume.density.resolution()[2], ranks, rank));
+  exchange.rows_per_message = settings.rows_per_message;
   grids::DomSettings part = settings;
   part.exchange = &exchange;
   // Cancelling is collective: every rank stops at the same iteration when any callback says stop.

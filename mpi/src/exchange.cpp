@@ -19,7 +19,6 @@ MpiExchange::MpiExchange(MPI_Comm comm, std::array<int, 2> planes) : comm_(comm)
   MPI_Comm_rank(comm, &rank_);
   MPI_Comm_size(comm, &ranks_);
   first_plane = planes[0], last_plane = planes[1];
-  requests_.fill(MPI_REQUEST_NULL);
   stats_.ranks = ranks_;
   stats_.planes = planes;
 }
@@ -73,14 +72,22 @@ bool MpiExchange::receive(int octant, float* face, std::size_t count) {
 void MpiExchange::send(int octant, const float* face, std::size_t count) {
   const int to = downwind(octant);
   if (to == MPI_PROC_NULL) return;
-  const auto o = static_cast<std::size_t>(octant);
-  MPI_Wait(&requests_[o], MPI_STATUS_IGNORE);  // the last sweep's face for this octant has left
-  buffers_[o].assign(face, face + count);
-  MPI_Isend(buffers_[o].data(), message_count(count, "face"), MPI_FLOAT, to, octant, comm_, &requests_[o]);
+  // Messages of one octant (one tag) arrive in the order sent: the blocks in sweep order.
+  sent_.remove_if([](Sent& s) {
+    int done = 0;
+    MPI_Test(&s.request, &done, MPI_STATUS_IGNORE);
+    return done != 0;
+  });
+  Sent& s = sent_.emplace_back();
+  s.face.assign(face, face + count);
+  MPI_Isend(s.face.data(), message_count(count, "face"), MPI_FLOAT, to, octant, comm_, &s.request);
   stats_.messages += 1;
   stats_.bytes_sent += count * sizeof(float);
 }
 
-void MpiExchange::finish() { MPI_Waitall(static_cast<int>(requests_.size()), requests_.data(), MPI_STATUSES_IGNORE); }
+void MpiExchange::finish() {
+  for (Sent& s : sent_) MPI_Wait(&s.request, MPI_STATUS_IGNORE);
+  sent_.clear();
+}
 
 }  // namespace haze::mpi

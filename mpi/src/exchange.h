@@ -1,7 +1,7 @@
 // MpiExchange: grids::DomExchange over an MPI communicator, a z slab per rank. Faces go to the
-// next rank along each octant's z direction in non-blocking sends (one buffer per octant, waited
-// on before its reuse and at finish()); sums are all-gathered and added in rank order, so every
-// rank gets the same bits and takes the same decisions.
+// next rank along each octant's z direction, block by block of rows, in non-blocking sends (each
+// from its own copy, freed once sent; all waited on at finish()); sums are all-gathered and added
+// in rank order, so every rank gets the same bits and takes the same decisions.
 #pragma once
 
 #include <haze/grids/dom.h>
@@ -10,6 +10,7 @@
 #include <mpi.h>
 
 #include <array>
+#include <list>
 #include <vector>
 
 namespace haze::mpi {
@@ -36,8 +37,11 @@ class MpiExchange final : public grids::DomExchange {
   int downwind(int octant) const;
   MPI_Comm comm_;
   int rank_ = 0, ranks_ = 1;
-  std::array<std::vector<float>, 8> buffers_;
-  std::array<MPI_Request, 8> requests_;
+  struct Sent {
+    std::vector<float> face;
+    MPI_Request request = MPI_REQUEST_NULL;
+  };
+  std::list<Sent> sent_;  // faces on their way, kept until their sends complete
   std::vector<double> gathered_;
   bool met_ = false;  // begin() or fail() called
   void meet(int failed);

@@ -72,7 +72,7 @@ const char* name(DomStorage storage);
 // A solve split over processes by z planes (haze::mpi implements one over MPI; docs/SCALING.md):
 // this process solves planes [first_plane, last_plane) of the volume's grid, the rest belongs to
 // others. The sweeps take the z face entering its planes from the process upwind and hand the
-// leaving one to the process downwind, octant by octant; the iteration's dot products are summed
+// leaving one to the process downwind, octant by octant in blocks of rows; the dot products are summed
 // over all processes. Each process calls solve_dom with the same volume, lights, depths and
 // settings, its own exchange, and (warm) its own part's solution; the solution holds its planes.
 // Scheme sweep with accelerator gmres, no boundary (refused otherwise, on every process alike).
@@ -91,11 +91,15 @@ class DomExchange {
     sum(&failed, 1);
     return failed == 0.0;
   }
+  // The sweeps go through this part's planes in blocks of this many y rows, trading each block's
+  // z face on its own: the process downwind starts on a block while this one sweeps the next.
+  int rows_per_message = 4;
   // The radiance entering this part's first plane (its last, for octants going -z: octant & 4)
-  // for octant `octant`, P values per face cell as Transport's faces hold them; false where that
-  // face is the grid's own (the sky's radiance enters there).
+  // for octant `octant` over the next block of rows in the octant's sweep order, P values per face
+  // cell as Transport's faces hold them; false where that face is the grid's own (the sky's
+  // radiance enters there).
   virtual bool receive(int octant, float* face, std::size_t count) = 0;
-  // The radiance leaving the part's last (first) plane toward the next process for the octant.
+  // The radiance leaving the part's last (first) plane over that block, toward the next process.
   virtual void send(int octant, const float* face, std::size_t count) = 0;
 };
 
@@ -133,6 +137,7 @@ struct DomSettings {
   ProgressCallback progress;  // once per iteration, with the fraction of max_iterations done
   std::size_t max_memory = 0;  // bytes the solve may take (RenderOptions::max_memory); 0: what is available
   DomExchange* exchange = nullptr;  // a part of a solve split over processes (DomExchange); null: the whole grid
+  int rows_per_message = 4;          // with haze::mpi: its exchange's DomExchange::rows_per_message
 };
 
 // The irradiance E_s the DOM solution's scattered light, the sky through the medium and (after the
@@ -243,6 +248,20 @@ Image render_dom(const Scene& scene, const ExtinctionVolume& volume, const std::
 RenderResult render_dom(const Scene& scene, const ExtinctionVolume& volume, const std::vector<DenseGrid>& delta_depths,
                         const DomSolution& solution, double step_cells, const RenderOptions& options, const View& view);
 
+// render_dom in parts, for a solution split over processes (haze::mpi): the scattered light of
+// the steps of each camera ray whose midpoints lie in z planes [planes[0], planes[1]) of the grid,
+// from `part`, which holds the moments of those planes and one more on each side (DomSolution::
+// first_plane): per pixel, the light those steps gather seen from the first of them, and their
+// transmittance. Front to back, the stretches of a ray compose as L = L_1 + T_1 L_2 + T_1 T_2 L_3 ...
+// No surfaces (a haze::Error): their light gathers over the whole grid.
+std::vector<PixelLayers> gather_planes(const Scene& scene, const ExtinctionVolume& volume, const std::vector<DenseGrid>& delta_depths,
+                                       const DomSolution& part, double step_cells, std::array<int, 2> planes, const View& view,
+                                       const RenderOptions& options);
+// The image given the scattered light per pixel (composed stretches, or render_dom's own gather):
+// the unscattered march of the whole volume, plus `scattered`.
+RenderResult render_dom(const Scene& scene, const ExtinctionVolume& volume, const std::vector<DenseGrid>& delta_depths, double delta_m_fraction,
+                        double step_cells, const RenderOptions& options, const View& view, const std::vector<PixelLayers>& scattered);
+
 // Everything method "dom" computes before it renders, from the scene and the method's settings in
 // options.settings (resolution, directions, terms, scheme, accelerator, iterations, tolerance,
 // delta_m, storage, optical_depth, step; unknown keys are an error), with the stats it reports.
@@ -261,6 +280,9 @@ struct DomFields {
   int surface_passes = 2;   // solves with the surfaces' reflected light entering the grid (dom_fields)
 };
 DomFields dom_fields(const Scene& scene, const RenderOptions& options);
+// Its first part: the settings read, the volume and the depths made, stats["depth_seconds"]; no
+// solution yet (what a split solve, haze::mpi, starts from).
+DomFields dom_setup(const Scene& scene, const RenderOptions& options);
 
 // The memory a solve with these settings needs, in bytes (what solve_dom checks).
 size_t dom_memory_bytes(const std::array<int, 3>& resolution, int channels, const DomSettings& settings);

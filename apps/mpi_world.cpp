@@ -1,0 +1,73 @@
+// MpiWorld and render_split (mpi_world.h): haze::mpi where this build has it.
+#include "mpi_world.h"
+
+#include <haze/core/error.h>
+
+#include <cstdlib>
+
+#ifdef HAZE_WITH_MPI
+#include <haze/mpi/render.h>
+
+#include <mpi.h>
+#endif
+
+namespace haze::app {
+namespace {
+
+// The number of processes a launcher says it started, 0 when none did.
+int launched_ranks() {
+  for (const char* name : {"OMPI_COMM_WORLD_SIZE", "PMI_SIZE", "PMIX_SIZE"})
+    if (const char* v = std::getenv(name)) return std::atoi(v);
+  return std::getenv("PMIX_RANK") ? 1 : 0;
+}
+
+bool started = false;
+
+}  // namespace
+
+MpiWorld::MpiWorld([[maybe_unused]] int& argc, [[maybe_unused]] char**& argv) {
+  if (launched_ranks() == 0) return;
+#ifdef HAZE_WITH_MPI
+  int provided = 0;
+  MPI_Init_thread(&argc, &argv, MPI_THREAD_FUNNELED, &provided);
+  started = true;
+#else
+  if (launched_ranks() > 1)
+    throw Error("mpirun", to_text(launched_ranks()) + " processes", "one: this haze was built without MPI (scripts/setup installs OpenMPI)");
+#endif
+}
+
+MpiWorld::~MpiWorld() {
+#ifdef HAZE_WITH_MPI
+  if (started) MPI_Finalize();
+#endif
+}
+
+int world_rank() {
+  int rank = 0;
+#ifdef HAZE_WITH_MPI
+  if (started) MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+#endif
+  return rank;
+}
+
+int world_ranks() {
+  int ranks = 1;
+#ifdef HAZE_WITH_MPI
+  if (started) MPI_Comm_size(MPI_COMM_WORLD, &ranks);
+#endif
+  return ranks;
+}
+
+RenderResult render_split([[maybe_unused]] const Scene& scene, const std::string& method, [[maybe_unused]] const RenderOptions& options,
+                          [[maybe_unused]] const View& view) {
+  if (method != "dom")
+    throw Error("--method", method, "dom under mpirun with " + to_text(world_ranks()) + " ranks (the one method split over MPI ranks), or one rank");
+#ifdef HAZE_WITH_MPI
+  return mpi::render_dom(MPI_COMM_WORLD, scene, view, options);
+#else
+  throw Error("mpirun", "this haze", "a haze built with MPI");
+#endif
+}
+
+}  // namespace haze::app
