@@ -54,7 +54,7 @@ std::array<int, 2> split_planes(int planes, int ranks, int rank) {
 
 grids::DomSolution solve_dom(MPI_Comm comm, const grids::ExtinctionVolume& volume, const std::vector<Light>& lights,
                              const std::vector<grids::DenseGrid>& delta_depths, const grids::DomSettings& settings,
-                             const grids::DomSolution* warm, DomPartStats* stats) {
+                             const grids::DomSolution* warm, DomPartStats* stats, std::array<int, 2> planes) {
   const Stopwatch watch;
   const Duplicate own(comm);
   int rank = 0, ranks = 1;
@@ -74,7 +74,20 @@ grids::DomSolution solve_dom(MPI_Comm comm, const grids::ExtinctionVolume& volum
       throw Error("ranks", "rank " + to_text(r) + " with another volume, lights or settings than rank 0",
                   "the same volume, depths, lights and settings on every rank");
 
-  MpiExchange exchange(own.comm, split_planes(volume.density.resolution()[2], ranks, rank));
+  // The ranks' planes, given or split, in rank order from the first plane to the last.
+  const int nz = volume.density.resolution()[2];
+  if (!(planes[0] < planes[1])) planes = split_planes(nz, ranks, rank);
+  std::vector<int> all_planes(2 * static_cast<size_t>(ranks));
+  MPI_Allgather(planes.data(), 2, MPI_INT, all_planes.data(), 2, MPI_INT, own.comm);
+  for (int r = 0; r < ranks; ++r) {
+    const int first = all_planes[2 * static_cast<size_t>(r)], last = all_planes[2 * static_cast<size_t>(r) + 1];
+    const int expected = r == 0 ? 0 : all_planes[2 * static_cast<size_t>(r) - 1];
+    if (first != expected || !(first < last) || last > nz || (r == ranks - 1 && last != nz))
+      throw Error("planes", "[" + to_text(first) + ", " + to_text(last) + ") on rank " + to_text(r) + " of " + to_text(ranks),
+                  "planes following each other in rank order, from 0 to the grid's " + to_text(nz) + " (rank " + to_text(r) + " from " +
+                      to_text(expected) + ")");
+  }
+  MpiExchange exchange(own.comm, planes);
   exchange.rows_per_message = settings.rows_per_message;
   grids::DomSettings part = settings;
   part.exchange = &exchange;

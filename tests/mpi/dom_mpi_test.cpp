@@ -97,6 +97,33 @@ TEST(MpiDom, MatchesTheSingleProcessSolver) {
   EXPECT_LT(std::sqrt(diff / ref), 1e-5);
 }
 
+// Planes given by the caller, one a rank but the last, which takes the rest: the same moments as
+// the single process; planes that do not follow each other are refused on every rank.
+TEST(MpiDom, PlanesGivenByTheCaller) {
+  const Cloud s;
+  const DomSettings settings = small_settings();
+  const int r = rank_of(), n = ranks_of();
+  const std::array<int, 2> planes{r, r == n - 1 ? 10 : r + 1};
+  DomPartStats stats;
+  const DomSolution part = solve_dom(MPI_COMM_WORLD, s.volume, s.lights, s.depths, settings, nullptr, &stats, planes);
+  EXPECT_EQ(stats.planes, planes);
+  const DomSolution whole = gather(MPI_COMM_WORLD, part);
+  if (r == 0) {
+    const DomSolution single = grids::solve_dom(s.volume, s.lights, s.depths, settings);
+    EXPECT_EQ(part.iterations, single.iterations);
+    for (int c = 0; c < 3; ++c) EXPECT_LT(relative_difference(whole.moments[static_cast<size_t>(c)], single.moments[static_cast<size_t>(c)]), 1e-5);
+  }
+  if (n < 2) return;
+  try {
+    solve_dom(MPI_COMM_WORLD, s.volume, s.lights, s.depths, settings, nullptr, nullptr, {0, 10});
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("planes: got [0, 10) on rank 1 of " + std::to_string(n) + ", expected planes following each other in rank order"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
 // Warm starts work per rank: each rank's part of a converged solve starts the same solve again,
 // which stops at once, as the single-process warm start does.
 TEST(MpiDom, WarmStartPerRank) {

@@ -37,10 +37,13 @@ struct DomPartStats {
 // solution. Returns this rank's part: its planes' moments (DomSolution::first_plane), the
 // iteration counts and changes of the whole solve, the same on every rank. settings.max_memory
 // caps each rank; a rank that would not fit fails the call on every rank alike, before anything
-// is allocated. Scheme sweep with accelerator gmres; settings.threads threads per rank.
+// is allocated. Scheme sweep with accelerator gmres; settings.threads threads per rank. `planes`,
+// when given (first < last), are this rank's instead of split_planes': the ranks' planes must
+// follow each other in rank order from 0 to the grid's last (checked: a haze::Error on every
+// rank), so a caller can give a rank more planes where they are cheap.
 grids::DomSolution solve_dom(MPI_Comm comm, const grids::ExtinctionVolume& volume, const std::vector<Light>& lights,
                              const std::vector<grids::DenseGrid>& delta_depths, const grids::DomSettings& settings,
-                             const grids::DomSolution* warm = nullptr, DomPartStats* stats = nullptr);
+                             const grids::DomSolution* warm = nullptr, DomPartStats* stats = nullptr, std::array<int, 2> planes = {0, 0});
 
 // The parts of every rank gathered on `root` into the whole grid's solution (render_dom takes it);
 // the other ranks get their part back unchanged. Collective.
