@@ -12,15 +12,6 @@
 namespace haze::mpi {
 namespace {
 
-// A communicator of our own for the solve's messages (its tags cannot meet the caller's).
-struct Duplicate {
-  MPI_Comm comm = MPI_COMM_NULL;
-  explicit Duplicate(MPI_Comm from) { MPI_Comm_dup(from, &comm); }
-  ~Duplicate() { MPI_Comm_free(&comm); }
-  Duplicate(const Duplicate&) = delete;
-  Duplicate& operator=(const Duplicate&) = delete;
-};
-
 // What must be the same on every rank, as numbers: sizes, settings and a checksum of the density
 // and the depths.
 std::vector<double> fingerprint(const grids::ExtinctionVolume& volume, const std::vector<Light>& lights,

@@ -48,6 +48,15 @@ class MpiExchange final : public grids::DomExchange {
   DomPartStats stats_;
 };
 
+// A communicator of our own for a call's messages (their tags cannot meet the caller's).
+struct Duplicate {
+  MPI_Comm comm = MPI_COMM_NULL;
+  explicit Duplicate(MPI_Comm from) { MPI_Comm_dup(from, &comm); }
+  ~Duplicate() { MPI_Comm_free(&comm); }
+  Duplicate(const Duplicate&) = delete;
+  Duplicate& operator=(const Duplicate&) = delete;
+};
+
 // A face holds at most 2^31 - 1 floats per message (MPI's int counts); haze::Error past that.
 int message_count(std::size_t count, const char* what);
 

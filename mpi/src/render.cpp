@@ -68,7 +68,9 @@ void receive_floats(MPI_Comm comm, std::vector<float>& v, int from) {
 
 }  // namespace
 
-RenderResult render_dom(MPI_Comm comm, const Scene& scene, const View& view, const RenderOptions& options, int root) {
+RenderResult render_dom(MPI_Comm caller, const Scene& scene, const View& view, const RenderOptions& options, int root) {
+  const Duplicate own(caller);
+  const MPI_Comm comm = own.comm;
   int rank = 0, ranks = 1;
   MPI_Comm_rank(comm, &rank);
   MPI_Comm_size(comm, &ranks);
@@ -92,9 +94,8 @@ RenderResult render_dom(MPI_Comm comm, const Scene& scene, const View& view, con
   DomPartStats part_stats;
   grids::DomSolution part = solve_dom(comm, f.volume, scene.lights, f.delta_depths, settings, nullptr, &part_stats);
   const double solve_seconds = watch.lap();
-  const int nz = f.volume.density.resolution()[2];
   const std::array<int, 2> planes{part.first_plane, part.first_plane + part.resolution[2]};
-  const grids::DomSolution grown = with_neighbour_planes(comm, part, nz);
+  const grids::DomSolution grown = with_neighbour_planes(comm, std::move(part), f.volume.density.resolution()[2]);
 
   // The stretches; a cancel asked on any rank is agreed after them (no rank leaves the others waiting).
   std::atomic<bool> cancel{false};
@@ -110,7 +111,7 @@ RenderResult render_dom(MPI_Comm comm, const Scene& scene, const View& view, con
   if (cancelled) throw Cancelled();
 
   const std::array<double, 8> mine{static_cast<double>(part_stats.cells), part_stats.wait_seconds, part_stats.reduce_seconds, solve_seconds,
-                                   gather_seconds, static_cast<double>(part_stats.bytes_sent), part.sweep_seconds, part.first_collision_seconds};
+                                   gather_seconds, static_cast<double>(part_stats.bytes_sent), grown.sweep_seconds, grown.first_collision_seconds};
   std::vector<double> all(mine.size() * static_cast<std::size_t>(ranks));
   MPI_Gather(mine.data(), static_cast<int>(mine.size()), MPI_DOUBLE, all.data(), static_cast<int>(mine.size()), MPI_DOUBLE, root, comm);
   if (rank != root) {
@@ -140,7 +141,7 @@ RenderResult render_dom(MPI_Comm comm, const Scene& scene, const View& view, con
   }
   RenderOptions march_options = options;
   march_options.progress = progress ? [&](double x) { return progress(0.95 + 0.05 * x); } : ProgressCallback();
-  RenderResult result = grids::render_dom(scene, f.volume, f.delta_depths, part.delta_m_fraction, f.step_cells, march_options, view, scattered);
+  RenderResult result = grids::render_dom(scene, f.volume, f.delta_depths, grown.delta_m_fraction, f.step_cells, march_options, view, scattered);
   result.stats = f.stats;
   auto column = [&](std::size_t k) {
     nlohmann::json v = nlohmann::json::array();
@@ -153,10 +154,10 @@ RenderResult render_dom(MPI_Comm comm, const Scene& scene, const View& view, con
   result.stats.update({{"ranks", ranks},
                        {"cells", f.volume.density.resolution()},
                        {"directions", settings.directions},
-                       {"terms", part.terms()},
-                       {"iterations", part.iterations},
-                       {"converged", part.converged},
-                       {"final_change", part.changes.empty() ? 0.0 : part.changes.back()},
+                       {"terms", grown.terms()},
+                       {"iterations", grown.iterations},
+                       {"converged", grown.converged},
+                       {"final_change", grown.changes.empty() ? 0.0 : grown.changes.back()},
                        {"depth_seconds", depth_seconds},
                        {"rank_cells", column(0)},
                        {"rank_wait_seconds", column(1)},
