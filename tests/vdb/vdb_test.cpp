@@ -130,6 +130,22 @@ TEST(VdbVolume, SamplesTrilinearlyAtTheGridsPlace) {
   EXPECT_EQ(cell(9, 4, 4), 0.0f);
 }
 
+// A grid whose density is one inactive root tile (4096^3 voxels) reads without a word on stderr:
+// NanoVDB's statistics, which Haze does not use, warned of it ("input tree only contained
+// inactive root tiles!", found by fuzz_vdb's ASan replay).
+TEST(VdbVolume, ReadsWithoutPrinting) {
+  const fs::path file = scratch() / "tile.vdb";
+  auto grid = openvdb::FloatGrid::create(0.0f);
+  grid->setName("density");
+  grid->tree().addTile(3, openvdb::Coord(0), 0.5f, false);
+  write(file, {grid});
+  testing::internal::CaptureStderr();
+  const auto volume = VolumeField::read(file);
+  EXPECT_EQ(testing::internal::GetCapturedStderr(), "");
+  EXPECT_EQ(volume->info().voxels, (std::array<int, 3>{4096, 4096, 4096}));
+  EXPECT_NEAR(volume->density(volume->bounds().lo + 0.5 * (volume->bounds().hi - volume->bounds().lo)), 0.5, 1e-6);
+}
+
 TEST(VdbVolume, FollowsAnAffineTransform) {
   const fs::path file = scratch() / "rotated.vdb";
   auto grid = box_grid(4, 1.0, Vec3(0.0));

@@ -197,7 +197,9 @@ std::shared_ptr<const VolumeField> VolumeField::read(const std::filesystem::path
       const openvdb::FloatGrid::Ptr open = read_openvdb_grid(at);
       set_transform(index_to_world(*open, at), at, *d);
       block_values(*open, open->background(), at, *d);
-      d->handle = nanovdb::openToNanoVDB(*open);
+      // Without NanoVDB's statistics, which Haze does not read (block_values has what it needs)
+      // and which print a warning of their own for a tree of inactive root tiles.
+      d->handle = nanovdb::openToNanoVDB(*open, nanovdb::StatsMode::Disable, nanovdb::ChecksumMode::Disable);
     }
   } catch (const std::bad_alloc&) {
     throw Error(at.field + ".file", at.value(), "a grid that fits in memory");
