@@ -56,16 +56,18 @@ struct Value {
   float v;
 };
 
-// Every value of an OpenVDB grid (leaf voxels and tiles, active or not) to fn(Value).
+// Every non-zero value of an OpenVDB grid (leaf voxels and tiles, active or not) to fn(Value): a
+// zero is finite, and holds no density.
 template <class Fn>
 void each_value(const openvdb::FloatGrid& grid, Fn&& fn) {
   for (auto it = grid.cbeginValueAll(); it; ++it) {
+    if (*it == 0.0f) continue;
     const openvdb::CoordBBox b = it.isVoxelValue() ? openvdb::CoordBBox(it.getCoord(), it.getCoord()) : it.getBoundingBox();
     fn(Value{{b.min().x(), b.min().y(), b.min().z()}, {b.max().x(), b.max().y(), b.max().z()}, *it});
   }
 }
 
-// Every value of a NanoVDB grid whose nodes check_tree has checked, placed where NanoVDB's
+// Every non-zero value of a NanoVDB grid whose nodes check_tree has checked, placed where NanoVDB's
 // accessor finds it: by the root tiles' keys and each child's slot in its parent (not by the
 // origins the nodes store, which the accessor never reads).
 template <class Fn>
@@ -73,7 +75,9 @@ void each_value(const nanovdb::NanoGrid<float>& grid, Fn&& fn) {
   using Upper = nanovdb::NanoUpper<float>;
   using Lower = nanovdb::NanoLower<float>;
   using Leaf = nanovdb::NanoLeaf<float>;
-  auto tile = [&](const std::array<int64_t, 3>& lo, int64_t dim, float v) { fn(Value{lo, {lo[0] + dim - 1, lo[1] + dim - 1, lo[2] + dim - 1}, v}); };
+  auto tile = [&](const std::array<int64_t, 3>& lo, int64_t dim, float v) {
+    if (v != 0.0f) fn(Value{lo, {lo[0] + dim - 1, lo[1] + dim - 1, lo[2] + dim - 1}, v});
+  };
   auto child_origin = [](const std::array<int64_t, 3>& o, uint32_t n, uint32_t log2dim, uint32_t child_total) {  // InternalNode::OffsetToLocalCoord
     const uint32_t m = n & ((1u << 2 * log2dim) - 1);
     return std::array<int64_t, 3>{o[0] + (int64_t{n >> 2 * log2dim} << child_total), o[1] + (int64_t{m >> log2dim} << child_total),
@@ -109,8 +113,8 @@ void each_value(const nanovdb::NanoGrid<float>& grid, Fn&& fn) {
   }
 }
 
-// Checks every value (the sampler reads them all), finds the index box of the non-zero ones and
-// their maxima per 8^3 block.
+// Checks every non-zero value (the sampler reads them all), finds their index box and their
+// maxima per 8^3 block.
 template <class Grid>
 void block_values(const Grid& grid, float background, const Where& at, VolumeField::Data& d) {
   if (background != 0.0f)
@@ -123,7 +127,6 @@ void block_values(const Grid& grid, float background, const Where& at, VolumeFie
       throw Error(at.field + ".grid",
                   to_text(v) + " at voxel (" + to_text(value.lo[0]) + ", " + to_text(value.lo[1]) + ", " + to_text(value.lo[2]) + ") of " + at.value(),
                   "finite density values >= 0");
-    if (v == 0.0f) return;
     for (int a = 0; a < 3; ++a) {
       lo[a] = empty ? value.lo[a] : std::min(lo[a], value.lo[a]);
       hi[a] = empty ? value.hi[a] : std::max(hi[a], value.hi[a]);
@@ -151,7 +154,6 @@ void block_values(const Grid& grid, float background, const Where& at, VolumeFie
   }
   d.block_max.assign(static_cast<size_t>(d.blocks[0]) * static_cast<size_t>(d.blocks[1]) * static_cast<size_t>(d.blocks[2]), 0.0f);
   each_value(grid, [&](const Value& value) {
-    if (value.v == 0.0f) return;
     std::array<size_t, 3> b0{}, b1{};  // the blocks of the value's box within [lo, hi]
     for (int a = 0; a < 3; ++a) {
       b0[a] = static_cast<size_t>((std::max(value.lo[a], lo[a]) - lo[a]) / d.block);
