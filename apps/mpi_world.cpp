@@ -21,7 +21,9 @@ int launched_ranks() {
   return std::getenv("PMIX_RANK") ? 1 : 0;
 }
 
-bool started = false;
+#ifdef HAZE_WITH_MPI
+bool started = false;  // MPI_Init_thread called
+#endif
 
 }  // namespace
 
