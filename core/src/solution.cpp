@@ -234,6 +234,14 @@ Rgb Solution::inscattered(const Vec3& x, const Vec3& w) const {
   return state_->field("inscattered", [&] { return state_->solution->inscattered(x, w); });
 }
 
+nlohmann::json method_settings(const Scene& scene, const std::string& method_name, const nlohmann::json& given) {
+  nlohmann::json settings = scene.method_name() == method_name ? scene.method : nlohmann::json::object();
+  if (!given.is_null() && !given.is_object()) throw Error("settings", json_text(given), "an object of " + method_name + " settings");
+  for (const auto& [key, value] : given.items()) settings[key] = value;
+  settings.erase("name");
+  return settings;
+}
+
 Solution prepare(const Scene& scene, const std::string& method_name, RenderOptions options) {
   const std::string name = method_name.empty() ? scene.method_name() : method_name;
   if (name.empty()) throw Error("method.name", "missing", "a method named by the scene or the caller");
@@ -248,12 +256,7 @@ Solution prepare(const Scene& scene, const std::string& method_name, RenderOptio
   }
   state->method = state->info.create();
   state->scene = scene;
-  nlohmann::json settings = nlohmann::json::object();
-  if (scene.method_name() == name) settings = scene.method;
-  if (!options.settings.is_null() && !options.settings.is_object())
-    throw Error("settings", json_text(options.settings), "an object of " + name + " settings");
-  for (const auto& [key, value] : options.settings.items()) settings[key] = value;
-  settings.erase("name");
+  nlohmann::json settings = method_settings(scene, name, options.settings);
   const ProgressCallback progress = std::move(options.progress);
   options.settings = std::move(settings);
   state->options = std::move(options);

@@ -112,11 +112,8 @@ grids::DomSolution gather(MPI_Comm comm, const grids::DomSolution& part, int roo
   unsigned long long bytes = part.bytes;
   MPI_Allreduce(MPI_IN_PLACE, &bytes, 1, MPI_UNSIGNED_LONG_LONG, MPI_SUM, own.comm);
   const size_t plane = static_cast<size_t>(part.resolution[0]) * static_cast<size_t>(part.resolution[1]) * static_cast<size_t>(part.terms());
-  constexpr size_t kChunk = size_t{1} << 28;  // floats per message, within MPI's int counts
   if (rank != root) {
-    for (const auto& m : part.moments)
-      for (size_t at = 0; at < m.size(); at += kChunk)
-        MPI_Send(m.data() + at, static_cast<int>(std::min(kChunk, m.size() - at)), MPI_FLOAT, root, 0, own.comm);
+    for (const auto& m : part.moments) send_floats(own.comm, m.data(), m.size(), root);
     return part;
   }
   grids::DomSolution whole = part;
@@ -134,8 +131,7 @@ grids::DomSolution gather(MPI_Comm comm, const grids::DomSolution& part, int roo
         std::copy(part.moments[c].begin(), part.moments[c].end(), to);
         continue;
       }
-      for (size_t at = 0; at < count; at += kChunk)
-        MPI_Recv(to + at, static_cast<int>(std::min(kChunk, count - at)), MPI_FLOAT, r, 0, own.comm, MPI_STATUS_IGNORE);
+      receive_floats(own.comm, to, count, r);
     }
   }
   return whole;

@@ -15,6 +15,20 @@ int message_count(std::size_t count, const char* what) {
   return static_cast<int>(count);
 }
 
+namespace {
+constexpr std::size_t kChunk = std::size_t{1} << 28;  // floats per message, within MPI's int counts
+}
+
+void send_floats(MPI_Comm comm, const float* values, std::size_t count, int to) {
+  for (std::size_t at = 0; at < count; at += kChunk)
+    MPI_Send(values + at, static_cast<int>(std::min(kChunk, count - at)), MPI_FLOAT, to, 0, comm);
+}
+
+void receive_floats(MPI_Comm comm, float* values, std::size_t count, int from) {
+  for (std::size_t at = 0; at < count; at += kChunk)
+    MPI_Recv(values + at, static_cast<int>(std::min(kChunk, count - at)), MPI_FLOAT, from, 0, comm, MPI_STATUS_IGNORE);
+}
+
 MpiExchange::MpiExchange(MPI_Comm comm, std::array<int, 2> planes) : comm_(comm) {
   MPI_Comm_rank(comm, &rank_);
   MPI_Comm_size(comm, &ranks_);

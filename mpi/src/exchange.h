@@ -57,6 +57,10 @@ struct Duplicate {
   Duplicate& operator=(const Duplicate&) = delete;
 };
 
+// `count` floats in as many messages as MPI's int counts need (tag 0), and their receipt.
+void send_floats(MPI_Comm comm, const float* values, std::size_t count, int to);
+void receive_floats(MPI_Comm comm, float* values, std::size_t count, int from);
+
 // A face holds at most 2^31 - 1 floats per message (MPI's int counts); haze::Error past that.
 int message_count(std::size_t count, const char* what);
 

@@ -3,6 +3,7 @@
 #include <haze/mpi/render.h>
 
 #include <haze/core/error.h>
+#include <haze/core/method.h>
 #include <haze/core/stopwatch.h>
 #include <haze/grids/dom.h>
 #include <haze/mpi/dom.h>
@@ -13,8 +14,6 @@
 
 namespace haze::mpi {
 namespace {
-
-constexpr std::size_t kChunk = std::size_t{1} << 28;  // floats per message, within MPI's int counts
 
 // `part` grown by the plane below its first and the plane above its last, from the ranks that
 // solved them (the trilinear stencil of a step near the rank's faces reaches into them).
@@ -56,16 +55,6 @@ std::vector<float> pack(const std::vector<PixelLayers>& layers) {
   return out;
 }
 
-void send_floats(MPI_Comm comm, const std::vector<float>& v, int to) {
-  for (std::size_t at = 0; at < v.size(); at += kChunk)
-    MPI_Send(v.data() + at, static_cast<int>(std::min(kChunk, v.size() - at)), MPI_FLOAT, to, 0, comm);
-}
-
-void receive_floats(MPI_Comm comm, std::vector<float>& v, int from) {
-  for (std::size_t at = 0; at < v.size(); at += kChunk)
-    MPI_Recv(v.data() + at, static_cast<int>(std::min(kChunk, v.size() - at)), MPI_FLOAT, from, 0, comm, MPI_STATUS_IGNORE);
-}
-
 }  // namespace
 
 RenderResult render_dom(MPI_Comm caller, const Scene& scene, const View& view, const RenderOptions& options, int root) {
@@ -79,15 +68,10 @@ RenderResult render_dom(MPI_Comm caller, const Scene& scene, const View& view, c
     throw Error("surfaces", to_text(scene.surfaces.size()) + " surfaces",
                 "none with the DOM split over MPI ranks (it carries no light between the medium and surfaces yet: render on one process)");
   check_scene(scene);
-  // The scene's dom settings, then the caller's (as haze::prepare takes them).
   RenderOptions setup = options;
-  setup.settings = scene.method_name() == "dom" ? scene.method : nlohmann::json::object();
-  if (!options.settings.is_null() && !options.settings.is_object()) throw Error("settings", json_text(options.settings), "an object of dom settings");
-  for (const auto& [key, value] : options.settings.items()) setup.settings[key] = value;
-  setup.settings.erase("name");
+  setup.settings = method_settings(scene, "dom", options.settings);  // as haze::prepare takes them
+  grids::DomFields f = grids::dom_setup(scene, setup);  // its stats hold depth_seconds
   Stopwatch watch;
-  grids::DomFields f = grids::dom_setup(scene, setup);
-  const double depth_seconds = watch.lap();
   grids::DomSettings settings = f.settings;
   const ProgressCallback& progress = options.progress;
   if (progress) settings.progress = [&](double x) { return progress(0.8 * x); };
@@ -115,7 +99,7 @@ RenderResult render_dom(MPI_Comm caller, const Scene& scene, const View& view, c
   std::vector<double> all(mine.size() * static_cast<std::size_t>(ranks));
   MPI_Gather(mine.data(), static_cast<int>(mine.size()), MPI_DOUBLE, all.data(), static_cast<int>(mine.size()), MPI_DOUBLE, root, comm);
   if (rank != root) {
-    send_floats(comm, stretch, root);
+    send_floats(comm, stretch.data(), stretch.size(), root);
     return RenderResult{};
   }
 
@@ -130,7 +114,7 @@ RenderResult render_dom(MPI_Comm caller, const Scene& scene, const View& view, c
       up[static_cast<std::size_t>(y) * static_cast<std::size_t>(camera.width_px) + static_cast<std::size_t>(x)] = camera.pixel_ray(x, y).direction.z >= 0.0;
   std::vector<float> received(rank == root && ranks > 1 ? stretch.size() : 0);
   for (int r = 0; r < ranks; ++r) {
-    if (r != root) receive_floats(comm, received, r);
+    if (r != root) receive_floats(comm, received.data(), received.size(), r);
     const std::vector<float>& s = r == root ? stretch : received;
     for (std::size_t i = 0; i < pixels; ++i) {
       const Rgb light(s[6 * i], s[6 * i + 1], s[6 * i + 2]), through(s[6 * i + 3], s[6 * i + 4], s[6 * i + 5]);
@@ -158,7 +142,6 @@ RenderResult render_dom(MPI_Comm caller, const Scene& scene, const View& view, c
                        {"iterations", grown.iterations},
                        {"converged", grown.converged},
                        {"final_change", grown.changes.empty() ? 0.0 : grown.changes.back()},
-                       {"depth_seconds", depth_seconds},
                        {"rank_cells", column(0)},
                        {"rank_wait_seconds", column(1)},
                        {"rank_reduce_seconds", column(2)},

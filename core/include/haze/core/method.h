@@ -177,6 +177,9 @@ class Solution {
 // single-scattering method: nothing in view) are left out first (light_culling.h); the stats
 // list them under "culled_lights".
 Solution prepare(const Scene& scene, const std::string& method_name = "", RenderOptions options = {});
+// The settings method `method_name` takes: the scene's method block when it names that method,
+// then `given`'s keys over it ("name" dropped); haze::Error unless `given` is null or an object.
+nlohmann::json method_settings(const Scene& scene, const std::string& method_name, const nlohmann::json& given);
 
 // prepare() (with options.single_view) and render() of the scene's camera in a row; the stats hold
 // both steps' figures.
