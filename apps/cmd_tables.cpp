@@ -66,7 +66,7 @@ Command add_tables(CLI::App& app) {
   auto* sub = app.add_subcommand("tables", "Precompute the analytic method's tables (EXR) for scenes");
   auto a = std::make_shared<TablesArgs>();
   sub->add_option("scenes", a->scenes, "Scene files (default: the built-in scenes)")->check(CLI::ExistingFile);
-  sub->add_option("--out", a->out, "Directory for the tables (default: the cache, $HAZE_CACHE_DIR or ~/.cache/haze)");
+  sub->add_option("--out", a->out, "Directory for the tables (default: the cache, $HAZE_CACHE_DIR, else $XDG_CACHE_HOME/haze, else ~/.cache/haze)");
   sub->add_option("--examples", a->examples, "Directory of the built-in scenes")->capture_default_str();
   sub->add_option("--threads", a->threads, "Thread cap (0: all cores)")->check(CLI::NonNegativeNumber);
   return {sub, [a] { return run(*a); }};

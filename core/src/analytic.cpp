@@ -456,7 +456,7 @@ class AnalyticMethod final : public Method {
 MethodInfo analytic_info() {
   MethodInfo info;
   info.name = "analytic";
-  info.summary = "closed-form single scattering, homogeneous medium, point and spot lights (seed 002; no shadows)";
+  info.summary = "closed-form single scattering, homogeneous medium, point and spot lights (seed 002; the airlight unshadowed)";
   info.create = [] { return std::make_unique<AnalyticMethod>(); };
   info.handles = {"constant density (bounded or not)", "point, spot",
                   "planes, spheres and meshes lit by unscattered light and the airlight, with shadows (not of the airlight onto them)", false};
