@@ -1,5 +1,6 @@
 #include <haze/core/error.h>
 #include <haze/core/image.h>
+#include <haze/core/progress.h>
 
 #include <ImfChannelList.h>
 #include <ImfFrameBuffer.h>
@@ -45,11 +46,25 @@ void check_same_size(const Image& a, const Image& b, const char* what) {
                 "the size of the image, " + to_text(a.width()) + " x " + to_text(a.height()));
 }
 
+constexpr long long kMaxPixels = 1LL << 28;  // as Image's
+
+// The size of an open EXR's data window, checked before its pixels are allocated (naming
+// `field`): a header of a few bytes may claim any size, and missing pixels would read as zeros.
+void window_size(const Imf::InputFile& file, const std::string& field, std::size_t bytes_per_pixel, int& width, int& height) {
+  const auto window = file.header().dataWindow();  // OpenEXR keeps its corners within +-2^30
+  const long long w = static_cast<long long>(window.max.x) - window.min.x + 1, h = static_cast<long long>(window.max.y) - window.min.y + 1;
+  if (w <= 0 || h <= 0 || w * h > kMaxPixels)
+    throw Error(field, "a data window of " + to_text(w) + " x " + to_text(h) + " pixels", "at most 2^28 pixels");
+  check_memory(static_cast<std::size_t>(w * h) * bytes_per_pixel, 0, field, to_text(w) + " x " + to_text(h) + " pixels", "a smaller image");
+  if (!file.isComplete()) throw Error(field, "a file whose pixels are not all there", "a complete OpenEXR file");
+  width = static_cast<int>(w), height = static_cast<int>(h);
+}
+
 // One float channel of an open EXR, x fastest from its data window's corner; its size through
 // width and height.
-std::vector<float> read_channel(Imf::InputFile& file, const char* channel, int& width, int& height) {
+std::vector<float> read_channel(Imf::InputFile& file, const std::string& field, const char* channel, int& width, int& height) {
+  window_size(file, field, sizeof(float), width, height);
   const auto window = file.header().dataWindow();
-  width = window.max.x - window.min.x + 1, height = window.max.y - window.min.y + 1;
   std::vector<float> values(static_cast<size_t>(width) * static_cast<size_t>(height));
   Imf::FrameBuffer fb;
   char* base = reinterpret_cast<char*>(values.data()) -
@@ -96,9 +111,11 @@ Image read_exr(const std::filesystem::path& path, std::optional<Image>* std_erro
     for (const char* name : {"R", "G", "B"})
       if (!file.header().channels().findChannel(name))
         throw Error("exr input " + path.string(), "channels " + (channels.empty() ? std::string("(none)") : channels), "channels R, G and B");
-    auto window = file.header().dataWindow();
-    Image image(window.max.x - window.min.x + 1, window.max.y - window.min.y + 1);
-    bool has_error = file.header().channels().findChannel("stderr.R") != nullptr;
+    const bool has_error = file.header().channels().findChannel("stderr.R") != nullptr;
+    int width = 0, height = 0;
+    window_size(file, "exr input " + path.string(), (std_error && has_error ? 2 : 1) * 3 * sizeof(float), width, height);
+    const auto window = file.header().dataWindow();
+    Image image(width, height);
     if (std_error) *std_error = has_error ? std::optional<Image>(Image(image.width(), image.height())) : std::nullopt;
     Imf::FrameBuffer fb;
     insert_layer(fb, "", image);
@@ -124,7 +141,7 @@ std::vector<float> read_exr_depth(const std::filesystem::path& path, int& width,
     const char* channel = file.header().channels().findChannel("Z") ? "Z" : file.header().channels().findChannel("depth") ? "depth" : nullptr;
     if (!channel)
       throw Error("depth " + path.string(), "no channel Z or depth", "an EXR with a float channel Z (or depth): distances along each pixel's ray");
-    return read_channel(file, channel, width, height);
+    return read_channel(file, "depth " + path.string(), channel, width, height);
   } catch (const Error&) {
     throw;
   } catch (const std::exception& e) {
@@ -162,7 +179,7 @@ std::vector<float> read_exr_table(const std::filesystem::path& path, int& width,
       if (name.rfind("haze.", 0) != 0) continue;
       if (auto* a = dynamic_cast<const Imf::StringAttribute*>(&it.attribute())) attributes[name.substr(5)] = a->value();
     }
-    return read_channel(file, "T", width, height);
+    return read_channel(file, "exr table " + path.string(), "T", width, height);
   } catch (const Error&) {
     throw;
   } catch (const std::exception& e) {

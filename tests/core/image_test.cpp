@@ -10,8 +10,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-
+#include <cstdint>
 #include <fstream>
+#include <iterator>
 
 namespace haze {
 namespace {
@@ -84,6 +85,54 @@ TEST(Image, ExrLayersAndDepthChannel) {
   } catch (const Error& e) {
     EXPECT_NE(e.field().find(path.string()), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("no channel Z or depth"), std::string::npos) << e.what();
+  }
+  std::filesystem::remove(path);
+}
+
+// A header is checked before any pixel is allocated: a file of 256 KB may claim a data window of
+// 2^29 pixels (2 GB a channel), and one whose pixels are not all written would read as zeros.
+TEST(Image, ExrHeadersAreCheckedBeforeThePixels) {
+  const auto path = temp_path("claims.exr");
+  write_exr(path, Image(1, 1));
+  std::string bytes;
+  {
+    std::ifstream in(path, std::ios::binary);
+    bytes.assign(std::istreambuf_iterator<char>(in), {});
+  }
+  // dataWindow's value: int size 16, then min.x, min.y, max.x, max.y.
+  const std::string name("dataWindow\0box2i\0", 17);
+  const auto at = bytes.find(name);
+  ASSERT_NE(at, std::string::npos);
+  const std::int32_t max[2] = {(1 << 15) - 1, (1 << 14) - 1};
+  bytes.replace(at + name.size() + 4 + 8, 8, reinterpret_cast<const char*>(max), 8);
+  bytes.append(std::size_t{1} << 18, '\0');  // room for the line offsets OpenEXR reads first
+  std::ofstream(path, std::ios::binary | std::ios::trunc) << bytes;
+  try {
+    read_exr(path);
+    FAIL() << "read a header claiming 2^29 pixels";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.field(), "exr input " + path.string());
+    EXPECT_EQ(e.value(), "a data window of 32768 x 16384 pixels");
+    EXPECT_EQ(e.expected(), "at most 2^28 pixels");
+  }
+  {  // One line of two written: the other's offset stays zero.
+    Imf::Header header(3, 2);
+    header.compression() = Imf::NO_COMPRESSION;
+    header.channels().insert("Z", Imf::Channel(Imf::FLOAT));
+    const std::vector<float> z(6, 1.0f);
+    Imf::FrameBuffer fb;
+    fb.insert("Z", Imf::Slice(Imf::FLOAT, const_cast<char*>(reinterpret_cast<const char*>(z.data())), sizeof(float), 3 * sizeof(float)));
+    Imf::OutputFile out(path.string().c_str(), header);
+    out.setFrameBuffer(fb);
+    out.writePixels(1);
+  }
+  int w = 0, h = 0;
+  try {
+    read_exr_depth(path, w, h);
+    FAIL() << "read an EXR with a line missing";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.field(), "depth " + path.string());
+    EXPECT_EQ(e.value(), "a file whose pixels are not all there");
   }
   std::filesystem::remove(path);
 }
