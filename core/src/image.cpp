@@ -2,6 +2,8 @@
 #include <haze/core/image.h>
 #include <haze/core/progress.h>
 
+#include "exr_layout.h"
+
 #include <ImfChannelList.h>
 #include <ImfFrameBuffer.h>
 #include <ImfHeader.h>
@@ -104,6 +106,7 @@ void write_exr(const std::filesystem::path& path, const Image& image, const std:
 
 Image read_exr(const std::filesystem::path& path, std::optional<Image>* std_error) {
   try {
+    check_exr_layout(path, "exr input " + path.string());
     Imf::InputFile file(path.string().c_str());
     // Missing channels would read as zeros: an image of other channels (a 1-channel Y or Z) is refused.
     std::string channels;
@@ -137,6 +140,7 @@ Image read_exr(const std::filesystem::path& path, std::optional<Image>* std_erro
 
 std::vector<float> read_exr_depth(const std::filesystem::path& path, int& width, int& height) {
   try {
+    check_exr_layout(path, "depth " + path.string());
     Imf::InputFile file(path.string().c_str());
     const char* channel = file.header().channels().findChannel("Z") ? "Z" : file.header().channels().findChannel("depth") ? "depth" : nullptr;
     if (!channel)
@@ -171,6 +175,7 @@ void write_exr_table(const std::filesystem::path& path, int width, int height, c
 std::vector<float> read_exr_table(const std::filesystem::path& path, int& width, int& height,
                                   std::map<std::string, std::string>& attributes) {
   try {
+    check_exr_layout(path, "exr table " + path.string());
     Imf::InputFile file(path.string().c_str());
     if (!file.header().channels().findChannel("T")) throw Error("exr table " + path.string(), "no channel T", "a Haze table");
     attributes.clear();

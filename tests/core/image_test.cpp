@@ -13,6 +13,7 @@
 #include <cstdint>
 #include <fstream>
 #include <iterator>
+#include <map>
 
 namespace haze {
 namespace {
@@ -89,8 +90,8 @@ TEST(Image, ExrLayersAndDepthChannel) {
   std::filesystem::remove(path);
 }
 
-// A header is checked before any pixel is allocated: a file of 256 KB may claim a data window of
-// 2^29 pixels (2 GB a channel), and one whose pixels are not all written would read as zeros.
+// A header is checked before anything it claims is allocated: a file of 256 KB may claim a data
+// window of 2^29 pixels (2 GB a channel), and one whose pixels are not all written would read as zeros.
 TEST(Image, ExrHeadersAreCheckedBeforeThePixels) {
   const auto path = temp_path("claims.exr");
   write_exr(path, Image(1, 1));
@@ -115,6 +116,44 @@ TEST(Image, ExrHeadersAreCheckedBeforeThePixels) {
     EXPECT_EQ(e.value(), "a data window of 32768 x 16384 pixels");
     EXPECT_EQ(e.expected(), "at most 2^28 pixels");
   }
+  // Before OpenEXR reads a header: an attribute claiming 1.2 GB (OpenEXR would fill a string that
+  // long), and a window of more chunks than the file has bytes for their offsets.
+  write_exr_table(path, 1, 1, {0.5f}, {{"key", "abc"}});
+  {
+    std::ifstream in(path, std::ios::binary);
+    bytes.assign(std::istreambuf_iterator<char>(in), {});
+  }
+  const std::string key("haze.key\0string\0", 16);
+  const auto key_at = bytes.find(key);
+  ASSERT_NE(key_at, std::string::npos);
+  const std::int32_t claim = 0x4a000019;
+  bytes.replace(key_at + key.size(), 4, reinterpret_cast<const char*>(&claim), 4);
+  std::ofstream(path, std::ios::binary | std::ios::trunc) << bytes;
+  int w = 0, h = 0;
+  std::map<std::string, std::string> attributes;
+  try {
+    read_exr_table(path, w, h, attributes);
+    FAIL() << "read a header claiming a 1.2 GB attribute";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.field(), "exr table " + path.string());
+    EXPECT_EQ(e.value().rfind("an attribute 'haze.key' of 1241514009 bytes with ", 0), 0u) << e.value();
+  }
+  write_exr(path, Image(1, 1));
+  {
+    std::ifstream in(path, std::ios::binary);
+    bytes.assign(std::istreambuf_iterator<char>(in), {});
+  }
+  const std::int32_t tall[2] = {0, (1 << 30) - 1};
+  bytes.replace(bytes.find(name) + name.size() + 4 + 8, 8, reinterpret_cast<const char*>(tall), 8);
+  std::ofstream(path, std::ios::binary | std::ios::trunc) << bytes;
+  try {
+    read_exr_depth(path, w, h);
+    FAIL() << "read a header claiming 2^30 lines";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.field(), "depth " + path.string());
+    EXPECT_NE(e.value().find("a data window of 1 x 1073741824 pixels in 1 x "), std::string::npos) << e.value();
+    EXPECT_EQ(e.expected(), "a file that holds its chunks' offsets (8 bytes each)");
+  }
   {  // One line of two written: the other's offset stays zero.
     Imf::Header header(3, 2);
     header.compression() = Imf::NO_COMPRESSION;
@@ -126,7 +165,6 @@ TEST(Image, ExrHeadersAreCheckedBeforeThePixels) {
     out.setFrameBuffer(fb);
     out.writePixels(1);
   }
-  int w = 0, h = 0;
   try {
     read_exr_depth(path, w, h);
     FAIL() << "read an EXR with a line missing";
