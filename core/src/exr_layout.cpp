@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <fstream>
+#include <map>
 
 namespace haze {
 
@@ -50,6 +51,49 @@ long long lines_per_chunk(int compression) {
   }
 }
 
+// Bytes that OpenEXR 3.1 reads for a value of a fixed-size type, whatever size the header states
+// (ImfStandardAttributes.h's types); 0 for others.
+int fixed_size(const std::string& type) {
+  static const std::map<std::string, int> sizes = {
+      {"box2i", 16}, {"box2f", 16}, {"chromaticities", 32}, {"compression", 1}, {"deepImageState", 1}, {"double", 8},
+      {"envmap", 1}, {"float", 4}, {"int", 4}, {"keycode", 28}, {"lineOrder", 1}, {"m33f", 36}, {"m33d", 72},
+      {"m44f", 64}, {"m44d", 128}, {"rational", 8}, {"tiledesc", 9}, {"timecode", 8}, {"v2i", 8}, {"v2f", 8},
+      {"v2d", 16}, {"v3i", 12}, {"v3f", 12}, {"v3d", 24}};
+  const auto it = sizes.find(type);
+  return it == sizes.end() ? 0 : it->second;
+}
+
+// The value of an attribute of `size` bytes, read as OpenEXR reads it (which follows a value's
+// own counts, not `size`, for channel lists, previews and string vectors): it must end where
+// `size` says, so that the walk and OpenEXR stay in step.
+void skip_value(Reader& r, const std::string& name, const std::string& type, std::int32_t size) {
+  const std::uint64_t start = r.at(), end = start + static_cast<std::uint64_t>(size);
+  const auto wrong = [&](const std::string& what) {
+    throw Error(r.field, "an attribute '" + name + "' of type " + type + " whose value " + what,
+                "a value laid out as its type's, " + to_text(size) + " bytes as its header says");
+  };
+  if (const int fixed = fixed_size(type)) {
+    if (size != fixed) wrong("is stated as " + to_text(size) + " bytes where the type has " + to_text(fixed));
+  } else if (type == "chlist") {  // name\0 then 16 bytes a channel, ended by an empty name
+    while (!r.text("channel name").empty()) {
+      r.in.seekg(16, std::ios::cur);
+      if (r.at() > end) wrong("runs past its stated size");
+    }
+    if (r.at() != end) wrong("ends before its stated size");
+  } else if (type == "preview") {  // width, height, then 4 bytes a pixel
+    const auto width = static_cast<std::uint32_t>(r.int32()), height = static_cast<std::uint32_t>(r.int32());
+    if (size < 8 || size % 4 != 0 || static_cast<std::uint64_t>(width) * height != static_cast<std::uint64_t>(size - 8) / 4)
+      wrong("holds a " + to_text(width) + " x " + to_text(height) + " preview in " + to_text(size) + " bytes");
+  } else if (type == "stringvector") {  // length, then the string, each
+    while (r.at() < end) {
+      const std::int32_t length = r.int32();
+      if (length < 0 || r.at() + static_cast<std::uint64_t>(length) > end) wrong("holds a string of " + to_text(length) + " bytes past its stated size");
+      r.in.seekg(length, std::ios::cur);
+    }
+  }
+  r.in.seekg(static_cast<std::streamoff>(end));
+}
+
 // One header: its attributes within the file, and its offset table's size within the file.
 // Returns false for the empty header that ends a multi-part file's list.
 bool check_header(Reader& r, bool first) {
@@ -79,7 +123,7 @@ bool check_header(Reader& r, bool first) {
       r.in.ignore(1);
       tiled = true;
     } else {
-      r.in.seekg(size, std::ios::cur);
+      skip_value(r, name, type, size);
     }
   }
   if (!has_window) return true;  // OpenEXR refuses a header without one

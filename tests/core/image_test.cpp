@@ -11,6 +11,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <fstream>
 #include <iterator>
 #include <map>
@@ -153,6 +154,27 @@ TEST(Image, ExrHeadersAreCheckedBeforeThePixels) {
     EXPECT_EQ(e.field(), "depth " + path.string());
     EXPECT_NE(e.value().find("a data window of 1 x 1073741824 pixels in 1 x "), std::string::npos) << e.value();
     EXPECT_EQ(e.expected(), "a file that holds its chunks' offsets (8 bytes each)");
+  }
+  // A channel list stated 4 bytes longer than its entries: OpenEXR reads the entries and goes on
+  // from their end, so the walk must not trust the stated size (fuzz_exr's second finding hid a
+  // 1 GB string attribute that way).
+  write_exr(path, Image(1, 1));
+  {
+    std::ifstream in(path, std::ios::binary);
+    bytes.assign(std::istreambuf_iterator<char>(in), {});
+  }
+  const std::string channels("channels\0chlist\0", 16);
+  const auto size_at = bytes.find(channels) + channels.size();
+  std::int32_t stated;
+  std::memcpy(&stated, bytes.data() + size_at, 4);
+  stated += 4;
+  bytes.replace(size_at, 4, reinterpret_cast<const char*>(&stated), 4);
+  std::ofstream(path, std::ios::binary | std::ios::trunc) << bytes;
+  try {
+    read_exr(path);
+    FAIL() << "read a channel list shorter than stated";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.value(), "an attribute 'channels' of type chlist whose value ends before its stated size") << e.what();
   }
   {  // One line of two written: the other's offset stays zero.
     Imf::Header header(3, 2);
