@@ -105,18 +105,19 @@ void write_exr(const std::filesystem::path& path, const Image& image, const std:
 }
 
 Image read_exr(const std::filesystem::path& path, std::optional<Image>* std_error) {
+  const std::string field = "exr input " + path.string();
   try {
-    check_exr_layout(path, "exr input " + path.string());
+    check_exr_layout(path, field);
     Imf::InputFile file(path.string().c_str());
     // Missing channels would read as zeros: an image of other channels (a 1-channel Y or Z) is refused.
     std::string channels;
     for (auto c = file.header().channels().begin(); c != file.header().channels().end(); ++c) channels += (channels.empty() ? "" : ", ") + std::string(c.name());
     for (const char* name : {"R", "G", "B"})
       if (!file.header().channels().findChannel(name))
-        throw Error("exr input " + path.string(), "channels " + (channels.empty() ? std::string("(none)") : channels), "channels R, G and B");
+        throw Error(field, "channels " + (channels.empty() ? std::string("(none)") : channels), "channels R, G and B");
     const bool has_error = file.header().channels().findChannel("stderr.R") != nullptr;
     int width = 0, height = 0;
-    window_size(file, "exr input " + path.string(), (std_error && has_error ? 2 : 1) * 3 * sizeof(float), width, height);
+    window_size(file, field, (std_error && has_error ? 2 : 1) * 3 * sizeof(float), width, height);
     const auto window = file.header().dataWindow();
     Image image(width, height);
     if (std_error) *std_error = has_error ? std::optional<Image>(Image(image.width(), image.height())) : std::nullopt;
@@ -134,22 +135,23 @@ Image read_exr(const std::filesystem::path& path, std::optional<Image>* std_erro
   } catch (const Error&) {
     throw;
   } catch (const std::exception& e) {
-    throw Error("exr input " + path.string(), e.what(), "a readable OpenEXR file");
+    throw Error(field, e.what(), "a readable OpenEXR file");
   }
 }
 
 std::vector<float> read_exr_depth(const std::filesystem::path& path, int& width, int& height) {
+  const std::string field = "depth " + path.string();
   try {
-    check_exr_layout(path, "depth " + path.string());
+    check_exr_layout(path, field);
     Imf::InputFile file(path.string().c_str());
     const char* channel = file.header().channels().findChannel("Z") ? "Z" : file.header().channels().findChannel("depth") ? "depth" : nullptr;
     if (!channel)
-      throw Error("depth " + path.string(), "no channel Z or depth", "an EXR with a float channel Z (or depth): distances along each pixel's ray");
-    return read_channel(file, "depth " + path.string(), channel, width, height);
+      throw Error(field, "no channel Z or depth", "an EXR with a float channel Z (or depth): distances along each pixel's ray");
+    return read_channel(file, field, channel, width, height);
   } catch (const Error&) {
     throw;
   } catch (const std::exception& e) {
-    throw Error("depth " + path.string(), e.what(), "a readable OpenEXR file");
+    throw Error(field, e.what(), "a readable OpenEXR file");
   }
 }
 
@@ -174,21 +176,22 @@ void write_exr_table(const std::filesystem::path& path, int width, int height, c
 
 std::vector<float> read_exr_table(const std::filesystem::path& path, int& width, int& height,
                                   std::map<std::string, std::string>& attributes) {
+  const std::string field = "exr table " + path.string();
   try {
-    check_exr_layout(path, "exr table " + path.string());
+    check_exr_layout(path, field);
     Imf::InputFile file(path.string().c_str());
-    if (!file.header().channels().findChannel("T")) throw Error("exr table " + path.string(), "no channel T", "a Haze table");
+    if (!file.header().channels().findChannel("T")) throw Error(field, "no channel T", "a Haze table");
     attributes.clear();
     for (auto it = file.header().begin(); it != file.header().end(); ++it) {
       std::string name = it.name();
       if (name.rfind("haze.", 0) != 0) continue;
       if (auto* a = dynamic_cast<const Imf::StringAttribute*>(&it.attribute())) attributes[name.substr(5)] = a->value();
     }
-    return read_channel(file, "exr table " + path.string(), "T", width, height);
+    return read_channel(file, field, "T", width, height);
   } catch (const Error&) {
     throw;
   } catch (const std::exception& e) {
-    throw Error("exr table " + path.string(), e.what(), "a readable OpenEXR table");
+    throw Error(field, e.what(), "a readable OpenEXR table");
   }
 }
 

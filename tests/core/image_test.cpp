@@ -23,6 +23,11 @@ std::filesystem::path temp_path(const std::string& name) {
   return std::filesystem::temp_directory_path() / ("haze_image_test_" + std::to_string(::getpid()) + "_" + name);
 }
 
+std::string file_bytes(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
 TEST(Image, ExrRoundTripKeepsLinearFloats) {
   Image img(5, 3), err(5, 3);
   for (int y = 0; y < 3; ++y)
@@ -96,11 +101,7 @@ TEST(Image, ExrLayersAndDepthChannel) {
 TEST(Image, ExrHeadersAreCheckedBeforeThePixels) {
   const auto path = temp_path("claims.exr");
   write_exr(path, Image(1, 1));
-  std::string bytes;
-  {
-    std::ifstream in(path, std::ios::binary);
-    bytes.assign(std::istreambuf_iterator<char>(in), {});
-  }
+  std::string bytes = file_bytes(path);
   // dataWindow's value: int size 16, then min.x, min.y, max.x, max.y.
   const std::string name("dataWindow\0box2i\0", 17);
   const auto at = bytes.find(name);
@@ -120,10 +121,7 @@ TEST(Image, ExrHeadersAreCheckedBeforeThePixels) {
   // Before OpenEXR reads a header: an attribute claiming 1.2 GB (OpenEXR would fill a string that
   // long), and a window of more chunks than the file has bytes for their offsets.
   write_exr_table(path, 1, 1, {0.5f}, {{"key", "abc"}});
-  {
-    std::ifstream in(path, std::ios::binary);
-    bytes.assign(std::istreambuf_iterator<char>(in), {});
-  }
+  bytes = file_bytes(path);
   const std::string key("haze.key\0string\0", 16);
   const auto key_at = bytes.find(key);
   ASSERT_NE(key_at, std::string::npos);
@@ -140,10 +138,7 @@ TEST(Image, ExrHeadersAreCheckedBeforeThePixels) {
     EXPECT_EQ(e.value().rfind("an attribute 'haze.key' of 1241514009 bytes with ", 0), 0u) << e.value();
   }
   write_exr(path, Image(1, 1));
-  {
-    std::ifstream in(path, std::ios::binary);
-    bytes.assign(std::istreambuf_iterator<char>(in), {});
-  }
+  bytes = file_bytes(path);
   const std::int32_t tall[2] = {0, (1 << 30) - 1};
   bytes.replace(bytes.find(name) + name.size() + 4 + 8, 8, reinterpret_cast<const char*>(tall), 8);
   std::ofstream(path, std::ios::binary | std::ios::trunc) << bytes;
@@ -159,10 +154,7 @@ TEST(Image, ExrHeadersAreCheckedBeforeThePixels) {
   // from their end, so the walk must not trust the stated size (fuzz_exr's second finding hid a
   // 1 GB string attribute that way).
   write_exr(path, Image(1, 1));
-  {
-    std::ifstream in(path, std::ios::binary);
-    bytes.assign(std::istreambuf_iterator<char>(in), {});
-  }
+  bytes = file_bytes(path);
   const std::string channels("channels\0chlist\0", 16);
   const auto size_at = bytes.find(channels) + channels.size();
   std::int32_t stated;
