@@ -31,10 +31,11 @@ nlohmann::json to_json(const py::handle& object) {
 }
 py::object to_python(const nlohmann::json& j) { return py::module_::import("json").attr("loads")(j.dump()); }
 
-// A scene and the numpy arrays it views (kept alive with it and every solution made from it).
+// A scene and the numpy array its grid density views (None when it views none): held while the
+// scene views it, dropped when set_density or set_particles replaces the density.
 struct PyScene {
   Scene scene;
-  std::vector<py::object> keep;
+  py::object density;
 };
 
 // (height, width, 3) float32, rows top to bottom.
@@ -123,9 +124,12 @@ MediumDesc particles_from(const std::optional<MediumDesc>& current, const Floats
   return medium;
 }
 
+// A solution and the numpy array its scene's grid density views: the scene's at prepare, then the
+// last update's (an update with particles views none). Methods that sample the density into a grid
+// of their own still keep the solution's scene, which views it (a rebuild reads it again).
 struct PySolution {
   std::unique_ptr<Solution> solution;
-  std::vector<py::object> keep;
+  py::object density;
 };
 
 }  // namespace
@@ -177,7 +181,7 @@ PYBIND11_MODULE(haze, m) {
             if (bounds) medium.bounds = {Vec3((*bounds)[0][0], (*bounds)[0][1], (*bounds)[0][2]), Vec3((*bounds)[1][0], (*bounds)[1][1], (*bounds)[1][2])};
             check_medium(medium);
             s.scene.medium = medium;
-            s.keep.push_back(kept);
+            s.density = kept;  // the array viewed before is no longer held
           },
           py::arg("density"), py::arg("bounds") = std::nullopt,
           "The medium's density from a (nz, ny, nx) array over its bounds: viewed in place when float32 and C-contiguous")
@@ -185,6 +189,7 @@ PYBIND11_MODULE(haze, m) {
           "set_particles",
           [](PyScene& s, const Floats& positions, const std::optional<Floats>& density, const std::optional<Floats>& diameter) {
             s.scene.medium = particles_from(s.scene.medium, positions, density, diameter);
+            s.density = py::none();  // particles are copied
           },
           py::arg("positions"), py::arg("density") = std::nullopt, py::arg("diameter") = std::nullopt,
           "The particles of the scene's particles block from arrays: positions (n, 3), density and diameter (n,) (copied)")
@@ -223,7 +228,7 @@ PYBIND11_MODULE(haze, m) {
               py::gil_scoped_release release;
               report = s.solution->update(change, options_from(py::none(), threads, progress));
             }
-            if (density) s.keep.push_back(kept);
+            if (change.medium) s.density = kept;  // the new array (None for particles) replaces the one viewed before
             py::dict d;
             d["rebuilt"] = report.rebuilt;
             d["redone"] = report.redone;
@@ -260,7 +265,7 @@ PYBIND11_MODULE(haze, m) {
           py::gil_scoped_release release;
           solution->solution = std::make_unique<Solution>(prepare(scene->scene, method, options));
         }
-        solution->keep = scene->keep;
+        solution->density = scene->density;
         return solution;
       },
       py::arg("scene"), py::arg("method") = "", py::arg("settings") = py::none(), py::arg("threads") = 0, py::arg("progress") = std::nullopt,

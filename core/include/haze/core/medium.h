@@ -36,7 +36,9 @@ struct RbfDensity {
 
 // Cell-centred samples over the medium's bounds, x fastest, then y, then z; trilinear in between.
 // The samples are the grid's own (`values`) or a view of the caller's memory (`view`, used when
-// set): a view is never copied, so it must outlive every medium and solution made from it.
+// set): a view is never copied, so it must outlive every medium made from it and every Solution
+// whose scene holds it, which is until an update hands that solution a new medium (the grid
+// methods sample it into their own grids at prepare and update; the others read it as they render).
 struct GridDensity {
   std::array<int, 3> resolution{1, 1, 1};
   std::vector<float> values;
