@@ -3,7 +3,7 @@
 // each took.
 #include "commands.h"
 
-#include <haze/core/airlight.h>
+#include <haze/analytic/airlight.h>
 #include <haze/core/stopwatch.h>
 #include <haze/core/error.h>
 
@@ -11,6 +11,9 @@
 #include <set>
 
 namespace haze::app {
+
+using analytic::AirlightTable;
+using analytic::SurfaceAirlightTable;
 
 namespace {
 

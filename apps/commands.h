@@ -45,7 +45,4 @@ RenderResult render_gl(const Scene& scene, const std::string& method, const Rend
 // a directory or holds none.
 std::vector<std::filesystem::path> scene_files(const std::string& directory, const std::string& option);
 
-// Registers every module's methods with core's registry (core's own are always there).
-void register_all_methods();
-
 }  // namespace haze::app

@@ -2,6 +2,7 @@
 #include "commands.h"
 #include "mpi_world.h"
 
+#include <haze/all.h>
 #include <haze/core/error.h>
 
 #include <iostream>
@@ -23,7 +24,7 @@ int main(int argc, char** argv) {
   CLI::App app{"Haze: light transport in participating media (fog, haze, smoke, clouds)"};
   app.require_subcommand(1);
   app.set_version_flag("--version", std::string("haze ") + HAZE_VERSION);
-  haze::app::register_all_methods();  // before the commands: their help lists the methods
+  haze::register_all();  // before the commands: their help lists the methods
   const haze::app::Command commands[] = {haze::app::add_info(app), haze::app::add_phase(app),
                                           haze::app::add_render(app), haze::app::add_demo(app),
                                           haze::app::add_compare(app), haze::app::add_tables(app),

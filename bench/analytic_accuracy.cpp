@@ -2,7 +2,7 @@
 // of Legendre orders (docs/ANALYTIC.md). Writes CSV and markdown to the directory given (default
 // .); scripts/plot-analytic turns the CSV into docs/analytic_error.png.
 // Run: build/release/bench/haze_analytic_accuracy OUT_DIR
-#include <haze/core/airlight.h>
+#include <haze/analytic/airlight.h>
 #include <haze/core/stopwatch.h>
 #include <haze/core/rng.h>
 
@@ -15,6 +15,7 @@
 namespace {
 
 using namespace haze;
+using namespace haze::analytic;
 
 struct Errors {
   double worst, median, rms;

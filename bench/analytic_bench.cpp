@@ -4,7 +4,8 @@
 #include <haze/core/camera.h>
 #include <haze/core/method.h>
 #include <haze/core/progress.h>
-#include <haze/simd/airlight_batch.h>
+#include <haze/all.h>
+#include <haze/analytic/airlight_batch.h>
 #include <haze/simd/phase_batch.h>
 
 #include <benchmark/benchmark.h>
@@ -14,6 +15,7 @@
 namespace {
 
 using namespace haze;
+using namespace haze::analytic;
 
 struct Frame {
   int width = 1920, height = 1080;
@@ -57,9 +59,9 @@ void BM_AirlightFrame(benchmark::State& state) {
                                f.dy.data() + begin, f.dz.data() + begin, f.length.data() + begin, n};
       for (const auto& light : lights) {
         if constexpr (kSimd) {
-          simd::add_airlight(table, light, batch, out.data() + begin);
+          add_airlight(table, light, batch, out.data() + begin);
         } else {
-          simd::add_airlight_reference(table, light, batch, out.data() + begin);
+          add_airlight_reference(table, light, batch, out.data() + begin);
         }
       }
     });
@@ -75,7 +77,7 @@ BENCHMARK(BM_AirlightFrame<false>)->Name("analytic/airlight_1080p_4_lights/scala
 // The issue's frame: 1920 x 1080, 4 point lights, airlight plus Lambert and Phong surface radiance
 // with dynamic g changing every frame (0.58 and 0.62 in turn), one method object kept across
 // frames (its Legendre tables stay in memory; they come from a disk cache built before timing).
-// Arg 1: the Highway airlight (simd::install); arg 0: core's float64 airlight loop.
+// Arg 1: the Highway airlight (setting kernel "simd"); arg 0: the float64 airlight loop ("float64").
 Scene frame_scene() {
   Scene scene;
   scene.camera.position = Vec3(0, 1.5, 6);
@@ -97,13 +99,9 @@ void BM_AnalyticFrame(benchmark::State& state) {
   Scene scene = frame_scene();
   RenderOptions options;
   options.threads = static_cast<int>(state.range(1));
-  options.settings = {{"dynamic_g_tolerance", 1e-2}};
+  options.settings = {{"dynamic_g_tolerance", 1e-2}, {"kernel", state.range(0) ? "simd" : "float64"}};
   options.cache_dir = std::filesystem::temp_directory_path() / "haze_bench_analytic_cache";
-  if (state.range(0)) {
-    simd::install();
-  } else {
-    set_airlight_batch_function(nullptr);
-  }
+  register_all();
   Solution solution = prepare(scene, "analytic", options);  // fills the cache and the method's tables
   int frame = 0;
   for (auto _ : state) {
@@ -111,7 +109,6 @@ void BM_AnalyticFrame(benchmark::State& state) {
     solution.update({.medium = scene.medium});
     benchmark::DoNotOptimize(solution.render().radiance.data().data());
   }
-  set_airlight_batch_function(nullptr);
   state.SetLabel(state.range(0) ? "simd airlight" : "float64 airlight");
 }
 BENCHMARK(BM_AnalyticFrame)->Name("analytic/frame_1080p_4_lights_dynamic_g/simd,threads")->Args({1, 2})->Args({0, 2})->UseRealTime()->Unit(benchmark::kMillisecond);
@@ -119,6 +116,7 @@ BENCHMARK(BM_AnalyticFrame)->Name("analytic/frame_1080p_4_lights_dynamic_g/simd,
 // Every table the frame needs, built from scratch (no cache, a fresh method object): the dynamic-g
 // airlight orders and the per-order J1 and J_24 tables. The issue's budget is 2 s.
 void BM_FrameTables(benchmark::State& state) {
+  register_all();
   Scene scene = frame_scene();
   scene.camera.width_px = 4, scene.camera.height_px = 4;
   RenderOptions options;

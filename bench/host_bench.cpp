@@ -5,8 +5,7 @@
 // Media: homogeneous fog (analytic, SIMD airlight) and a 128^3 heterogeneous cloud (propagation).
 #include <haze/core/froxels.h>
 #include <haze/core/rng.h>
-#include <haze/grids/methods.h>
-#include <haze/simd/airlight_batch.h>
+#include <haze/all.h>
 
 #include <benchmark/benchmark.h>
 
@@ -77,8 +76,7 @@ std::vector<float> floor_depth(const Camera& camera) {
 void BM_HostFrame(benchmark::State& state) {
   const bool cloud = state.range(0) != 0;
   const int stage = static_cast<int>(state.range(1));
-  simd::install();
-  grids::register_methods();
+  register_all();
   const Scene scene = host_scene(cloud);
   RenderOptions options;
   options.threads = 2;

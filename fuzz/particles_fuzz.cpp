@@ -3,10 +3,10 @@
 #include "fuzz_input.h"
 
 #include <haze/core/scene.h>
-#include <haze/particles/methods.h>
+#include <haze/all.h>
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-  static const bool registered = (haze::particles::register_methods(), true);
+  static const bool registered = (haze::register_all(), true);
   (void)registered;
   haze::fuzz::write("particles.csv", data, size);
   const auto scene = nlohmann::json::parse(R"({"camera": {"position": [0, 0, 4], "look_at": [0, 0, 0]},

@@ -3,11 +3,10 @@
 #include "fuzz_input.h"
 
 #include <haze/core/scene.h>
-#include <haze/particles/methods.h>
-#include <haze/vdb/vdb.h>
+#include <haze/all.h>
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-  static const bool registered = (haze::particles::register_methods(), haze::vdb::register_readers(), true);
+  static const bool registered = (haze::register_all(), true);
   (void)registered;
   const auto path = haze::fuzz::write("scene.json", data, size);
   haze::fuzz::refused_or_fine([&] { haze::check_scene(haze::Scene::load(path)); });

@@ -4,12 +4,12 @@
 
 #include <haze/core/medium.h>
 #include <haze/core/scene.h>
-#include <haze/vdb/vdb.h>
+#include <haze/all.h>
 
 #include <cstring>
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-  static const bool registered = (haze::vdb::register_readers(), true);
+  static const bool registered = (haze::register_all(), true);
   (void)registered;
   // NanoVDB files by their magic number ("NanoVDB0"), the rest as OpenVDB files.
   const bool nano = size >= 8 && std::memcmp(data, "NanoVDB0", 8) == 0;

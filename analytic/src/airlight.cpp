@@ -1,18 +1,17 @@
-#include <haze/core/airlight.h>
+#include <haze/analytic/airlight.h>
 #include <haze/core/error.h>
 #include <haze/core/integrate.h>
 #include <haze/core/image.h>
 #include <haze/core/light.h>
 
 #include <algorithm>
-#include <atomic>
 #include <cstdio>
 #include <map>
 #include <optional>
 #include <thread>
 #include <unordered_map>
 
-namespace haze {
+namespace haze::analytic {
 
 namespace {
 
@@ -206,16 +205,6 @@ void add_airlight_float64(const AirlightTable& table, const AirlightChannel& lig
         table.eval(medium, AirlightSegment::from_points(origin, glm::normalize(dir), Vec3(light.x, light.y, light.z), length)));
   }
 }
-
-namespace {
-std::atomic<AirlightBatchFunction> batch_function{add_airlight_float64};
-}  // namespace
-
-void set_airlight_batch_function(AirlightBatchFunction function) {
-  batch_function.store(function ? function : add_airlight_float64);
-}
-
-AirlightBatchFunction airlight_batch_function() { return batch_function.load(); }
 
 LegendreAirlightTables::LegendreAirlightTables(int terms, int a_samples, int eta_samples, int threads)
     : terms_(terms), na_(a_samples), neta_(eta_samples) {
@@ -647,4 +636,4 @@ double SurfaceAirlightTable::eval(double optical_depth, double angle) const {
   return v / (1.0 + optical_depth);
 }
 
-}  // namespace haze
+}  // namespace haze::analytic

@@ -1,16 +1,16 @@
 // Per-target airlight kernel (Highway: included once per target by foreach_target.h).
-#if defined(HAZE_SIMD_AIRLIGHT_BATCH_INL_H_) == defined(HWY_TARGET_TOGGLE)
-#ifdef HAZE_SIMD_AIRLIGHT_BATCH_INL_H_
-#undef HAZE_SIMD_AIRLIGHT_BATCH_INL_H_
+#if defined(HAZE_ANALYTIC_AIRLIGHT_BATCH_INL_H_) == defined(HWY_TARGET_TOGGLE)
+#ifdef HAZE_ANALYTIC_AIRLIGHT_BATCH_INL_H_
+#undef HAZE_ANALYTIC_AIRLIGHT_BATCH_INL_H_
 #else
-#define HAZE_SIMD_AIRLIGHT_BATCH_INL_H_
+#define HAZE_ANALYTIC_AIRLIGHT_BATCH_INL_H_
 #endif
 
 #include <hwy/contrib/math/math-inl.h>
 #include <hwy/highway.h>
 
 HWY_BEFORE_NAMESPACE();
-namespace haze::simd::HWY_NAMESPACE {
+namespace haze::analytic::HWY_NAMESPACE {
 namespace hn = hwy::HWY_NAMESPACE;
 
 // log T(u, eta) for T = K (1 + w)(1 + a) / 2, bilinear in the fine log table
@@ -80,7 +80,7 @@ HWY_NOINLINE size_t AirlightBatch(const float* HWY_RESTRICT table, int na, int n
   return i;
 }
 
-}  // namespace haze::simd::HWY_NAMESPACE
+}  // namespace haze::analytic::HWY_NAMESPACE
 HWY_AFTER_NAMESPACE();
 
-#endif  // HAZE_SIMD_AIRLIGHT_BATCH_INL_H_
+#endif  // HAZE_ANALYTIC_AIRLIGHT_BATCH_INL_H_

@@ -8,13 +8,13 @@
 #include <hwy/highway.h>
 
 #if HWY_ONCE
-#include <haze/simd/airlight_batch.h>
+#include <haze/analytic/airlight_batch.h>
 
 #include <algorithm>
 #include <cmath>
 #include <vector>
 
-namespace haze::simd {
+namespace haze::analytic {
 
 HWY_EXPORT(AirlightBatch);
 
@@ -88,7 +88,5 @@ void add_airlight(const AirlightTable& table, const AirlightChannel& light, cons
   }
 }
 
-void install() { set_airlight_batch_function(&add_airlight); }
-
-}  // namespace haze::simd
+}  // namespace haze::analytic
 #endif  // HWY_ONCE

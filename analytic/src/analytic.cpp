@@ -5,10 +5,12 @@
 // it (eq. 4.11-4.15, tables J1 and J_n). Surfaces shadow the view segments (each light's airlight is
 // summed over the stretches it lights, core's lit_stretches) and each other's direct light; the
 // airlight onto a surface is not shadowed. Like the thesis' model it has no multiple scattering.
-#include "builtin_methods.h"
-
-#include <haze/core/airlight.h>
+#include <haze/analytic/airlight.h>
+#include <haze/analytic/airlight_batch.h>
+#include <haze/analytic/methods.h>
+#include <haze/core/features.h>
 #include <haze/core/error.h>
+#include <haze/core/method.h>
 #include <haze/core/stopwatch.h>
 
 #include <array>
@@ -17,9 +19,12 @@
 #include <mutex>
 #include <optional>
 
-namespace haze::internal {
+namespace haze::analytic {
 
 namespace {
+
+// out[i] += airlight of segment i: add_airlight (SIMD, float32) or add_airlight_float64.
+using AirlightKernel = void (*)(const AirlightTable& table, const AirlightChannel& light, const SegmentBatch& batch, float* out);
 
 // Point lights use the airlight table; spot lights integrate the stretches inside their cone.
 struct AnalyticLight {
@@ -82,7 +87,7 @@ struct SurfaceShading {
 class AnalyticSolution final : public MethodSolution {
  public:
   AnalyticSolution(const Scene& scene, std::vector<AnalyticLight> lights, std::unique_ptr<Medium> medium, const Rgb& sigma_t,
-                   const Rgb& sigma_s, bool grey, bool airlight, bool surface_airlight, AirlightTable table,
+                   const Rgb& sigma_s, bool grey, bool airlight, bool surface_airlight, AirlightKernel kernel, AirlightTable table,
                    std::optional<SurfaceAirlightTable> lambert, std::map<double, SurfaceAirlightTable> phong)
       : scene_(scene),
         lights_(std::move(lights)),
@@ -92,6 +97,7 @@ class AnalyticSolution final : public MethodSolution {
         grey_(grey),
         airlight_(airlight),
         surface_airlight_(surface_airlight),
+        kernel_(kernel),
         table_(std::move(table)),
         lambert_(std::move(lambert)),
         phong_(std::move(phong)) {}
@@ -102,11 +108,11 @@ class AnalyticSolution final : public MethodSolution {
     const Stopwatch watch;
     RenderResult result = RenderResult::for_view(view);
     ProgressTracker progress(options.progress, camera.height_px);
-    const AirlightBatchFunction add_airlight = airlight_batch_function();
+    const AirlightKernel add_airlight = kernel_;
     const SurfaceShading shade{*medium_, scene_.surfaces, lights_, sigma_t_, sigma_s_, grey_, surface_airlight_, lambert_, phong_};
     parallel_for(camera.height_px, options.threads, 1, [&](long long y0, long long y1) {
       // Per row: the view segments inside the medium as float arrays, then each point light's
-      // airlight over the whole row in one batch (SIMD when haze::simd::install() has run).
+      // airlight over the whole row in one batch (SIMD unless the kernel setting says float64).
       std::vector<float> ox, oy, oz, dx, dy, dz, seg;
       std::vector<int> slot(static_cast<size_t>(camera.width_px));
       struct PixelHit {
@@ -242,7 +248,7 @@ class AnalyticSolution final : public MethodSolution {
     const Camera& camera = view.camera;
     const auto width = static_cast<size_t>(camera.width_px), n = distances.size();
     const Aabb bounds = medium_->bounds();
-    const AirlightBatchFunction add_airlight = airlight_batch_function();
+    const AirlightKernel add_airlight = kernel_;
     std::vector<PixelLayers> out(width * static_cast<size_t>(camera.height_px) * n);
     parallel_for(camera.height_px, options.threads, 1, [&](long long y0, long long y1) {
       std::vector<Ray> rays(width);
@@ -302,7 +308,7 @@ class AnalyticSolution final : public MethodSolution {
   // the RGB airlight. Grey media take one batch at unit intensity scaled per channel (the airlight
   // is linear in I), others one batch per channel.
   template <class Accumulate>
-  void light_airlight(AirlightBatchFunction add_airlight, const AnalyticLight& light, const SegmentBatch& batch, std::vector<float>& unit,
+  void light_airlight(AirlightKernel add_airlight, const AnalyticLight& light, const SegmentBatch& batch, std::vector<float>& unit,
                       Accumulate accumulate) const {
     const Vec3& p = light.position;
     auto add = [&](int c, float intensity, const Rgb& scale) {
@@ -329,6 +335,7 @@ class AnalyticSolution final : public MethodSolution {
   const std::unique_ptr<Medium> medium_;
   const Rgb sigma_t_, sigma_s_;
   const bool grey_, airlight_, surface_airlight_;
+  const AirlightKernel kernel_;
   const AirlightTable table_;
   const std::optional<SurfaceAirlightTable> lambert_;
   const std::map<double, SurfaceAirlightTable> phong_;
@@ -358,6 +365,7 @@ class AnalyticMethod final : public Method {
     // Dynamic g (seed 002 sec. 4.3): > 0 builds g-independent Legendre tables (cached) and sums
     // them for the scene's g with enough orders for this relative tolerance.
     const double dynamic_g = settings.number("dynamic_g_tolerance");
+    const bool simd_kernel = settings.choice("kernel") == "simd";
     settings.reject_unknown();
 
     if (!scene.medium) throw Error("medium", "missing", "a homogeneous medium for the analytic method");
@@ -436,9 +444,9 @@ class AnalyticMethod final : public Method {
       }
     }
     auto solution = std::make_unique<AnalyticSolution>(scene, std::move(lights), std::move(medium), sigma_t, sigma_s, grey, airlight,
-                                                       surface_airlight, table, std::move(lambert), std::move(phong));
+                                                       surface_airlight, simd_kernel ? &add_airlight : &add_airlight_float64, table, std::move(lambert), std::move(phong));
     solution->stats = {{"table_seconds", watch.seconds()},
-                       {"airlight_path", airlight_batch_function() == &add_airlight_float64 ? "float64" : "simd"},
+                       {"airlight_path", simd_kernel ? "simd" : "float64"},
                        {"tables_reused", all_reused},
                        {"table", {a_samples, eta_samples}},
                        {"legendre_terms", legendre_terms},
@@ -465,7 +473,9 @@ MethodInfo analytic_info() {
                    SettingInfo::integer("surface_airlight", 1, 0, 1, "1: surfaces also receive the airlight (tables J1 and J_n)"),
                    SettingInfo::integer("airlight", 1, 0, 1, "0: leave out the view ray's airlight (surfaces only)"),
                    SettingInfo::number("dynamic_g_tolerance", 0.0, 0.0, 0.5,
-                                       "> 0: sum g-independent Legendre tables for the scene's HG g to this relative tolerance")};
+                                       "> 0: sum g-independent Legendre tables for the scene's HG g to this relative tolerance"),
+                   SettingInfo::choice("kernel", "simd", {"simd", "float64"},
+                                       "the view rays' airlight: float32 Highway lanes (within 1e-3 of quadrature), or the table evaluated in float64")};
   for (auto [a, eta] : {std::pair{64, 128}, {128, 256}, {256, 512}}) info.trade_sweep.push_back({{"table_a", a}, {"table_eta", eta}});
   info.offer = [](const SceneFeatures& f, double tolerance) {
     if (!single_scattering_suffices(f, tolerance)) return AutoOffer{false, {}, 0.0, "multiple scattering matters"};
@@ -476,4 +486,6 @@ MethodInfo analytic_info() {
   return info;
 }
 
-}  // namespace haze::internal
+void register_methods() { register_method(analytic_info()); }
+
+}  // namespace haze::analytic

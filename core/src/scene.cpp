@@ -598,7 +598,7 @@ Scene parse(const json& j, const fs::path& base_dir) {
     for (std::string_view f : kSceneFields) fields += (fields.empty() ? "" : ", ") + std::string(f);
     for (const std::string& t : types) fields += ", " + t;
     throw Error(key, "unknown field \"" + key + "\"",
-                "a field of the scene: " + fields + ", or a density type a module registers (haze::particles::register_methods() registers particles)");
+                "a field of the scene: " + fields + ", or a density type a module registers (haze::register_all() registers every one built, haze::particles::register_methods() particles)");
   }
   Scene scene;
   scene.directory = base_dir;

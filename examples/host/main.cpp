@@ -13,7 +13,7 @@
 #include <haze/core/image.h>
 #include <haze/gl/context.h>
 #include <haze/gl/froxels.h>
-#include <haze/grids/methods.h>
+#include <haze/all.h>
 
 #include <GL/glcorearb.h>
 #include <glm/ext/matrix_clip_space.hpp>
@@ -133,7 +133,7 @@ int main(int argc, char** argv) {
     }
   }
   try {
-    haze::grids::register_methods();
+    haze::register_all();
     haze::Scene scene = haze::Scene::load(scene_file);
     scene.camera.width_px = width, scene.camera.height_px = height;
     const haze::Camera& c = scene.camera;

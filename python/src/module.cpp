@@ -1,15 +1,12 @@
-// The `haze` Python module (DESIGN.md, "Python"): pybind11 bindings over the same API. Scenes from
+// The `haze` Python module (docs/PYTHON.md): pybind11 bindings over the same API. Scenes from
 // dicts or files, numpy densities viewed in place where their layout allows, images and fields out
 // as numpy arrays, solutions with update, progress and cancellation, haze.Error.
+#include <haze/all.h>
 #include <haze/core/error.h>
 #include <haze/core/image.h>
 #include <haze/core/method.h>
 #include <haze/core/scene.h>
-#include <haze/grids/methods.h>
 #include <haze/particles/field.h>
-#include <haze/particles/methods.h>
-#include <haze/simd/airlight_batch.h>
-#include <haze/vdb/vdb.h>
 
 #include <pybind11/functional.h>
 #include <pybind11/numpy.h>
@@ -136,10 +133,7 @@ struct PySolution {
 
 PYBIND11_MODULE(haze, m) {
   m.doc() = "Haze: light transport in participating media (docs/PYTHON.md)";
-  simd::install();
-  grids::register_methods();
-  particles::register_methods();
-  vdb::register_readers();
+  register_all();
 
   // haze.Error (a ValueError) with .field, .value and .expected; haze.Cancelled, a haze.Error, when
   // a progress callback stops the work.

@@ -1,14 +1,14 @@
 // The batched airlight on every compiled target against its scalar reference, and the reference
 // against the float64 table path.
 #include <haze/core/rng.h>
-#include <haze/simd/airlight_batch.h>
+#include <haze/analytic/airlight_batch.h>
 
 #include <gtest/gtest.h>
 #include <algorithm>
 #include <cstdio>
 #include <hwy/tests/hwy_gtest.h>
 
-namespace haze::simd {
+namespace haze::analytic {
 namespace {
 
 struct Segments {
@@ -86,4 +86,4 @@ TEST(AirlightBatch, FloatPathAgreesWithQuadrature) {
 }
 
 }  // namespace
-}  // namespace haze::simd
+}  // namespace haze::analytic

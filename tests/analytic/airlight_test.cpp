@@ -1,6 +1,6 @@
 // The angle-formulated airlight (seed 002 sec. 4.2.1): the quadrature yardstick against closed
 // forms and the adaptive integrator against known integrals.
-#include <haze/core/airlight.h>
+#include <haze/analytic/airlight.h>
 #include <haze/core/stopwatch.h>
 #include <haze/core/error.h>
 #include <haze/core/integrate.h>
@@ -12,7 +12,7 @@
 #include <unistd.h>
 
 
-namespace haze {
+namespace haze::analytic {
 namespace {
 
 // BEYOND.md: Sun et al. 2005, sigma_t 0.5, albedo 1, I 1, d_sv 2, gamma 0.7, d_vp 5 -> 0.0132328536.
@@ -259,4 +259,4 @@ TEST(Integrate, AdaptiveGaussKronrodResolvesPeaksAndEndpoints) {
 }
 
 }  // namespace
-}  // namespace haze
+}  // namespace haze::analytic

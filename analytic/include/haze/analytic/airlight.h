@@ -1,7 +1,7 @@
 // Single-scattered airlight from a point light along a view segment in a homogeneous medium
 // (seed 002 sec. 4.2.1, the angle-formulated airlight integral, eq. 4.3-4.8).
 //
-// In Haze's conventions (DESIGN.md) the thesis' C0 = kappa_t I0 e^(-kappa_t t) / h becomes
+// In Haze's conventions (docs/SCENES.md) the thesis' C0 = kappa_t I0 e^(-kappa_t t) / h becomes
 // sigma_s I e^(-sigma_t t) / h: the thesis writes kappa_t where sigma_s = albedo sigma_t belongs,
 // and its p integrates to 1 over the sphere as Haze's does. With theta the angle of the light's
 // emission direction from the perpendicular to the ray, x = t + h tan(theta) and r = h / cos(theta):
@@ -19,7 +19,7 @@
 
 #pragma GCC visibility push(default)  // the public API: exported from shared builds
 
-namespace haze {
+namespace haze::analytic {
 
 // One view segment and one point light (thesis table 4.1).
 struct AirlightSegment {
@@ -79,7 +79,7 @@ double spot_airlight(const PhaseFunction& phase, const AirlightMedium& medium, c
 // to 1e-13), and m = sqrt(a / (1 + a)) uniform in [0, 1] (the square root absorbs K's u log u
 // behaviour at small u; m = 1 is the exact limit). Lookups are bicubic (Catmull-Rom). At the
 // default 256 x 512 the worst relative error against quadrature over 10^4 random segments with
-// the extremes (tests/core/airlight_test.cpp) is 5.8e-4 for HG g in [-0.95, 0.95]; a table takes
+// the extremes (tests/analytic/airlight_test.cpp) is 5.8e-4 for HG g in [-0.95, 0.95]; a table takes
 // about 0.4 s on 2 threads.
 class AirlightTable {
  public:
@@ -182,13 +182,9 @@ struct AirlightChannel {
   float sigma_t, sigma_s, intensity;
 };
 
-// out[i] += airlight of segment i. Core's own is the float64 loop over AirlightTable::eval;
-// haze::simd::install() replaces it with the Highway kernel (core does not depend on simd).
-using AirlightBatchFunction = void (*)(const AirlightTable& table, const AirlightChannel& light, const SegmentBatch& batch,
-                                       float* out);
+// out[i] += airlight of segment i, one segment at a time through AirlightTable::eval in float64
+// (method analytic's `kernel` "float64"; add_airlight in airlight_batch.h is the SIMD one).
 void add_airlight_float64(const AirlightTable& table, const AirlightChannel& light, const SegmentBatch& batch, float* out);
-void set_airlight_batch_function(AirlightBatchFunction function);
-AirlightBatchFunction airlight_batch_function();
 
 // Airlight scattered onto a surface (seed 002 eq. 4.11-4.15) in Haze's energy-normalized BRDFs:
 //   L_pa = sigma_s I e^(-T) / d_sp [kd J1(T, theta_s) + ks J_n(T, theta'_s) max(0, n . R)],
@@ -243,6 +239,6 @@ class LegendreSurfaceTables {
   std::vector<std::vector<float>> j_;  // per order
 };
 
-}  // namespace haze
+}  // namespace haze::analytic
 
 #pragma GCC visibility pop

@@ -1,4 +1,4 @@
-// Blackbody colour and radiance for emission (DESIGN.md, "Emission", after Blender Cycles'
+// Blackbody colour and radiance for emission (docs/SCENES.md, "medium.emission", after Blender Cycles'
 // Principled Volume): the Rec.709 colour of a Planck spectrum, normalized to luminance 1.
 #pragma once
 

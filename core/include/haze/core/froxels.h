@@ -3,7 +3,7 @@
 // from the camera to the froxel's far slice boundary. A host renders it once per frame and looks up
 // every pixel's layers at the pixel's depth (trilinear), instead of Haze rendering every pixel:
 // colour = L_in(d) + T(d) * host colour (docs/HOST.md). Built from any solution whose method
-// renders layers (DESIGN.md, "Callers").
+// renders layers (docs/HOST.md).
 #pragma once
 
 #include <haze/core/camera.h>

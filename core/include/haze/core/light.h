@@ -1,4 +1,4 @@
-// Lights (DESIGN.md "Units"): point (radiant intensity I, irradiance I / d^2), spot
+// Lights (docs/SCENES.md, "lights"): point (radiant intensity I, irradiance I / d^2), spot
 // (I0 cos^n(theta) inside the cone half-angle), directional (irradiance E), sky (radiance from
 // outside the medium, the same in every direction).
 #pragma once

@@ -1,5 +1,5 @@
 // The Medium interface every renderer in Haze works on, and the media a scene file describes.
-// sigma_t(x) = sigma_t_scale * density(x) per RGB channel; sigma_s = albedo * sigma_t (DESIGN.md).
+// sigma_t(x) = sigma_t_scale * density(x) per RGB channel; sigma_s = albedo * sigma_t (docs/SCENES.md, "medium").
 #pragma once
 
 #include <haze/core/math.h>
@@ -77,7 +77,7 @@ struct FieldDensity {
 
 using Density = std::variant<ConstantDensity, RbfDensity, GridDensity, FieldDensity>;
 
-// Emission (DESIGN.md, "Emission", after Blender Cycles' Principled Volume): radiance per unit
+// Emission (docs/SCENES.md, "medium.emission", after Blender Cycles' Principled Volume): radiance per unit
 // length added to the transfer equation's source, unaffected by albedo, inside the medium's bounds:
 //   L_e(x) = strength color g(x) + blackbody_intensity tint blackbody_color(T) sigma T^4,
 // g the emission grid where given, else the medium's density; T = temperature times the

@@ -1,4 +1,4 @@
-// Triangle meshes as opaque surfaces (DESIGN.md, "Surfaces"): from OBJ files (tinyobjloader) or
+// Triangle meshes as opaque surfaces (docs/SCENES.md, "surfaces"): from OBJ files (tinyobjloader) or
 // from a caller's vertex and index buffers, placed by an affine transform, ray queries through
 // Embree. A mesh is shared, immutable once built, and safe to query from any thread.
 #pragma once

@@ -22,7 +22,7 @@
 
 namespace haze {
 
-// A method turns a scene into a solution (DESIGN.md, "Callers"); the solution renders views.
+// A method turns a scene into a solution (docs/ARCHITECTURE.md, "The shape for callers"); the solution renders views.
 class Method {
  public:
   virtual ~Method() = default;
@@ -171,9 +171,9 @@ class Solution {
 };
 
 // Prepares `method_name`, or the scene's method when empty. The scene's method settings apply
-// when its name matches; options.settings override them key by key. A scene with particles and no
-// medium prepares a method that does not read particles through the registered
-// ParticleMediumFactory. Lights that reach nothing (with options.single_view and a
+// when its name matches; options.settings override them key by key. A scene's particles block is
+// its medium (density type "particles", which the particles module registers), so every method
+// that takes its density renders particles. Lights that reach nothing (with options.single_view and a
 // single-scattering method: nothing in view) are left out first (light_culling.h); the stats
 // list them under "culled_lights".
 Solution prepare(const Scene& scene, const std::string& method_name = "", RenderOptions options = {});

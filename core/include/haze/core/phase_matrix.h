@@ -22,7 +22,7 @@ class PhaseMatrix {
   double operator()(int i, int j) const { return matrix_(i, j); }
   // Row sums of the unscaled matrix: the quadrature's estimate of integral p = 1 for each direction.
   const Eigen::VectorXd& raw_row_sums() const { return raw_row_sums_; }
-  // New row sum over old row sum, 1 / raw_row_sums(): the accuracy diagnostic DESIGN.md asks for.
+  // New row sum over old row sum, 1 / raw_row_sums(): the accuracy diagnostic (docs/ARCHITECTURE.md, "Phase matrix").
   Eigen::VectorXd renormalization_factors() const { return raw_row_sums_.cwiseInverse(); }
   // The symmetric scaling: P_ij = s_i p(w_i . w_j) w_j s_j. A direction w outside the set gets the
   // row s(w) p(w . w_j) w_j s_j with s(w) = 1 / sum_j p(w . w_j) w_j s_j (the same rule at w_i).

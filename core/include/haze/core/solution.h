@@ -1,4 +1,4 @@
-// Solve once, render many (DESIGN.md, "Callers"): what a method computes before it sees a camera,
+// Solve once, render many (docs/ARCHITECTURE.md, "The shape for callers"): what a method computes before it sees a camera,
 // the views it renders, and the changes it can take without solving again.
 #pragma once
 
@@ -61,7 +61,7 @@ struct View {
   }
 };
 
-// A pixel's light as a host composites it (DESIGN.md, "Callers"): the radiance scattered toward
+// A pixel's light as a host composites it (docs/HOST.md): the radiance scattered toward
 // the camera along the ray up to its end (`inscatter`, L_in), the ray's transmittance to its end
 // (T), and the radiance leaving its end toward the camera (C: Haze's own surface, shaded, or the
 // background; 0 where the host's depth ends it). The image is L_in + T C.
@@ -114,8 +114,8 @@ class MethodSolution {
   virtual ~MethodSolution() = default;
   // The scene's medium, lights and surfaces as prepared, seen from view.camera.
   virtual RenderResult render(const View& view, const RenderOptions& options) const = 0;
-  // Whether render honours View::depth and View::layers (the methods that do not yet are refused
-  // such views with a haze::Error).
+  // Whether render honours View::depth and View::layers; a method that does not is refused such
+  // views with a haze::Error (every method Haze registers does).
   virtual bool renders_layers() const { return false; }
   // L_in and T along each of the view's rays to each of `distances` (ascending, > 0), as
   // out[ray * distances.size() + k], in one pass; std::nullopt where the method has no such path

@@ -1,5 +1,5 @@
 // Opaque surfaces that block and reflect light: planes, spheres and triangle meshes (mesh.h) with energy-normalized BRDFs
-// (DESIGN.md): Lambert kd / pi plus Phong ks (n + 2) / (2 pi) cos^n(alpha). The thesis (seed 002)
+// (docs/SCENES.md, "surfaces"): Lambert kd / pi plus Phong ks (n + 2) / (2 pi) cos^n(alpha). The thesis (seed 002)
 // writes kd and ks cos^n; its constants are folded in here.
 #pragma once
 

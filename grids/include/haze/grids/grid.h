@@ -1,4 +1,4 @@
-// Dense scalar grids (DESIGN.md "Grids"): cell-centred over an AABB, public order x fastest, then
+// Dense scalar grids (docs/ARCHITECTURE.md): cell-centred over an AABB, public order x fastest, then
 // y, then z; float32 values. BrickGrid is the cache-blocked internal layout solvers sweep over.
 #pragma once
 

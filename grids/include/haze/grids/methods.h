@@ -5,8 +5,7 @@
 
 namespace haze::grids {
 
-// Registers every grid-based method this build has (today "propagation"; discrete ordinates will
-// land here too); safe to call more than once.
+// Registers "propagation" and "dom"; safe to call more than once.
 void register_methods();
 
 }  // namespace haze::grids

@@ -52,7 +52,7 @@ void check_depth_memory(const DenseGrid& density, const std::vector<Light>& ligh
 std::vector<DenseGrid> optical_depths(const DenseGrid& density, const std::vector<Light>& lights, const DepthOptions& options = {},
                                       DepthStats* stats = nullptr);
 
-// Surface shadows (DESIGN.md "Surfaces are part of the transport"): per light of `lights` (point,
+// Surface shadows (docs/ARCHITECTURE.md, "Surfaces in the transport"): per light of `lights` (point,
 // spot or directional, as optical_depths), 1 at the cell centres of `grid` that see the light past
 // every surface and 0 where a surface is in the way. Empty when there are no surfaces. Gathers
 // read it trilinear and multiply the light's E e^-tau by it; first-collision sources, at cell

@@ -77,7 +77,7 @@ struct NetworkSolution {
   std::shared_ptr<const PhaseMatrix> matrix;
   VisibilityNetwork visibility;
   std::vector<float> rho;                 // the continuous density at each particle
-  // The medium's emission (DESIGN.md, "Emission") where the particles are: per channel, each
+  // The medium's emission (docs/SCENES.md, "medium.emission") where the particles are: per channel, each
   // particle's source function L_e / (sigma_t rho) at its centre (exact where L_e follows the
   // density: strength color / sigma_t), added to the gaps' source in the iteration and to what
   // each particle sends to the eye; empty when the medium does not emit.

@@ -1,6 +1,6 @@
 // A particle medium (seed 001 section 2.1): particle p stands for its spherical neighbourhood of
 // diameter delta_s_p and carries an extinction density rho_p, so sigma_t = sigma_t_scale * rho
-// (DESIGN.md); albedo and phase are shared by the set. Simulations hand particles over as spans
+// (docs/SCENES.md, "particles"); albedo and phase are shared by the set. Simulations hand particles over as spans
 // (ParticleView, not copied); scenes give them in a `particles` block (docs/SCENES.md).
 #pragma once
 

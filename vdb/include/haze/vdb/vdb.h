@@ -1,4 +1,4 @@
-// OpenVDB (.vdb) and NanoVDB (.nvdb) volumes as densities (DESIGN.md, "Volume data"): a float grid
+// OpenVDB (.vdb) and NanoVDB (.nvdb) volumes as densities (docs/SCENES.md, "medium.density"): a float grid
 // read by name, placed by its own affine index-to-world transform, kept sparse (NanoVDB) and
 // sampled trilinearly, with a majorant grid over its leaves and tiles for the tracers; and a
 // solution's lighting fields written back as VDB grids.
