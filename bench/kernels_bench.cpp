@@ -6,11 +6,11 @@
 #include <haze/grids/dom.h>
 #include <haze/grids/optical_depth.h>
 #include <haze/grids/propagation.h>
-#include <haze/simd/dom_sweep.h>
+#include <haze/grids/dom_sweep.h>
 #include <haze/simd/half.h>
-#include <haze/simd/march_rays.h>
+#include <haze/grids/march_rays.h>
 #include <haze/simd/phase_batch.h>
-#include <haze/simd/sweep_cells.h>
+#include <haze/grids/sweep_cells.h>
 
 #include <benchmark/benchmark.h>
 #include <hwy/targets.h>
@@ -172,7 +172,7 @@ std::shared_ptr<std::vector<float>> density64() {
 Work sweep_work(bool scalar) {
   auto density = density64();
   auto depth = std::make_shared<std::vector<float>>(density->size()), mean = std::make_shared<std::vector<float>>(density->size());
-  auto v = std::make_shared<simd::SweepVolume>();
+  auto v = std::make_shared<grids::SweepVolume>();
   for (int e = 0; e < 3; ++e) v->n[e] = 64, v->lo[e] = -1.0f, v->h[e] = 2.0f / 64.0f;
   v->density = density->data(), v->mean = mean->data(), v->directional = true;
   const float to_light[3] = {0.3f, 0.9f, 0.3f};
@@ -182,7 +182,7 @@ Work sweep_work(bool scalar) {
             for (int layer = 63; layer >= 0; --layer)  // y is the dominant axis toward the light
               for (int k = 0; k < 64; ++k) {
                 const size_t at = static_cast<size_t>((k * 64 + layer) * 64);
-                (scalar ? simd::sweep_cells_reference : simd::sweep_cells)(*v, 0, layer, k, 0, 64, depth->data() + at, mean->data() + at);
+                (scalar ? grids::sweep_cells_reference : grids::sweep_cells)(*v, 0, layer, k, 0, 64, depth->data() + at, mean->data() + at);
               }
             benchmark::DoNotOptimize(depth->data());
           },
@@ -193,9 +193,9 @@ Work sweep_work(bool scalar) {
 Work march_work(bool scalar) {
   auto density = density64();
   auto depths = std::make_shared<std::vector<float>>(2 * density->size(), 0.5f);
-  auto lights = std::make_shared<std::vector<simd::MarchLight>>(2);
+  auto lights = std::make_shared<std::vector<grids::MarchLight>>(2);
   (*lights)[0].position[0] = 1.5f, (*lights)[1].position[1] = 1.5f;
-  auto v = std::make_shared<simd::MarchVolume>();
+  auto v = std::make_shared<grids::MarchVolume>();
   for (int e = 0; e < 3; ++e) v->n[e] = 64, v->lo[e] = -1.0f, v->h[e] = 2.0f / 64.0f;
   v->density = density->data(), v->depths = depths->data(), v->lights = lights->data(), v->light_count = 2;
   const size_t n = 256;
@@ -206,14 +206,14 @@ Work march_work(bool scalar) {
     for (size_t a = 0; a < 9; ++a) (*in)[a * n + r] = values[a];
   }
   auto row = [](std::vector<float>& b, size_t a, size_t count) { return b.data() + a * count; };
-  auto packet = std::make_shared<simd::RayPacket>(simd::RayPacket{row(*in, 0, n), row(*in, 1, n), row(*in, 2, n), row(*in, 3, n), row(*in, 4, n),
+  auto packet = std::make_shared<grids::RayPacket>(grids::RayPacket{row(*in, 0, n), row(*in, 1, n), row(*in, 2, n), row(*in, 3, n), row(*in, 4, n),
                                                                    row(*in, 5, n), row(*in, 6, n), row(*in, 7, n), row(*in, 8, n), n,
                                                                    {row(*out, 0, n), row(*out, 1, n), row(*out, 2, n)},
                                                                    {row(*out, 3, n), row(*out, 4, n), row(*out, 5, n)}});
   const PhaseFunction phase = PhaseFunction::henyey_greenstein(0.4);
   (void)scalar;  // its reference is the float64 marcher in grids (MarchSettings::scalar), not a kernel
   return {[=] {
-            simd::march_rays(*v, phase, *packet);
+            grids::march_rays(*v, phase, *packet);
             benchmark::DoNotOptimize(out->data());
           },
           128.0 * static_cast<double>(n), 0.0, {density, depths, lights, in}};
@@ -235,20 +235,20 @@ Work dom_work(bool scalar, bool diamond, int p, int terms) {
       (*q)[static_cast<size_t>(d * padded + k)] = 0.02f * static_cast<float>((k * d) % 5);
     }
   }
-  auto octant = std::make_shared<simd::DomOctant>(simd::DomOctant{p, terms, padded, a->data(), lq->data(), q->data(), diamond});
+  auto octant = std::make_shared<grids::DomOctant>(grids::DomOctant{p, terms, padded, a->data(), lq->data(), q->data(), diamond});
   auto density = std::make_shared<std::vector<float>>(count, 1.0f), first = std::make_shared<std::vector<float>>(static_cast<size_t>(count * p), 0.1f);
   auto m_in = std::make_shared<std::vector<float>>(static_cast<size_t>(count * terms), 0.05f),
        m_out = std::make_shared<std::vector<float>>(static_cast<size_t>(count * terms));
   auto x = std::make_shared<std::vector<float>>(p), y = std::make_shared<std::vector<float>>(static_cast<size_t>(count * p)),
        z = std::make_shared<std::vector<float>>(static_cast<size_t>(count * p)), scratch = std::make_shared<std::vector<float>>(4 * p + padded);
   auto marks = std::make_shared<std::vector<std::uint8_t>>(8 * count, 0);
-  auto row = std::make_shared<simd::DomRow>();
+  auto row = std::make_shared<grids::DomRow>();
   row->count = count, row->density = density->data(), row->sigma_t_scale = 2.0f, row->albedo = 0.9f;
   row->first = first->data(), row->first_stride = static_cast<size_t>(p), row->m_in = m_in->data(), row->m_out = m_out->data();
   row->x_run = x->data(), row->y_row = y->data(), row->z_row = z->data(), row->scratch = scratch->data();
   row->bounded = marks->data();
   return {[=] {
-            (scalar ? simd::dom_sweep_row_reference : simd::dom_sweep_row)(*octant, *row);
+            (scalar ? grids::dom_sweep_row_reference : grids::dom_sweep_row)(*octant, *row);
             benchmark::DoNotOptimize(m_out->data());
           },
           static_cast<double>(count * p), 0.0, {a, lq, q, density, first, m_in, x, y, z, scratch, marks}};

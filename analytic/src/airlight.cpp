@@ -1,6 +1,6 @@
 #include <haze/analytic/airlight.h>
 #include <haze/core/error.h>
-#include <haze/core/integrate.h>
+#include <haze/analytic/integrate.h>
 #include <haze/core/image.h>
 #include <haze/core/light.h>
 

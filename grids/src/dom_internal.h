@@ -3,7 +3,7 @@
 #pragma once
 
 #include <haze/grids/dom.h>
-#include <haze/simd/dom_sweep.h>
+#include <haze/grids/dom_sweep.h>
 
 #include <array>
 #include <cstdint>
@@ -66,7 +66,7 @@ class Transport {
   // radiance `boundary` entering through every face (or, given, `faces`), and the moments of the
   // result  m_out[cell * N + k] = sum_d Q[d][k] L_d   (eq. 10).
   // first (from first_collision) and m_in may be null; with first and no m_in it sets the
-  // channel's fix-up marks (Channel::bounded). Rows run through simd::dom_sweep_row. Directions
+  // channel's fix-up marks (Channel::bounded). Rows run through dom_sweep_row. Directions
   // going up and going down run on two threads into separate buffers, summed in a fixed order.
   void sweep(const Channel& channel, const FirstCollision* first, const float* m_in, float boundary, float* m_out, int threads,
              const Faces* faces = nullptr) const;
@@ -112,7 +112,7 @@ class Transport {
   // The kernel's view: per octant, its directions padded to a multiple of 8.
   struct Octant {
     std::vector<float> a, lq, q;
-    simd::DomOctant view;
+    DomOctant view;
     size_t offset = 0;              // of its first direction in a cell's padded run
   };
   std::array<Octant, 8> octants_;

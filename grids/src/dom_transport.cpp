@@ -158,7 +158,7 @@ void Transport::sweep(const Channel& ch, const FirstCollision* first, const floa
   Stopwatch start;
   const size_t size = cells_ * static_cast<size_t>(n_terms_);
   scratch_.resize(size);
-  const auto row_kernel = scalar_kernel_ ? simd::dom_sweep_row_reference : simd::dom_sweep_row;
+  const auto row_kernel = scalar_kernel_ ? dom_sweep_row_reference : dom_sweep_row;
   long long skipped[2] = {0, 0};
   // Split over processes, the halves in order on this thread: each half's octants wait on the
   // process upwind, which must be in the same half (one process per core).
@@ -191,7 +191,7 @@ void Transport::sweep(const Channel& ch, const FirstCollision* first, const floa
         // skipped. Exact.
         std::vector<char> z_dark(sx * sy), y_darks(kept * sx);
         for (size_t c = 0; c < sx * sy; ++c) enter(2, c, z_plane.data() + c * p);
-        simd::DomRow row;
+        DomRow row;
         row.step = o & 1 ? -1 : 1;
         row.density = ch.density, row.sigma_t_scale = ch.sigma_t_scale, row.albedo = ch.albedo;
         if (first && first->half.empty()) row.first = first->values.data() + oc.offset;

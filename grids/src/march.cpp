@@ -1,12 +1,12 @@
 // The ray marcher of method "propagation" (seed 003 sec. 4.4, eq. 8-10): the float64 reference
-// one pixel at a time, and the SIMD kernel (haze/simd/march_rays.h) over each image row. Surfaces
+// one pixel at a time, and the SIMD kernel (haze/grids/march_rays.h) over each image row. Surfaces
 // shadow the medium (surface_visibility, trilinear) and each other (a ray to each light).
 #include <haze/core/error.h>
 #include <haze/core/directions.h>
 #include <haze/core/grid_walk.h>
 #include <haze/grids/optical_depth.h>
 #include <haze/grids/propagation.h>
-#include <haze/simd/march_rays.h>
+#include <haze/grids/march_rays.h>
 
 #include <algorithm>
 #include <cmath>
@@ -154,8 +154,8 @@ struct Marcher {
 
 // The kernel's view of the volume and lights; false where it cannot take them (a tabulated phase
 // function, a sky light, emission).
-bool simd_volume(const Marcher& m, std::vector<simd::MarchLight>& lights, simd::MarchVolume& v) {
-  if (!simd::march_supported(m.volume.phase) || m.volume.emission.emits()) return false;
+bool simd_volume(const Marcher& m, std::vector<MarchLight>& lights, MarchVolume& v) {
+  if (!march_supported(m.volume.phase) || m.volume.emission.emits()) return false;
   const DenseGrid& density = m.volume.density;
   const Vec3 h = density.cell_size();
   for (int e = 0; e < 3; ++e) {
@@ -168,16 +168,16 @@ bool simd_volume(const Marcher& m, std::vector<simd::MarchLight>& lights, simd::
     for (int e = 0; e < 3; ++e) to[e] = static_cast<float>(from[e]);
   };
   for (const Light& light : m.scene.lights) {
-    simd::MarchLight l;
+    MarchLight l;
     Rgb intensity;
     if (const auto* p = std::get_if<PointLight>(&light)) {
       set(p->position, l.position), intensity = p->intensity;
     } else if (const auto* s = std::get_if<SpotLight>(&light)) {
-      l.type = simd::MarchLight::spot;
+      l.type = MarchLight::spot;
       set(s->position, l.position), set(s->direction, l.axis), intensity = s->intensity;
       l.cos_cone = static_cast<float>(std::cos(s->cone_deg * kPi / 180.0)), l.exponent = static_cast<float>(s->exponent);
     } else if (const auto* d = std::get_if<DirectionalLight>(&light)) {
-      l.type = simd::MarchLight::directional;
+      l.type = MarchLight::directional;
       set(-d->direction, l.to_light), intensity = d->irradiance;
     } else {
       return false;
@@ -196,7 +196,7 @@ bool simd_volume(const Marcher& m, std::vector<simd::MarchLight>& lights, simd::
 }
 
 // One image row through the SIMD kernel; surfaces and the background per pixel after it.
-void march_row(const Marcher& m, const simd::MarchVolume& v, const View& view, int y, RenderResult& result) {
+void march_row(const Marcher& m, const MarchVolume& v, const View& view, int y, RenderResult& result) {
   const Camera& camera = view.camera;
   const auto width = static_cast<size_t>(camera.width_px);
   std::vector<float> in(9 * width), out(6 * width, 0.0f);
@@ -211,9 +211,9 @@ void march_row(const Marcher& m, const simd::MarchVolume& v, const View& view, i
     for (size_t a = 0; a < 9; ++a) in[a * width + x] = static_cast<float>(values[a]);
   }
   auto row = [&](std::vector<float>& buffer, size_t a) { return buffer.data() + a * width; };
-  simd::RayPacket packet{row(in, 0), row(in, 1), row(in, 2), row(in, 3), row(in, 4), row(in, 5), row(in, 6), row(in, 7), row(in, 8), width,
+  RayPacket packet{row(in, 0), row(in, 1), row(in, 2), row(in, 3), row(in, 4), row(in, 5), row(in, 6), row(in, 7), row(in, 8), width,
                          {row(out, 0), row(out, 1), row(out, 2)}, {row(out, 3), row(out, 4), row(out, 5)}};
-  simd::march_rays(v, m.volume.phase, packet);
+  march_rays(v, m.volume.phase, packet);
   for (size_t x = 0; x < width; ++x) {
     Rgb radiance, transmittance;
     for (int c = 0; c < 3; ++c) {
@@ -226,7 +226,7 @@ void march_row(const Marcher& m, const simd::MarchVolume& v, const View& view, i
 }
 
 // Row y's stretches between consecutive distances, one packet, chained per ray (march_distances).
-void march_row_distances(const Marcher& m, const simd::MarchVolume& v, const View& view, std::span<const double> distances, int y,
+void march_row_distances(const Marcher& m, const MarchVolume& v, const View& view, std::span<const double> distances, int y,
                          std::vector<PixelLayers>& out) {
   const Camera& camera = view.camera;
   const auto width = static_cast<size_t>(camera.width_px), n = distances.size();
@@ -255,9 +255,9 @@ void march_row_distances(const Marcher& m, const simd::MarchVolume& v, const Vie
   for (size_t i = 0; i < count; ++i)
     for (size_t a = 0; a < 9; ++a) packed[a * count + i] = segments[i][a];
   auto row = [&](std::vector<float>& buffer, size_t a) { return buffer.data() + a * count; };
-  simd::RayPacket packet{row(packed, 0), row(packed, 1), row(packed, 2), row(packed, 3), row(packed, 4), row(packed, 5), row(packed, 6), row(packed, 7),
+  RayPacket packet{row(packed, 0), row(packed, 1), row(packed, 2), row(packed, 3), row(packed, 4), row(packed, 5), row(packed, 6), row(packed, 7),
                          row(packed, 8), count, {row(result, 0), row(result, 1), row(result, 2)}, {row(result, 3), row(result, 4), row(result, 5)}};
-  if (count > 0) simd::march_rays(v, m.volume.phase, packet);
+  if (count > 0) march_rays(v, m.volume.phase, packet);
   // Each segment's own L and T, then chained along the ray.
   std::vector<PixelLayers> own(width * n);
   for (size_t i = 0; i < count; ++i)
@@ -283,8 +283,8 @@ std::optional<std::vector<PixelLayers>> march_distances(const Scene& scene, cons
                                                         std::span<const double> distances, const std::vector<DenseGrid>* visibility) {
   const Vec3 h = volume.density.cell_size();
   const Marcher marcher(scene, volume, depths, settings.step_cells * std::min({h.x, h.y, h.z}), options.threads, visibility, false);
-  std::vector<simd::MarchLight> lights;
-  simd::MarchVolume simd_view;
+  std::vector<MarchLight> lights;
+  MarchVolume simd_view;
   if (settings.scalar || !simd_volume(marcher, lights, simd_view)) return std::nullopt;
   const Camera& camera = view.camera;
   std::vector<PixelLayers> out(static_cast<size_t>(camera.width_px) * static_cast<size_t>(camera.height_px) * distances.size());
@@ -309,8 +309,8 @@ RenderResult march_view(const Scene& scene, const ExtinctionVolume& volume, cons
     throw Error("visibility", to_text(visibility->size()) + " volumes", "one per light (" + to_text(depths.size()) + ")");
   const Marcher marcher(scene, volume, depths, settings.step_cells * std::min({h.x, h.y, h.z}), options.threads, visibility,
                         settings.surface_gather);
-  std::vector<simd::MarchLight> lights;
-  simd::MarchVolume simd_view;
+  std::vector<MarchLight> lights;
+  MarchVolume simd_view;
   const bool use_simd = !settings.scalar && simd_volume(marcher, lights, simd_view);
   const Camera& camera = view.camera;
   RenderResult result = RenderResult::for_view(view);

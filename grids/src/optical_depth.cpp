@@ -2,7 +2,7 @@
 #include <haze/core/grid_walk.h>
 #include <haze/core/progress.h>
 #include <haze/grids/optical_depth.h>
-#include <haze/simd/sweep_cells.h>
+#include <haze/grids/sweep_cells.h>
 
 #include <algorithm>
 #include <atomic>
@@ -133,7 +133,7 @@ int compute_paper(const DenseGrid& density, const LightGeometry& g, DenseGrid& o
   return iterations;
 }
 
-// Short characteristics (BEYOND.md), the formulas of haze/simd/sweep_cells.h: from each cell
+// Short characteristics (BEYOND.md), the formulas of haze/grids/sweep_cells.h: from each cell
 // centre toward the light to the cell-centre plane `layers` layers away along the dominant axis,
 // walked cell by cell; beyond it, the mean density along the landing point's own path (bilinear
 // in that plane) times that path's length. Interpolating the mean density rather than the depth,
@@ -147,7 +147,7 @@ class Sweeper {
   Sweeper(const DenseGrid& density, const LightGeometry& g, DenseGrid& out, int layers, bool scalar, int exact_radius,
           const int light_cell[3])
       : out_(out), mean_(density.resolution(), density.bounds()),
-        kernel_(scalar ? &simd::sweep_cells_reference : &simd::sweep_cells) {
+        kernel_(scalar ? &sweep_cells_reference : &sweep_cells) {
     const Vec3 h = density.cell_size();
     for (int e = 0; e < 3; ++e) {
       volume_.n[e] = density.resolution()[static_cast<size_t>(e)];
@@ -195,8 +195,8 @@ class Sweeper {
  private:
   DenseGrid& out_;
   DenseGrid mean_;  // depth / path length inside the grid, read by later landings
-  simd::SweepVolume volume_;
-  void (*kernel_)(const simd::SweepVolume&, int, int, int, int, int, float*, float*);
+  SweepVolume volume_;
+  void (*kernel_)(const SweepVolume&, int, int, int, int, int, float*, float*);
 };
 
 void compute_sweep(const DenseGrid& density, const LightGeometry& g, DenseGrid& out, int layers, bool scalar, int threads) {

@@ -2,7 +2,7 @@
 // each cell with its majorant, for the path tracer's lookups and delta tracking.
 #include <haze/core/majorant.h>
 #include <haze/particles/field.h>
-#include <haze/simd/gaussian_sum.h>
+#include <haze/particles/gaussian_sum.h>
 
 #include <algorithm>
 #include <cmath>
@@ -52,7 +52,7 @@ ParticleDensity::ParticleDensity(ParticleSet set, int neighbours) : set_(std::mo
     count.assign(static_cast<size_t>(n_[0]) * static_cast<size_t>(n_[1]) * static_cast<size_t>(n_[2]), 0);
     for (size_t p = 0; p < field_.size(); ++p) for_support(p, [&](size_t c, double) { ++count[c]; });
     size_t entries = 0;
-    for (size_t& c : count) entries += c = (c + simd::kGaussianPad - 1) / simd::kGaussianPad * simd::kGaussianPad;
+    for (size_t& c : count) entries += c = (c + kGaussianPad - 1) / kGaussianPad * kGaussianPad;
     if (entries <= kMaxEntries || (n_[0] == 1 && n_[1] == 1 && n_[2] == 1)) break;
   }
   start_.assign(count.size() + 1, 0);
@@ -83,9 +83,9 @@ double ParticleDensity::density(const Vec3& x) const {
     c[a] = std::min(static_cast<int>(u), n_[static_cast<size_t>(a)] - 1);
   }
   const size_t cell = cell_index(c[0], c[1], c[2]), e = start_[cell];
-  const simd::GaussianList list{x_.data() + e, y_.data() + e, z_.data() + e, inv_h2_.data() + e, w_.data() + e, start_[cell + 1] - e};
+  const GaussianList list{x_.data() + e, y_.data() + e, z_.data() + e, inv_h2_.data() + e, w_.data() + e, start_[cell + 1] - e};
   if (list.count == 0) return 0.0;
-  return simd::gaussian_sum(list, static_cast<float>(x.x), static_cast<float>(x.y), static_cast<float>(x.z), static_cast<float>(kCut * kCut));
+  return gaussian_sum(list, static_cast<float>(x.x), static_cast<float>(x.y), static_cast<float>(x.z), static_cast<float>(kCut * kCut));
 }
 
 double ParticleDensity::max_density(const Aabb& region) const {

@@ -3,7 +3,7 @@
 #define HWY_TARGET_INCLUDE "phase_batch.cc"
 #include <hwy/foreach_target.h>  // IWYU pragma: keep
 
-#include "phase_batch-inl.h"
+#include <haze/simd/phase_batch-inl.h>
 
 #include <hwy/highway.h>
 

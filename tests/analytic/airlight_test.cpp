@@ -3,7 +3,7 @@
 #include <haze/analytic/airlight.h>
 #include <haze/core/stopwatch.h>
 #include <haze/core/error.h>
-#include <haze/core/integrate.h>
+#include <haze/analytic/integrate.h>
 #include <haze/core/rng.h>
 
 #include <gtest/gtest.h>

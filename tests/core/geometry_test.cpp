@@ -3,7 +3,7 @@
 #include <haze/core/directions.h>
 #include <haze/core/error.h>
 #include <haze/core/grid_walk.h>
-#include <haze/core/integrate.h>
+#include <haze/analytic/integrate.h>
 #include <haze/core/light.h>
 #include <haze/core/medium.h>
 #include <haze/core/phase.h>
@@ -233,7 +233,7 @@ TEST(Light, EquiangularNodesIntegrateTheInverseSquarePeak) {
   const int count = equiangular_nodes(ray, centre, 1.7, 2.5, 0.2, t, w);
   double sum = 0.0;
   for (int n = 0; n < count; ++n) sum += w[n] * std::exp(-t[n]) / glm::dot(ray.at(t[n]), ray.at(t[n]));
-  const double adaptive = integrate_adaptive([&](double s) { return std::exp(-s) / glm::dot(ray.at(s), ray.at(s)); }, 1.7, 2.5, 1e-12).value;
+  const double adaptive = analytic::integrate_adaptive([&](double s) { return std::exp(-s) / glm::dot(ray.at(s), ray.at(s)); }, 1.7, 2.5, 1e-12).value;
   EXPECT_NEAR(sum, adaptive, 1e-3 * adaptive);
   EXPECT_GT(std::abs(0.8 * std::exp(-2.1) / glm::dot(ray.at(2.1), ray.at(2.1)) - adaptive), 0.5 * adaptive);
   // A ray through the point and an empty stretch stay finite.

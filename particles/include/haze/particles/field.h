@@ -93,7 +93,7 @@ class ParticleDensity final : public DensityField {
   ParticleField field_;  // views set_
   Vec3 origin_{0.0}, cell_{1.0};
   std::array<int, 3> n_{1, 1, 1};
-  // Cell c lists entries start_[c] .. start_[c + 1] (padded to simd::kGaussianPad).
+  // Cell c lists entries start_[c] .. start_[c + 1] (padded to kGaussianPad).
   std::vector<size_t> start_;
   std::vector<float> x_, y_, z_, inv_h2_, w_;
   std::vector<double> majorant_;  // per cell

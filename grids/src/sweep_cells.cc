@@ -11,7 +11,7 @@
 #include <algorithm>
 #include <cmath>
 
-namespace haze::simd {
+namespace haze::grids {
 
 HWY_EXPORT(SweepCells);
 
@@ -90,5 +90,5 @@ void sweep_cells(const SweepVolume& volume, int i, int j, int k, int axis, int c
   HWY_DYNAMIC_DISPATCH(SweepCells)(volume, i, j, k, axis, count, depth, mean);
 }
 
-}  // namespace haze::simd
+}  // namespace haze::grids
 #endif  // HWY_ONCE

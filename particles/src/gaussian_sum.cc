@@ -10,7 +10,7 @@
 #if HWY_ONCE
 #include <cmath>
 
-namespace haze::simd {
+namespace haze::particles {
 
 HWY_EXPORT(GaussianSum);
 
@@ -28,5 +28,5 @@ float gaussian_sum_reference(const GaussianList& g, float px, float py, float pz
   return sum;
 }
 
-}  // namespace haze::simd
+}  // namespace haze::particles
 #endif  // HWY_ONCE

@@ -1,7 +1,7 @@
 // Sums of truncated Gaussians on every compiled Highway target: one term is w exp(-r^2 / h^2),
 // terms at or past the cut are left out, and random lists agree with the scalar reference.
 #include <haze/core/rng.h>
-#include <haze/simd/gaussian_sum.h>
+#include <haze/particles/gaussian_sum.h>
 
 #include <gtest/gtest.h>
 #include <hwy/tests/hwy_gtest.h>
@@ -9,7 +9,7 @@
 #include <cmath>
 #include <vector>
 
-namespace haze::simd {
+namespace haze::particles {
 namespace {
 
 class GaussianSum : public hwy::TestWithParamTarget {};
@@ -52,4 +52,4 @@ TEST_P(GaussianSum, AgreesWithTheScalarReference) {
 }
 
 }  // namespace
-}  // namespace haze::simd
+}  // namespace haze::particles

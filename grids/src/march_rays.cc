@@ -10,20 +10,20 @@
 #if HWY_ONCE
 #include <haze/core/error.h>
 
-namespace haze::simd {
+namespace haze::grids {
 
 HWY_EXPORT(MarchRays);
 
 bool march_supported(const PhaseFunction& phase) {
-  PhaseParams p;
-  return params_for(phase, p);
+  simd::PhaseParams p;
+  return simd::params_for(phase, p);
 }
 
 void march_rays(const MarchVolume& volume, const PhaseFunction& phase, const RayPacket& rays) {
-  PhaseParams p;
-  if (!params_for(phase, p)) throw Error("phase", phase.name(), "an analytic phase function for the SIMD marcher");
+  simd::PhaseParams p;
+  if (!simd::params_for(phase, p)) throw Error("phase", phase.name(), "an analytic phase function for the SIMD marcher");
   HWY_DYNAMIC_DISPATCH(MarchRays)(volume, p, rays);
 }
 
-}  // namespace haze::simd
+}  // namespace haze::grids
 #endif  // HWY_ONCE

@@ -11,7 +11,7 @@
 #include <cmath>
 
 #if HWY_ONCE
-namespace haze::simd {
+namespace haze::grids {
 
 HWY_EXPORT(DomSweepRow);
 
@@ -104,5 +104,5 @@ void dom_sweep_row_reference(const DomOctant& o, const DomRow& r) {
 
 void dom_sweep_row(const DomOctant& octant, const DomRow& row) { HWY_DYNAMIC_DISPATCH(DomSweepRow)(octant, row); }
 
-}  // namespace haze::simd
+}  // namespace haze::grids
 #endif  // HWY_ONCE

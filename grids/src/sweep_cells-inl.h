@@ -1,12 +1,12 @@
 // Per-target optical-depth sweep kernel (Highway: included once per target by foreach_target.h).
-#if defined(HAZE_SIMD_SWEEP_CELLS_INL_H_) == defined(HWY_TARGET_TOGGLE)
-#ifdef HAZE_SIMD_SWEEP_CELLS_INL_H_
-#undef HAZE_SIMD_SWEEP_CELLS_INL_H_
+#if defined(HAZE_GRIDS_SWEEP_CELLS_INL_H_) == defined(HWY_TARGET_TOGGLE)
+#ifdef HAZE_GRIDS_SWEEP_CELLS_INL_H_
+#undef HAZE_GRIDS_SWEEP_CELLS_INL_H_
 #else
-#define HAZE_SIMD_SWEEP_CELLS_INL_H_
+#define HAZE_GRIDS_SWEEP_CELLS_INL_H_
 #endif
 
-#include <haze/simd/sweep_cells.h>
+#include <haze/grids/sweep_cells.h>
 
 #include <hwy/highway.h>
 
@@ -14,7 +14,7 @@
 #include <cmath>
 
 HWY_BEFORE_NAMESPACE();
-namespace haze::simd::HWY_NAMESPACE {
+namespace haze::grids::HWY_NAMESPACE {
 namespace hn = hwy::HWY_NAMESPACE;
 
 // One vector of cells: lane m is cell (i, j, k) + min(m, last) e_axis. The formulas of
@@ -165,7 +165,7 @@ HWY_NOINLINE void SweepCells(const SweepVolume& v, int i, int j, int k, int axis
   }
 }
 
-}  // namespace haze::simd::HWY_NAMESPACE
+}  // namespace haze::grids::HWY_NAMESPACE
 HWY_AFTER_NAMESPACE();
 
-#endif  // HAZE_SIMD_SWEEP_CELLS_INL_H_
+#endif  // HAZE_GRIDS_SWEEP_CELLS_INL_H_

@@ -48,7 +48,7 @@
 
 #pragma GCC visibility push(default)  // the public API: exported from shared builds
 
-namespace haze::simd {
+namespace haze::grids {
 
 // The diamond scheme's floor on a denominator (a cell with sigma_t = 0, a direction along a face).
 inline constexpr float kDiamondTiny = 1e-30f;
@@ -81,7 +81,7 @@ struct DomRow {
   const float* density = nullptr;  // per cell
   float sigma_t_scale = 1.0f, albedo = 0.0f;
   const float* first = nullptr;    // [cell * first_stride + d], or null
-  const Half* first_half = nullptr;  // or the same in float16, times first_scale[cell]
+  const simd::Half* first_half = nullptr;  // or the same in float16, times first_scale[cell]
   const float* first_scale = nullptr;
   size_t first_stride = 0;
   // Or null: [cell * 3 + e], the first-collision source's change across the cell along axis e over
@@ -104,6 +104,6 @@ void dom_sweep_row(const DomOctant& octant, const DomRow& row);
 // The scalar reference: the same float32 formulas, one direction at a time.
 void dom_sweep_row_reference(const DomOctant& octant, const DomRow& row);
 
-}  // namespace haze::simd
+}  // namespace haze::grids
 
 #pragma GCC visibility pop

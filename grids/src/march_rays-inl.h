@@ -1,29 +1,29 @@
 // Per-target ray-march kernel (Highway: included once per target by foreach_target.h).
 #include <haze/simd/phase_params.h>
 
-#if defined(HAZE_SIMD_MARCH_RAYS_INL_H_) == defined(HWY_TARGET_TOGGLE)
-#ifdef HAZE_SIMD_MARCH_RAYS_INL_H_
-#undef HAZE_SIMD_MARCH_RAYS_INL_H_
+#if defined(HAZE_GRIDS_MARCH_RAYS_INL_H_) == defined(HWY_TARGET_TOGGLE)
+#ifdef HAZE_GRIDS_MARCH_RAYS_INL_H_
+#undef HAZE_GRIDS_MARCH_RAYS_INL_H_
 #else
-#define HAZE_SIMD_MARCH_RAYS_INL_H_
+#define HAZE_GRIDS_MARCH_RAYS_INL_H_
 #endif
 
-#include <haze/simd/march_rays.h>
+#include <haze/grids/march_rays.h>
 
 #include <hwy/contrib/math/math-inl.h>
 #include <hwy/highway.h>
 
 #include <algorithm>
 
-#include "phase_batch-inl.h"
+#include <haze/simd/phase_batch-inl.h>
 
 HWY_BEFORE_NAMESPACE();
-namespace haze::simd::HWY_NAMESPACE {
+namespace haze::grids::HWY_NAMESPACE {
 namespace hn = hwy::HWY_NAMESPACE;
 
 // One vector of rays starting at ray `first` (lanes past the end repeat the last ray), `C` channels.
 template <int C, class D>
-HWY_INLINE void MarchVector(D d, const MarchVolume& v, const PhaseParams& phase, const RayPacket& rays, size_t first,
+HWY_INLINE void MarchVector(D d, const MarchVolume& v, const simd::PhaseParams& phase, const RayPacket& rays, size_t first,
                             size_t last, float* HWY_RESTRICT radiance_out, float* HWY_RESTRICT transmittance_out) {
   using V = hn::Vec<D>;
   const hn::RebindToSigned<D> di;
@@ -103,7 +103,7 @@ HWY_INLINE void MarchVector(D d, const MarchVolume& v, const PhaseParams& phase,
         falloff = hn::Mul(falloff, visible);
       }
       const V mu = hn::MulAdd(to[0], dir[0], hn::MulAdd(to[1], dir[1], hn::Mul(to[2], dir[2])));
-      const V weight_l = hn::Mul(EvalPhase(d, phase, mu), falloff);
+      const V weight_l = hn::Mul(simd::HWY_NAMESPACE::EvalPhase(d, phase, mu), falloff);
       for (int c = 0; c < C; ++c)
         in[c] = hn::MulAdd(hn::Mul(weight_l, hn::Set(d, light.intensity[c])), hn::Exp(d, hn::Mul(hn::Set(d, -v.sigma_t[c]), depth)), in[c]);
     }
@@ -121,7 +121,7 @@ HWY_INLINE void MarchVector(D d, const MarchVolume& v, const PhaseParams& phase,
 }
 
 template <int C>
-HWY_INLINE void MarchAll(const MarchVolume& v, const PhaseParams& phase, const RayPacket& rays) {
+HWY_INLINE void MarchAll(const MarchVolume& v, const simd::PhaseParams& phase, const RayPacket& rays) {
   const hn::ScalableTag<float> d;
   const size_t lanes = hn::Lanes(d);
   HWY_ALIGN float radiance[3 * hn::MaxLanes(d)], transmittance[3 * hn::MaxLanes(d)];
@@ -135,7 +135,7 @@ HWY_INLINE void MarchAll(const MarchVolume& v, const PhaseParams& phase, const R
   }
 }
 
-HWY_NOINLINE void MarchRays(const MarchVolume& v, const PhaseParams& phase, const RayPacket& rays) {
+HWY_NOINLINE void MarchRays(const MarchVolume& v, const simd::PhaseParams& phase, const RayPacket& rays) {
   if (v.channels == 1) {
     MarchAll<1>(v, phase, rays);
   } else {
@@ -143,7 +143,7 @@ HWY_NOINLINE void MarchRays(const MarchVolume& v, const PhaseParams& phase, cons
   }
 }
 
-}  // namespace haze::simd::HWY_NAMESPACE
+}  // namespace haze::grids::HWY_NAMESPACE
 HWY_AFTER_NAMESPACE();
 
-#endif  // HAZE_SIMD_MARCH_RAYS_INL_H_
+#endif  // HAZE_GRIDS_MARCH_RAYS_INL_H_

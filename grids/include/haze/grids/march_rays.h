@@ -14,7 +14,7 @@
 
 #pragma GCC visibility push(default)  // the public API: exported from shared builds
 
-namespace haze::simd {
+namespace haze::grids {
 
 struct MarchLight {
   enum Type { point, spot, directional } type = point;
@@ -49,6 +49,6 @@ struct RayPacket {
 bool march_supported(const PhaseFunction& phase);
 void march_rays(const MarchVolume& volume, const PhaseFunction& phase, const RayPacket& rays);
 
-}  // namespace haze::simd
+}  // namespace haze::grids
 
 #pragma GCC visibility pop

@@ -8,7 +8,7 @@
 
 #pragma GCC visibility push(default)  // the public API: exported from shared builds
 
-namespace haze::simd {
+namespace haze::particles {
 
 // Structure of arrays; `count` a multiple of kGaussianPad (pad with w = 0, inv_h2 = 0).
 struct GaussianList {
@@ -21,6 +21,6 @@ float gaussian_sum(const GaussianList& terms, float px, float py, float pz, floa
 // The scalar reference (std::exp, summed in order).
 float gaussian_sum_reference(const GaussianList& terms, float px, float py, float pz, float cut2);
 
-}  // namespace haze::simd
+}  // namespace haze::particles
 
 #pragma GCC visibility pop

@@ -1,6 +1,6 @@
 // The discrete-ordinate row sweep on every compiled Highway target against its scalar reference.
 #include <haze/core/rng.h>
-#include <haze/simd/dom_sweep.h>
+#include <haze/grids/dom_sweep.h>
 
 #include <gtest/gtest.h>
 #include <hwy/tests/hwy_gtest.h>
@@ -12,7 +12,7 @@
 #include <cstdint>
 #include <vector>
 
-namespace haze::simd {
+namespace haze::grids {
 namespace {
 
 class DomSweep : public hwy::TestWithParamTarget {};
@@ -49,8 +49,8 @@ TEST_P(DomSweep, MatchesScalarReferenceOnEveryTarget) {
           std::vector<float> density(cells), first(static_cast<size_t>(cells) * up), m_in(static_cast<size_t>(cells * n));
           std::vector<float> slope(3 * static_cast<size_t>(cells));
           fill(density, 0.0f, 4.0f), fill(first, 0.0f, 1.0f), fill(m_in, 0.0f, 2.0f), fill(slope, -2.0f, 2.0f);
-          std::vector<Half> first_half(first.size());
-          to_half_reference(first.data(), first_half.data(), first.size());
+          std::vector<simd::Half> first_half(first.size());
+          simd::to_half_reference(first.data(), first_half.data(), first.size());
           std::vector<float> first_scale(density.size());
           fill(first_scale, 0.5f, 3.0f);
           density[3] = 0.0f;  // an empty cell: pure transport
@@ -202,4 +202,4 @@ TEST(DomDiamond, SecondOrderAcrossAnAbsorber) {
 }
 
 }  // namespace
-}  // namespace haze::simd
+}  // namespace haze::grids

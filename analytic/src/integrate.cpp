@@ -1,11 +1,11 @@
 #include <haze/core/error.h>
-#include <haze/core/integrate.h>
+#include <haze/analytic/integrate.h>
 
 #include <cmath>
 #include <queue>
 #include <vector>
 
-namespace haze {
+namespace haze::analytic {
 
 namespace {
 
@@ -149,4 +149,4 @@ std::vector<double> integrate_adaptive_nodes(const std::function<void(const doub
   return total;
 }
 
-}  // namespace haze
+}  // namespace haze::analytic

@@ -7,7 +7,7 @@
 
 #pragma GCC visibility push(default)  // the public API: exported from shared builds
 
-namespace haze {
+namespace haze::analytic {
 
 struct IntegrationResult {
   double value = 0.0;
@@ -29,6 +29,6 @@ std::vector<double> integrate_adaptive_vector(const std::function<void(double, d
 std::vector<double> integrate_adaptive_nodes(const std::function<void(const double*, int, double*)>& f, int dims, double a,
                                              double b, double rel_tol = 1e-10, int max_intervals = 4096);
 
-}  // namespace haze
+}  // namespace haze::analytic
 
 #pragma GCC visibility pop

@@ -1,18 +1,18 @@
 // Per-target sums of truncated Gaussians (Highway: included once per target by foreach_target.h).
-#if defined(HAZE_SIMD_GAUSSIAN_SUM_INL_H_) == defined(HWY_TARGET_TOGGLE)
-#ifdef HAZE_SIMD_GAUSSIAN_SUM_INL_H_
-#undef HAZE_SIMD_GAUSSIAN_SUM_INL_H_
+#if defined(HAZE_PARTICLES_GAUSSIAN_SUM_INL_H_) == defined(HWY_TARGET_TOGGLE)
+#ifdef HAZE_PARTICLES_GAUSSIAN_SUM_INL_H_
+#undef HAZE_PARTICLES_GAUSSIAN_SUM_INL_H_
 #else
-#define HAZE_SIMD_GAUSSIAN_SUM_INL_H_
+#define HAZE_PARTICLES_GAUSSIAN_SUM_INL_H_
 #endif
 
-#include <haze/simd/gaussian_sum.h>
+#include <haze/particles/gaussian_sum.h>
 
 #include <hwy/contrib/math/math-inl.h>
 #include <hwy/highway.h>
 
 HWY_BEFORE_NAMESPACE();
-namespace haze::simd::HWY_NAMESPACE {
+namespace haze::particles::HWY_NAMESPACE {
 namespace hn = hwy::HWY_NAMESPACE;
 
 inline HWY_NOINLINE float GaussianSum(const GaussianList& g, float px, float py, float pz, float cut2) {
@@ -29,7 +29,7 @@ inline HWY_NOINLINE float GaussianSum(const GaussianList& g, float px, float py,
   return hn::GetLane(hn::SumOfLanes(d, sum));
 }
 
-}  // namespace haze::simd::HWY_NAMESPACE
+}  // namespace haze::particles::HWY_NAMESPACE
 HWY_AFTER_NAMESPACE();
 
 #endif  // include guard

@@ -1,19 +1,19 @@
 // Per-target discrete-ordinate row sweep (Highway: included once per target by foreach_target.h).
-#if defined(HAZE_SIMD_DOM_SWEEP_INL_H_) == defined(HWY_TARGET_TOGGLE)
-#ifdef HAZE_SIMD_DOM_SWEEP_INL_H_
-#undef HAZE_SIMD_DOM_SWEEP_INL_H_
+#if defined(HAZE_GRIDS_DOM_SWEEP_INL_H_) == defined(HWY_TARGET_TOGGLE)
+#ifdef HAZE_GRIDS_DOM_SWEEP_INL_H_
+#undef HAZE_GRIDS_DOM_SWEEP_INL_H_
 #else
-#define HAZE_SIMD_DOM_SWEEP_INL_H_
+#define HAZE_GRIDS_DOM_SWEEP_INL_H_
 #endif
 
-#include <haze/simd/dom_sweep.h>
+#include <haze/grids/dom_sweep.h>
 
 #include <hwy/highway.h>
 
 #include <algorithm>
 
 HWY_BEFORE_NAMESPACE();
-namespace haze::simd::HWY_NAMESPACE {
+namespace haze::grids::HWY_NAMESPACE {
 namespace hn = hwy::HWY_NAMESPACE;
 
 // 1 / x to about float precision for finite x > 0: the approximate reciprocal and one Newton step,
@@ -121,7 +121,7 @@ void DomSweepRow(const DomOctant& o, const DomRow& r) {
     const bool empty = sigma_t_value == 0.0f;
     const float* HWY_RESTRICT m_in = r.m_in && !empty ? r.m_in + c * n : nullptr;
     const float* HWY_RESTRICT first = r.first && !empty ? r.first + c * r.first_stride : nullptr;
-    const Half* HWY_RESTRICT first_half = !r.first && r.first_half && !empty ? r.first_half + c * r.first_stride : nullptr;
+    const simd::Half* HWY_RESTRICT first_half = !r.first && r.first_half && !empty ? r.first_half + c * r.first_stride : nullptr;
     const bool linear = r.first_slope && (first || first_half) && o.diamond;
     V ts[3];
     for (int e = 0; e < 3; ++e)
@@ -213,7 +213,7 @@ void DomSweepRow(const DomOctant& o, const DomRow& r) {
   }
 }
 
-}  // namespace haze::simd::HWY_NAMESPACE
+}  // namespace haze::grids::HWY_NAMESPACE
 HWY_AFTER_NAMESPACE();
 
 #endif  // include guard

@@ -18,7 +18,7 @@
 
 #pragma GCC visibility push(default)  // the public API: exported from shared builds
 
-namespace haze::simd {
+namespace haze::grids {
 
 struct SweepVolume {
   int n[3] = {1, 1, 1};
@@ -39,6 +39,6 @@ void sweep_cells(const SweepVolume& volume, int i, int j, int k, int axis, int c
 // The scalar reference: the same float32 formulas, one cell at a time.
 void sweep_cells_reference(const SweepVolume& volume, int i, int j, int k, int axis, int count, float* depth, float* mean);
 
-}  // namespace haze::simd
+}  // namespace haze::grids
 
 #pragma GCC visibility pop
