@@ -18,6 +18,16 @@ namespace haze::app {
 
 namespace {
 
+// The yardstick and the chooser (method auto) as the registry names them (MethodInfo::Role).
+const std::string& reference_method() {
+  static const std::string name = method_with_role(MethodInfo::Role::reference);
+  return name;
+}
+const std::string& chooser_method() {
+  static const std::string name = method_with_role(MethodInfo::Role::chooser);
+  return name;
+}
+
 struct TradeArgs {
   std::string suite = HAZE_TRADE_SUITE_DIR, out = "build/trade", method;
   long long spp = 16384;
@@ -39,7 +49,7 @@ struct Config {
 std::vector<Config> sweep() {
   std::vector<Config> c;
   for (const MethodInfo& m : registered_methods())
-    if (m.name != "auto")
+    if (m.name != chooser_method())
       for (const nlohmann::json& settings : m.trade_sweep) c.push_back({m.name, settings});
   return c;
 }
@@ -172,7 +182,7 @@ struct Reference {
 // file name, its render time beside it.
 Reference cached_reference(const Scene& scene, const std::string& name, long long spp, const std::filesystem::path& out,
                            const TradeArgs& a) {
-  const auto path = out / "reference" / (name + "_" + std::to_string(spp) + "spp.exr");
+  const auto path = out / reference_method() / (name + "_" + std::to_string(spp) + "spp.exr");
   const auto meta = std::filesystem::path(path).replace_extension(".json");
   Reference ref{spp, {}, {}, 0.0};
   if (std::filesystem::exists(path)) {
@@ -189,7 +199,7 @@ Reference cached_reference(const Scene& scene, const std::string& name, long lon
   options.settings = {{"spp", spp}, {"seed", 1}};
   ProgressBar bar(name + " reference " + std::to_string(spp) + " spp");
   options.progress = bar.callback();
-  RenderResult r = timed_once(scene, "reference", options, ref.seconds);
+  RenderResult r = timed_once(scene, reference_method(), options, ref.seconds);
   write_exr(path, r.radiance, &*r.std_error);
   std::ofstream(meta) << nlohmann::json{{"seconds", ref.seconds}}.dump();
   ref.image = std::move(r.radiance), ref.se = std::move(*r.std_error);
@@ -202,22 +212,22 @@ Reference cached_reference(const Scene& scene, const std::string& name, long lon
 void deepen_reference(const Scene& scene, const std::string& name, const Image& reference, const Image& se, const TradeArgs& a,
                       const std::vector<Row>& kept, std::vector<Row>& rows) {
   const double smallest = *std::min_element(a.tolerances.begin(), a.tolerances.end());
-  auto last = std::find_if(rows.rbegin(), rows.rend(), [](const Row& r) { return r.method == "reference"; });
+  auto last = std::find_if(rows.rbegin(), rows.rend(), [](const Row& r) { return r.method == reference_method(); });
   if (last == rows.rend()) return;
   long long spp = last->settings["spp"].get<long long>();
   double seconds = last->seconds;
   bool met = last->measure() < smallest;
   while (!met && spp < kDeepestSpp) {
     spp *= 2, seconds *= 2;
-    auto faster = [&](const Row& r) { return r.scene == name && r.method != "auto" && r.measure() < smallest && r.seconds < seconds; };
+    auto faster = [&](const Row& r) { return r.scene == name && r.method != chooser_method() && r.measure() < smallest && r.seconds < seconds; };
     if (std::any_of(rows.begin(), rows.end(), faster) || std::any_of(kept.begin(), kept.end(), faster)) return;
     RenderOptions options;
     options.threads = a.threads;
     options.settings = {{"spp", spp}, {"seed", 7}};
     ProgressBar bar(name + " reference " + std::to_string(spp) + " spp");
     options.progress = bar.callback();
-    Row row{name, "reference", options.settings, 0.0, {}, false, {}};
-    row.error = lit_pixel_error(timed_once(scene, "reference", options, row.seconds).radiance, reference, &se);
+    Row row{name, reference_method(), options.settings, 0.0, {}, false, {}};
+    row.error = lit_pixel_error(timed_once(scene, reference_method(), options, row.seconds).radiance, reference, &se);
     seconds = row.seconds;
     print_row(row);
     met = row.measure() < smallest;
@@ -228,7 +238,7 @@ void deepen_reference(const Scene& scene, const std::string& name, const Image& 
 const Row* fastest_within(const std::vector<Row>& rows, const std::string& scene, double tolerance) {
   const Row* best = nullptr;
   for (const Row& r : rows)
-    if (r.scene == scene && r.method != "auto" && r.robust() < tolerance && (!best || r.seconds < best->seconds)) best = &r;
+    if (r.scene == scene && r.method != chooser_method() && r.robust() < tolerance && (!best || r.seconds < best->seconds)) best = &r;
   return best;
 }
 
@@ -241,15 +251,15 @@ void recheck_seeds(const Scene& scene, const std::string& name, const Image& ref
   for (double tolerance : a.tolerances) {
     for (;;) {
       Row* best = const_cast<Row*>(fastest_within(all, name, tolerance));
-      if (!best || best->method != "reference" || best->worst >= 0.0 || best->seconds > kRecheckSeconds) break;
+      if (!best || best->method != reference_method() || best->worst >= 0.0 || best->seconds > kRecheckSeconds) break;
       best->worst = best->measure();
       for (int seed : kRecheckSeeds) {
         RenderOptions options;
         options.threads = a.threads;
         options.settings = {{"spp", best->settings["spp"]}, {"seed", seed}};
-        const double error = lit_pixel_error(render(scene, "reference", options).radiance, reference, &se).rms_noise_removed;
+        const double error = lit_pixel_error(render(scene, reference_method(), options).radiance, reference, &se).rms_noise_removed;
         best->worst = std::max(best->worst, error);
-        std::printf("%-15s %-12s %-40s seed %d: %8s\n", name.c_str(), "reference", compact(best->settings).c_str(), seed, percent(error).c_str());
+        std::printf("%-15s %-12s %-40s seed %d: %8s\n", name.c_str(), reference_method().c_str(), compact(best->settings).c_str(), seed, percent(error).c_str());
         std::fflush(stdout);
       }
     }
@@ -300,16 +310,18 @@ void write_tradeoffs(const std::filesystem::path& file, const std::vector<std::s
   for (const auto& scene : scenes) {
     const Row* fast = nullptr;  // the most accurate measurement of a method other than the reference
     for (const Row& r : rows)
-      if (r.scene == scene && r.method != "auto" && r.method != "reference" && (!fast || r.measure() < fast->measure())) fast = &r;
+      if (r.scene == scene && r.method != chooser_method() && r.method != reference_method() && (!fast || r.measure() < fast->measure())) fast = &r;
     const Row* five = fastest_within(rows, scene, 0.05);
     md << "- **" << scene << "**: the most accurate fast method is "
        << (fast ? fast->method + " (" + compact(fast->settings) + ") at " + percent(fast->measure()) + " in " + secs(fast->seconds) : std::string("none"))
        << "; under 5% the fastest is " << (five ? five->method + " at " + secs(five->seconds) : std::string("nothing the sweep measured")) << ".\n";
   }
-  md << "\nThe single-scattering methods (analytic, quadrature, propagation) miss the light scattered more than\n"
-        "once; every method but the reference and dom lights surfaces with unscattered light only, and only\n"
-        "the reference and dom send the light surfaces reflect back into the medium (dom: from surfaces\n"
-        "outside its grid or on its faces). On scenes where either matters, the path tracer itself is the\n"
+  std::string single;
+  for (const MethodInfo& m : registered_methods())
+    if (m.single_scattering) single += (single.empty() ? "" : ", ") + m.name;
+  md << "\nThe single-scattering methods (" << single << ") miss the light scattered more than once. How each\n"
+        "method lights surfaces, and whether it sends the light they reflect back into the medium, is in\n"
+        "docs/METHODS.md (`haze methods`). On scenes where either matters, the path tracer itself is the\n"
         "fastest way under a tight tolerance.\n";
   md << "\n## Recommended settings per error level\n\nThe fastest measured method and settings under each error level, per scene (- : none of\n"
         "the sweep reached it).\n\n| scene | under 10% | under 5% | under 2% | under 1% |\n|---|---|---|---|---|\n";
@@ -329,11 +341,11 @@ void write_tradeoffs(const std::filesystem::path& file, const std::vector<std::s
         "| scene | T | auto chose | seconds | error | the same, swept | under T | fastest under T | auto / fastest |\n"
         "|---|---|---|---|---|---|---|---|---|\n";
   for (const Row& r : rows) {
-    if (r.method != "auto") continue;
+    if (r.method != chooser_method()) continue;
     const double t = r.settings["tolerance"].get<double>();
     const Row* best = fastest_within(rows, r.scene, t);
     const auto same = std::find_if(rows.begin(), rows.end(), [&](const Row& o) {
-      return o.scene == r.scene && o.method != "auto" && o.method + " " + compact(o.settings) == r.chosen;
+      return o.scene == r.scene && o.method != chooser_method() && o.method + " " + compact(o.settings) == r.chosen;
     });
     char ratio[32] = "-";
     if (best) std::snprintf(ratio, sizeof ratio, "%.2fx", r.seconds / best->seconds);
@@ -347,7 +359,7 @@ void write_tradeoffs(const std::filesystem::path& file, const std::vector<std::s
   for (const auto& scene : scenes) {
     md << "\n### " << scene << "\n\n![" << scene << "](trade_" << scene << ".png)\n\n| method | settings | seconds | error | signed mean |\n|---|---|---|---|---|\n";
     for (const Row& r : rows) {
-      if (r.scene != scene || r.method == "auto") continue;
+      if (r.scene != scene || r.method == chooser_method()) continue;
       const std::string b = r.pareto ? "**" : "";
       md << "| " << b << r.method << b << " | " << compact(r.settings) << " | " << secs(r.seconds) << " | " << b << percent(r.measure()) << b
          << " | " << percent(r.error.signed_mean) << " |\n";
@@ -363,7 +375,7 @@ int run(const TradeArgs& a) {
   for (const auto& path : scenes) names.push_back(path.stem().string());
   const std::filesystem::path out = a.out;
   std::filesystem::create_directories(out / "plot");
-  std::filesystem::create_directories(out / "reference");
+  std::filesystem::create_directories(out / reference_method());
 
   std::vector<Row> all;
   if (a.report_only) {
@@ -424,20 +436,20 @@ int run(const TradeArgs& a) {
       print_row(row);
       rows.push_back(row);
     }
-    if (a.method.empty() || a.method == "reference") deepen_reference(scene, name, reference, se, a, all, rows);
+    if (a.method.empty() || a.method == reference_method()) deepen_reference(scene, name, reference, se, a, all, rows);
     all.insert(all.end(), rows.begin(), rows.end());
     recheck_seeds(scene, name, reference, se, a, all);
-    if (!a.method.empty() && a.method != "auto") continue;
+    if (!a.method.empty() && a.method != chooser_method()) continue;
     for (double tolerance : a.tolerances) {
       RenderOptions options;
       options.threads = a.threads;
       options.cache_dir = default_cache_dir();
       options.settings = {{"tolerance", tolerance}};
-      Row row{name, "auto", options.settings, 0.0, {}, false, {}};
-      const RenderResult r = timed_once(scene, "auto", options, row.seconds);  // once: its choice may be a long reference render
+      Row row{name, chooser_method(), options.settings, 0.0, {}, false, {}};
+      const RenderResult r = timed_once(scene, chooser_method(), options, row.seconds);  // once: its choice may be a long reference render
       row.error = lit_pixel_error(r.radiance, reference, &se);
-      row.chosen = r.stats["auto"]["method"].get<std::string>() + " " + compact(r.stats["auto"]["settings"]);
-      if (r.stats["auto"]["settings"].contains("target_noise"))  // the reference's rounds: the samples they took
+      row.chosen = r.stats[chooser_method()]["method"].get<std::string>() + " " + compact(r.stats[chooser_method()]["settings"]);
+      if (r.stats[chooser_method()]["settings"].contains("target_noise"))  // the reference's rounds: the samples they took
         row.chosen += ": spp=" + std::to_string(r.stats["method_stats"]["spp"].get<long long>());
       print_row(row);
       all.push_back(row);
@@ -449,7 +461,7 @@ int run(const TradeArgs& a) {
   for (const std::string& name : names) {
     std::vector<Row*> scene_rows;
     for (Row& r : all)
-      if (r.scene == name && r.method != "auto") scene_rows.push_back(&r);
+      if (r.scene == name && r.method != chooser_method()) scene_rows.push_back(&r);
     for (Row* r : scene_rows)
       r->pareto = std::none_of(scene_rows.begin(), scene_rows.end(), [&](const Row* o) {
         return o != r && o->seconds <= r->seconds && o->measure() <= r->measure() && (o->seconds < r->seconds || o->measure() < r->measure());
@@ -468,7 +480,7 @@ int run(const TradeArgs& a) {
   // Plot data: one file per scene and method (seconds, error), and the scene's Pareto front.
   std::map<std::string, std::ofstream> files;
   for (const Row& r : all) {
-    if (r.method == "auto") continue;
+    if (r.method == chooser_method()) continue;
     auto& f = files[r.scene + "__" + r.method];
     if (!f.is_open()) f.open(out / "plot" / (r.scene + "__" + r.method + ".dat"));
     f << r.seconds << " " << std::max(r.measure(), 1e-4) << "\n";

@@ -63,7 +63,7 @@ RenderResult reference_render(const Scene& scene, long long spp, int threads, co
   options.settings = {{"spp", spp}, {"seed", 1}};
   ProgressBar bar(label);
   options.progress = bar.callback();
-  return render(scene, "reference", options);
+  return render(scene, method_with_role(MethodInfo::Role::reference), options);
 }
 
 Plan plan(const std::filesystem::path& file, const DemoArgs& a) {
@@ -166,7 +166,8 @@ int run(const DemoArgs& a) {
   const std::vector<std::filesystem::path> scenes = scene_files(a.examples, "--examples");
   auto methods = registered_methods();
   // auto is a chooser and the reference the yardstick: the rows are the methods auto chooses from.
-  std::erase_if(methods, [](const MethodInfo& m) { return m.name == "auto" || m.name == "reference"; });
+  std::erase_if(methods, [](const MethodInfo& m) { return m.role != MethodInfo::Role::solver; });
+  const std::string reference_name = method_with_role(MethodInfo::Role::reference);
 
   std::vector<Plan> plans;
   for (const auto& file : scenes) plans.push_back(plan(file, a));
@@ -201,17 +202,17 @@ int run(const DemoArgs& a) {
     }
     const double reference_noise = lit_pixel_error(reference, reference, &noise).noise_rms;
     const auto ref_exr = std::filesystem::path(a.out) / (stem + "_reference.exr");
-    save_result({reference, noise, {}}, "reference", seconds, ref_exr, true);
+    save_result({reference, noise, {}}, reference_name, seconds, ref_exr, true);
     char took[32];
     std::snprintf(took, sizeof took, "%.3f", seconds);
-    std::printf("%-16s %-12s %9s %10s %9s  %s (%lld spp%s)\n", stem.c_str(), "reference", size.c_str(), seconds > 0 ? took : "cached",
+    std::printf("%-16s %-12s %9s %10s %9s  %s (%lld spp%s)\n", stem.c_str(), reference_name.c_str(), size.c_str(), seconds > 0 ? took : "cached",
                 ("noise " + percent(reference_noise)).c_str(), ref_exr.string().c_str(), p.spp, seconds > 0 ? "" : ", from the cache");
     if (reference_noise > 0.05)
       std::printf("%-16s %-12s   errors under %s are not resolved; --reference-seconds %.0f would bring the noise to about 5%%\n", "", "",
                   percent(1.5 * reference_noise).c_str(),
                   a.reference_seconds * (reference_noise / 0.05) * (reference_noise / 0.05));
     std::vector<Image> shown, compared;
-    std::string order = "reference";
+    std::string order = reference_name;
     for (const auto& method : methods) {
       auto timed = [&](const Scene& at, const std::string& label) {
         RenderOptions options;

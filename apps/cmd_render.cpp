@@ -94,16 +94,17 @@ int render_scene(const RenderArgs& a, const Deadline& deadline) {
       throw Error(std::string("--set ") + key, json_text(options.settings[key]), std::string("not given with ") + flag + " (one of them)");
     options.settings[key] = *value;
   }
+  const std::string chooser = method_with_role(MethodInfo::Role::chooser);
   if (a.tolerance) {
-    if (method != "auto") throw Error("--tolerance", std::to_string(*a.tolerance), "--method auto (the only method that takes a tolerance)");
+    if (method != chooser) throw Error("--tolerance", std::to_string(*a.tolerance), "--method " + chooser + " (the only method that takes a tolerance)");
     options.settings["tolerance"] = *a.tolerance;
   }
-  if (a.explain && method != "auto") throw Error("--explain", "method " + method, "--method auto (the choice it explains)");
+  if (a.explain && method != chooser) throw Error("--explain", "method " + method, "--method " + chooser + " (the choice it explains)");
   if (a.explain) {  // before the render, which may be long
-    nlohmann::json settings = scene.method_name() == "auto" ? scene.method : nlohmann::json::object();
+    nlohmann::json settings = scene.method_name() == chooser ? scene.method : nlohmann::json::object();
     for (const auto& [key, value] : options.settings.items()) settings[key] = value;
     const AutoChoice choice = choose_method(scene, settings.value("tolerance", 0.05));
-    std::cout << "auto chose " << choice.method << " " << choice.settings.dump() << ", expected "
+    std::cout << chooser << " chose " << choice.method << " " << choice.settings.dump() << ", expected "
               << (choice.expected_seconds > 0.0 ? to_text(choice.expected_seconds) + " s (the trade suite's closest scene)"
                                                 : std::string("time unknown (the reference renders until its noise target)"))
               << "\n";

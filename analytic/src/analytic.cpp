@@ -21,6 +21,9 @@
 
 namespace haze::analytic {
 
+// The method's name, written once: the registry, its settings and its errors read it here.
+constexpr const char* kAnalyticName = "analytic";
+
 namespace {
 
 // out[i] += airlight of segment i: add_airlight (SIMD, float32) or add_airlight_float64.
@@ -357,7 +360,7 @@ class AnalyticMethod final : public Method {
   }
 
   std::unique_ptr<MethodSolution> prepare(const Scene& scene, const RenderOptions& options) const override {
-    Settings settings(options.settings, "analytic");
+    Settings settings(options.settings, kAnalyticName);
     const int a_samples = static_cast<int>(settings.integer("table_a"));
     const int eta_samples = static_cast<int>(settings.integer("table_eta"));
     const bool surface_airlight = settings.integer("surface_airlight") == 1;
@@ -463,7 +466,7 @@ class AnalyticMethod final : public Method {
 
 MethodInfo analytic_info() {
   MethodInfo info;
-  info.name = "analytic";
+  info.name = kAnalyticName;
   info.summary = "closed-form single scattering, homogeneous medium, point and spot lights (seed 002; the airlight unshadowed)";
   info.create = [] { return std::make_unique<AnalyticMethod>(); };
   info.handles = {"constant density (bounded or not)", "point, spot",

@@ -14,6 +14,9 @@
 
 namespace haze {
 
+// The method's name, written once: the registry, its settings and its errors read it here.
+constexpr const char* kAutoName = "auto";
+
 namespace {
 
 std::string format(const char* f, double a, double b = 0.0, double c = 0.0) {
@@ -29,7 +32,7 @@ std::string format(const char* f, double a, double b = 0.0, double c = 0.0) {
 constexpr double kNoiseShare = 0.75;
 
 AutoChoice reference_for(double tolerance, AutoChoice choice) {
-  choice.method = "reference";
+  choice.method = method_with_role(MethodInfo::Role::reference);
   // Rounded to 6 decimals so the setting prints as written (0.0375, not 0.037500000000000006).
   choice.settings = {{"target_noise", std::round(kNoiseShare * tolerance * 1e6) / 1e6}, {"seed", 5}};
   choice.why.push_back(format("reference: adds samples until its own noise over the lit pixels is %.2f T (%.2f%%)", kNoiseShare,
@@ -71,7 +74,7 @@ class AutoSolution final : public MethodSolution {
 class AutoMethod final : public Method {
  public:
   std::unique_ptr<MethodSolution> prepare(const Scene& scene, const RenderOptions& options) const override {
-    Settings settings(options.settings, "auto");
+    Settings settings(options.settings, kAutoName);
     const double tolerance = settings.number("tolerance");
     settings.reject_unknown();
     const AutoChoice choice = choose_method(scene, tolerance);
@@ -172,7 +175,8 @@ AutoChoice choose(const Scene& scene, double tolerance) {
 
 MethodInfo internal::auto_info() {
   MethodInfo info;
-  info.name = "auto";
+  info.name = kAutoName;
+  info.role = MethodInfo::Role::chooser;
   info.emission = true;  // only methods that render emission bid for an emitting medium
   info.summary = "the cheapest registered method and settings expected to meet --set tolerance=T (0.05), chosen from the scene alone";
   info.create = [] { return std::make_unique<AutoMethod>(); };

@@ -14,6 +14,9 @@
 
 namespace haze::internal {
 
+// The method's name, written once: the registry, its settings and its errors read it here.
+constexpr const char* kQuadratureName = "quadrature";
+
 namespace {
 
 constexpr int kNodesPerPanel = 8;
@@ -170,7 +173,7 @@ class QuadratureSolution final : public MethodSolution {
 class QuadratureMethod final : public Method {
  public:
   std::unique_ptr<MethodSolution> prepare(const Scene& scene, const RenderOptions& options) const override {
-    Settings settings(options.settings, "quadrature");
+    Settings settings(options.settings, kQuadratureName);
     const int steps = static_cast<int>(settings.integer("steps"));
     const int sky_count = static_cast<int>(settings.integer("sky_directions"));
     settings.reject_unknown();
@@ -182,7 +185,7 @@ class QuadratureMethod final : public Method {
 
 MethodInfo quadrature_info() {
   MethodInfo info;
-  info.name = "quadrature";
+  info.name = kQuadratureName;
   info.summary = "single scattering by deterministic numerical quadrature (any medium; a yardstick, not fast)";
   info.create = [] { return std::make_unique<QuadratureMethod>(); };
   info.handles = {"any: constant, RBF and grid densities, the particles' density", "point, spot, directional, sky",

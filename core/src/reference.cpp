@@ -17,6 +17,9 @@
 
 namespace haze::internal {
 
+// The method's name, written once: the registry, its settings and its errors read it here.
+constexpr const char* kReferenceName = "reference";
+
 namespace {
 
 constexpr long long kSamplesPerBlock = 1024;  // a work item: one pixel's samples in blocks of this size
@@ -436,7 +439,7 @@ class ReferenceSolution final : public MethodSolution {
 class ReferenceMethod final : public Method {
  public:
   std::unique_ptr<MethodSolution> prepare(const Scene& scene, const RenderOptions& options) const override {
-    Settings settings(options.settings, "reference");
+    Settings settings(options.settings, kReferenceName);
     ReferenceSettings s;
     // With target_noise, samples are added in rounds until the image's own relative noise over
     // the lit pixels (lit_pixel_error's noise_rms) is at most target_noise; spp is then the cap.
@@ -455,7 +458,8 @@ class ReferenceMethod final : public Method {
 
 MethodInfo reference_info() {
   MethodInfo info;
-  info.name = "reference";
+  info.name = kReferenceName;
+  info.role = MethodInfo::Role::reference;
   info.summary = "unbiased volumetric path tracer with a standard-error image (the yardstick for every method)";
   info.create = [] { return std::make_unique<ReferenceMethod>(); };
   info.handles = {"any: constant, RBF and grid densities, the particles' density", "point, spot, directional, sky",

@@ -19,6 +19,9 @@
 
 namespace haze::grids {
 
+// The method's name, written once: the registry, its settings and its errors read it here.
+constexpr const char* kDomName = "dom";
+
 namespace {
 
 // The cells an integer resolution gives at least through a thinner side, per optical depth
@@ -333,7 +336,7 @@ class DomMethod final : public Method {
 }  // namespace
 
 DomFields dom_setup(const Scene& scene, const RenderOptions& options) {
-  Settings settings(options.settings, "dom");
+  Settings settings(options.settings, kDomName);
   // Cells along the longest side, at least 4 per optical depth through a thinner axis (up to 32),
   // or exactly the three counts given.
   CellCount cells;
@@ -474,7 +477,7 @@ AutoOffer surface_offer(const SceneFeatures& f, double tolerance) {
 
 MethodInfo dom_info() {
   MethodInfo info;
-  info.name = "dom";
+  info.name = kDomName;
   info.emission = true;  // an isotropic source in the sweeps (lights the medium and surfaces) and in the camera's march
   info.summary = "multiple scattering on grids: discrete ordinates with a separable phase function (seed 000)";
   info.create = [] { return std::make_unique<DomMethod>(); };

@@ -13,6 +13,9 @@
 
 namespace haze::grids {
 
+// The method's name, written once: the registry, its settings and its errors read it here.
+constexpr const char* kPropagationName = "propagation";
+
 namespace {
 
 void check_lights(const std::vector<Light>& lights) {
@@ -82,7 +85,7 @@ class PropagationMethod final : public Method {
 }  // namespace
 
 PropagationFields propagation_fields(const Scene& scene, const RenderOptions& options) {
-  Settings settings(options.settings, "propagation");
+  Settings settings(options.settings, kPropagationName);
   const int resolution = static_cast<int>(settings.integer("resolution"));
   DepthOptions depth;
   depth.scheme = depth_scheme_from_name(settings.choice("optical_depth"));
@@ -114,7 +117,7 @@ PropagationFields propagation_fields(const Scene& scene, const RenderOptions& op
 
 MethodInfo propagation_info() {
   MethodInfo info;
-  info.name = "propagation";
+  info.name = kPropagationName;
   info.summary = "single scattering in heterogeneous media: RBF injection, optical-depth volumes, ray marching (seed 003)";
   info.create = [] { return std::make_unique<PropagationMethod>(); };
   info.handles = {"RBF, grid and bounded constant densities, the particles' density", "point, spot, directional",

@@ -10,6 +10,9 @@
 
 namespace haze::particles {
 
+// The method's name, written once: the registry, its settings and its errors read it here.
+constexpr const char* kNetworkName = "network";
+
 namespace {
 
 constexpr int kTile = 16;
@@ -375,7 +378,7 @@ class NetworkMethodSolution final : public MethodSolution {
 class NetworkMethod final : public Method {
  public:
   std::unique_ptr<MethodSolution> prepare(const Scene& scene, const RenderOptions& options) const override {
-    Settings settings(options.settings, "network");
+    Settings settings(options.settings, kNetworkName);
     NetworkSettings network;
     network.directions = static_cast<int>(settings.integer("directions"));
     network.window = static_cast<int>(settings.integer("window"));
@@ -401,7 +404,7 @@ class NetworkMethod final : public Method {
 
 MethodInfo network_info() {
   MethodInfo info;
-  info.name = "network";
+  info.name = kNetworkName;
   info.summary = "multiple scattering in particle media: visibility and illumination networks (seed 001)";
   info.create = [] { return std::make_unique<NetworkMethod>(); };
   info.emission = true;  // where the particles are: each one's L_e / (sigma_t rho) in the iteration and the camera's march

@@ -9,6 +9,9 @@
 #include <algorithm>
 
 namespace haze {
+
+// The method's name, written once: the registry, its settings and its errors read it here.
+constexpr const char* kToyName = "toy";
 namespace {
 
 // Renders every pixel at `brightness` times the medium's albedo.
@@ -29,7 +32,7 @@ class ToySolution final : public MethodSolution {
 class ToyMethod final : public Method {
  public:
   std::unique_ptr<MethodSolution> prepare(const Scene& scene, const RenderOptions& options) const override {
-    Settings settings(options.settings, "toy");
+    Settings settings(options.settings, kToyName);
     const double brightness = settings.number("brightness");
     settings.reject_unknown();
     return std::make_unique<ToySolution>(brightness * scene.medium.value_or(MediumDesc{}).albedo);
@@ -38,7 +41,7 @@ class ToyMethod final : public Method {
 
 MethodInfo toy_info() {
   MethodInfo info;
-  info.name = "toy";
+  info.name = kToyName;
   info.summary = "a constant image (a test of the registry)";
   info.create = [] { return std::make_unique<ToyMethod>(); };
   info.handles = {"any", "any", "none", false};

@@ -68,6 +68,11 @@ struct AutoOffer {
 using AutoRule = std::function<AutoOffer(const SceneFeatures& features, double tolerance)>;
 
 struct MethodInfo {
+  // What a method is to the tools that pick among methods (method auto, `haze demo`, `haze bench
+  // trade`): one that solves, the unbiased reference every other is measured against, or one that
+  // chooses another and delegates to it.
+  enum class Role { solver, reference, chooser };
+
   std::string name;
   std::string summary;  // one line for `haze render --help` and error messages
   std::function<std::unique_ptr<Method>()> create;
@@ -84,6 +89,7 @@ struct MethodInfo {
   // Renders a medium's emission (MediumDesc::emission); haze::prepare refuses an emitting medium
   // to a method without it.
   bool emission = false;
+  Role role = Role::solver;
 
   const SettingInfo* setting(const std::string& key) const;
 };
@@ -123,6 +129,10 @@ void register_method(MethodInfo info);
 std::vector<MethodInfo> registered_methods();
 // Throws haze::Error listing the available methods when the name is unknown.
 std::unique_ptr<Method> create_method(const std::string& name);
+// The name of the registered method with this role (the first by name); haze::Error when none is.
+std::string method_with_role(MethodInfo::Role role);
+// Whether `name` is a registered method with this role.
+bool has_role(const std::string& name, MethodInfo::Role role);
 
 // A prepared method: render any camera without solving again, update it when the scene changes,
 // read its fields. Made by haze::prepare; movable, not copyable.
