@@ -12,8 +12,8 @@
 #include <haze/grids/methods.h>
 #include <haze/grids/optical_depth.h>
 
-#include "cloud_scene.h"  // tests/grids: the scenes the dom tests measure
-#include "slab_scene.h"
+#include "scenes/cloud_scene.h"  // the scenes the dom tests measure
+#include "scenes/slab_scene.h"
 
 #include <cmath>
 #include <cstdio>

@@ -11,23 +11,17 @@
 #include <cmath>
 #include <cstdio>
 
+#include "scenes/lumpy_cloud.h"
+
 using namespace haze;
 using namespace haze::grids;
 
 namespace {
 
 DenseGrid medium(int n, bool heterogeneous) {
+  if (heterogeneous) return lumpy_cloud(n);
   DenseGrid g({n, n, n}, {Vec3(-1), Vec3(1)});
-  if (!heterogeneous) {
-    std::fill(g.values().begin(), g.values().end(), 1.0f);
-    return g;
-  }
-  std::vector<RbfBlob> blobs;
-  for (int i = 0; i < 12; ++i) {
-    double t = 0.5 * i;
-    blobs.push_back({Vec3(0.5 * std::cos(t), 0.4 * std::sin(1.3 * t), 0.45 * std::cos(0.7 * t + 1)), 1.0 + 0.5 * std::sin(t), 3.0 + (i % 4)});
-  }
-  inject_rbf(blobs, g);
+  std::fill(g.values().begin(), g.values().end(), 1.0f);
   return g;
 }
 

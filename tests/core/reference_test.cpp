@@ -7,6 +7,8 @@
 
 #include <gtest/gtest.h>
 
+#include "scenes/fog_box.h"
+
 namespace haze {
 namespace {
 
@@ -76,7 +78,7 @@ struct SlabCase {
   double tolerance = 0.01;  // relative, against the published value
 };
 
-class Slab : public testing::TestWithParam<SlabCase> {};
+class Slab : public ::testing::TestWithParam<SlabCase> {};
 
 // Each within 3 standard errors and within 1% of the published value, and within 3 combined
 // standard errors of the independent local-estimate Monte Carlo.
@@ -101,7 +103,7 @@ TEST_P(Slab, MatchesPublishedReflectionAndTransmission) {
 // DISORT test problems (Stamnes et al.; van de Hulst 1980 tables).
 INSTANTIATE_TEST_SUITE_P(
     Disort, Slab,
-    testing::Values(SlabCase{"thin_absorbing_top_mu01", 0.03125, 0.2, 0.0, 0.1, 0.1, true, 0.117771, 3 << 20},
+    ::testing::Values(SlabCase{"thin_absorbing_top_mu01", 0.03125, 0.2, 0.0, 0.1, 0.1, true, 0.117771, 3 << 20},
                     SlabCase{"thin_absorbing_top_mu05", 0.03125, 0.2, 0.0, 0.1, 0.5, true, 0.0264170, 13 << 20},
                     SlabCase{"thin_absorbing_top_mu1", 0.03125, 0.2, 0.0, 0.1, 1.0, true, 0.0134041, 26 << 20},
                     SlabCase{"thin_conservative_top_mu05", 0.03125, 1.0, 0.0, 0.1, 0.5, true, 0.139763, 4 << 20},
@@ -158,16 +160,7 @@ TEST(Reference, WhiteFurnace) {
 // Single scattering only (max_scattering 1) against the deterministic quadrature method: a point
 // light in a bounded homogeneous medium, image means within 0.5%, pixels within 4 standard errors.
 TEST(Reference, SingleScatteringMatchesQuadrature) {
-  Scene scene;
-  scene.camera.position = Vec3(0, 0.3, 3);
-  scene.camera.width_px = scene.camera.height_px = 8;
-  MediumDesc m;
-  m.bounds = {Vec3(-1), Vec3(1)};
-  m.sigma_t = Rgb(0.8, 1.0, 1.3);
-  m.albedo = Rgb(0.7);
-  m.phase = PhaseFunction::henyey_greenstein(0.5);
-  scene.medium = m;
-  scene.lights.push_back(PointLight{Vec3(0.4, 0.5, -0.2), Rgb(3.0)});
+  const Scene scene = testing::unit_fog({3.0, Rgb(0.8, 1.0, 1.3), Rgb(0.7), 0.5, PointLight{Vec3(0.4, 0.5, -0.2), Rgb(3.0)}});
   RenderOptions reference;
   reference.settings = {{"spp", 1 << 18}, {"max_scattering", 1}};
   auto mc = render(scene, "reference", reference);

@@ -13,7 +13,7 @@
 
 #include <cstdio>
 
-#include "../grids/cloud_scene.h"
+#include "scenes/cloud_scene.h"
 
 namespace haze::gl {
 namespace {

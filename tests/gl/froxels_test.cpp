@@ -10,7 +10,7 @@
 #include <glm/trigonometric.hpp>
 #include <gtest/gtest.h>
 
-#include "../methods/fog_box.h"
+#include "scenes/fog_box.h"
 
 #include <limits>
 

@@ -7,9 +7,9 @@
 #include <haze/grids/methods.h>
 #include <haze/grids/optical_depth.h>
 
-#include "cloud_scene.h"
-#include "slab_scene.h"
-#include "small_cloud.h"
+#include "scenes/cloud_scene.h"
+#include "scenes/slab_scene.h"
+#include "scenes/small_cloud.h"
 
 #include <gtest/gtest.h>
 

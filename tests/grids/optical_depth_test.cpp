@@ -8,24 +8,14 @@
 #include <gtest/gtest.h>
 #include <hwy/tests/hwy_gtest.h>
 
+#include "scenes/lumpy_cloud.h"
+
 namespace haze::grids {
 namespace {
 
 DenseGrid constant_grid(int n, float rho) {
   DenseGrid g({n, n, n}, {Vec3(-1), Vec3(1)});
   std::fill(g.values().begin(), g.values().end(), rho);
-  return g;
-}
-
-// A lumpy cloud: 12 blobs over the unit cube's middle.
-DenseGrid cloud(int n) {
-  DenseGrid g({n, n, n}, {Vec3(-1), Vec3(1)});
-  std::vector<RbfBlob> blobs;
-  for (int i = 0; i < 12; ++i) {
-    double t = 0.5 * i;
-    blobs.push_back({Vec3(0.5 * std::cos(t), 0.4 * std::sin(1.3 * t), 0.45 * std::cos(0.7 * t + 1)), 1.0 + 0.5 * std::sin(t), 3.0 + (i % 4)});
-  }
-  inject_rbf(blobs, g);
   return g;
 }
 
@@ -73,7 +63,7 @@ TEST(OpticalDepth, SweepAndExactAgreeInAHomogeneousGrid) {
 // light: the mean error over the mean depth, and the mean relative error where the depth is at
 // least 0.1 (below that relative errors of tiny depths say little about transmittance).
 TEST(OpticalDepth, SweepIsWithinTwoPercentOfExactInAHeterogeneousMedium) {
-  DenseGrid g = cloud(64);
+  DenseGrid g = lumpy_cloud(64);
   for (const Light& light : {Light{PointLight{Vec3(0.05, 0.1, -0.02)}}, Light{PointLight{Vec3(1.8, 1.1, 0.6)}},
                              Light{DirectionalLight{glm::normalize(Vec3(0.4, -1.0, 0.3))}}}) {
     DenseGrid exact = optical_depth(g, light, {DepthScheme::exact});

@@ -6,7 +6,7 @@
 #include <haze/grids/optical_depth.h>
 #include <haze/grids/propagation.h>
 
-#include "cloud_scene.h"
+#include "scenes/cloud_scene.h"
 
 #include <gtest/gtest.h>
 

@@ -8,7 +8,7 @@
 #include <haze/grids/propagation.h>
 #include <haze/grids/methods.h>
 
-#include "cloud_scene.h"
+#include "scenes/cloud_scene.h"
 
 #include <gtest/gtest.h>
 

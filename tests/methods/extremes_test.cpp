@@ -15,21 +15,14 @@
 #include <string>
 #include <vector>
 
+#include "scenes/fog_box.h"
+
 namespace haze {
 namespace {
 
 // Fog in [-1, 1]^3 over a floor at y = -1, a point light inside and the sun; 8 x 8 pixels.
 Scene fog_box() {
-  Scene scene;
-  scene.camera.position = Vec3(0.0, 0.3, 4.0);
-  scene.camera.width_px = scene.camera.height_px = 8;
-  MediumDesc fog;
-  fog.bounds = {Vec3(-1.0), Vec3(1.0)};
-  fog.sigma_t = Rgb(1.0, 1.2, 1.4);
-  fog.albedo = Rgb(0.9);
-  fog.phase = PhaseFunction::henyey_greenstein(0.5);
-  scene.medium = fog;
-  scene.lights.push_back(PointLight{Vec3(0.3, 0.5, 0.2), Rgb(5.0)});
+  Scene scene = testing::unit_fog({4.0, Rgb(1.0, 1.2, 1.4), Rgb(0.9), 0.5, PointLight{Vec3(0.3, 0.5, 0.2), Rgb(5.0)}});
   scene.lights.push_back(DirectionalLight{glm::normalize(Vec3(0.3, -1.0, -0.2)), Rgb(1.0)});
   scene.surfaces.push_back(Surface{Plane{Vec3(0.0, -1.0, 0.0), Vec3(0.0, 1.0, 0.0)}, Rgb(0.5), Rgb(0.0), 1.0});
   scene.background = Rgb(0.01);

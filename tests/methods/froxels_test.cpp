@@ -8,7 +8,7 @@
 
 #include <gtest/gtest.h>
 
-#include "fog_box.h"
+#include "scenes/fog_box.h"
 
 #include <cmath>
 #include <cstdio>

@@ -11,7 +11,7 @@
 #include <glm/trigonometric.hpp>
 #include <gtest/gtest.h>
 
-#include "fog_box.h"
+#include "scenes/fog_box.h"
 
 #include <algorithm>
 #include <cmath>

@@ -7,7 +7,7 @@
 #include <haze/core/method.h>
 #include <haze/grids/methods.h>
 
-#include "../grids/cloud_scene.h"
+#include "scenes/cloud_scene.h"
 
 #include <gtest/gtest.h>
 

@@ -6,7 +6,7 @@
 #include <haze/grids/dom.h>
 #include <haze/mpi/dom.h>
 
-#include "../grids/small_cloud.h"
+#include "scenes/small_cloud.h"
 
 #include <gtest/gtest.h>
 

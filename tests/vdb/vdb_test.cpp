@@ -8,7 +8,7 @@
 #include <haze/particles/methods.h>
 #include <haze/vdb/vdb.h>
 
-#include "../grids/cloud_scene.h"
+#include "scenes/cloud_scene.h"
 
 #include <gtest/gtest.h>
 #include <nanovdb/util/IO.h>
