@@ -353,7 +353,7 @@ DomFields dom_setup(const Scene& scene, const RenderOptions& options) {
     throw Error("method.terms", to_text(dom.terms), "at most method.directions (" + to_text(dom.directions) + "), or 0 for the full matrix");
   dom.scheme = dom_scheme_from_name(settings.choice("scheme"));
   // The paper's scheme is the step scheme: it takes diamond only when asked (and refuses it).
-  dom.spatial = dom_spatial_from_name(settings.choice("spatial", dom.scheme == DomScheme::paper ? "step" : "diamond"));
+  dom.spatial = dom_spatial_from_name(dom.scheme == DomScheme::paper ? settings.choice("spatial", name(DomSpatial::step)) : settings.choice("spatial"));
   dom.accelerator = dom_accelerator_from_name(settings.choice("accelerator"));
   dom.max_iterations = static_cast<int>(settings.integer("iterations"));
   dom.tolerance = settings.number("tolerance");
@@ -489,17 +489,17 @@ MethodInfo dom_info() {
                          "RBF and constant media: cells along the longest side of the bounds (and at least 4 per optical depth through a thinner side, up to 32), or [nx, ny, nz]"),
       SettingInfo::integer("directions", d.directions, 8, 4096, "D, spherical Fibonacci directions"),
       SettingInfo::integer("terms", nullptr, 0, 4096, "N separable terms of the phase matrix: min(25, D); 0 or D: the full matrix"),
-      SettingInfo::choice("scheme", "sweep", {"paper", "sweep"}, "sweep: upwind transport sweeps; paper: seed 000's Jacobi scheme"),
-      SettingInfo::choice("spatial", "diamond", {"step", "diamond", "bounded"},
+      SettingInfo::choice("scheme", name(d.scheme), names_of<DomScheme>(kDomSchemes), "sweep: upwind transport sweeps; paper: seed 000's Jacobi scheme"),
+      SettingInfo::choice("spatial", name(d.spatial), names_of<DomSpatial>(kDomSpatials),
                           "how radiance leaves a cell: weighted diamond difference (second order; bounded where radiance would go below 0), "
                           "bounded everywhere (damps lamps' ray effects in fog), or seed 000's step (step with scheme paper)"),
-      SettingInfo::choice("accelerator", "gmres", {"none", "gmres"}, "GMRES on the moments, or plain source iteration"),
+      SettingInfo::choice("accelerator", name(d.accelerator), names_of<DomAccelerator>(kDomAccelerators), "GMRES on the moments, or plain source iteration"),
       SettingInfo::integer("iterations", d.max_iterations, 1, 100000, "transport sweeps per channel at most"),
       SettingInfo::number("tolerance", d.tolerance, 1e-9, 1.0, "stop when an iteration changes the moments by less (relative)"),
       SettingInfo::integer("delta_m", 1, 0, 1, "delta-M scaling of the phase function when N < D"),
       SettingInfo::integer("dsa", 1, 0, 1, "diffusion synthetic acceleration of source iteration (warm updates with a sweep budget)"),
-      SettingInfo::choice("storage", "float32", {"float32", "float16"}, "float16 halves the first-collision source and GMRES basis"),
-      SettingInfo::choice("optical_depth", "exact", {"exact", "paper", "sweep"}, "how the depth to each light is computed"),
+      SettingInfo::choice("storage", name(d.storage), names_of<DomStorage>(kDomStorages), "float16 halves the first-collision source and GMRES basis"),
+      SettingInfo::choice("optical_depth", name(DepthScheme::exact), names_of<DepthScheme>(kDepthSchemes), "how the depth to each light is computed"),
       SettingInfo::number("step", 0.5, 0.01, 4.0, "camera gather's ray-march step in cells"),
       SettingInfo::integer("warm_iterations", 0, 0, 100000, "source-iteration sweeps per update, the first-collision source in each (0: GMRES to the tolerance)"),
       SettingInfo::integer("surface_passes", 2, 0, 100, "solves with the light surfaces reflect into the medium, one more bounce each (scheme sweep)"),

@@ -16,36 +16,14 @@
 
 namespace haze::grids {
 
-DomScheme dom_scheme_from_name(const std::string& name) {
-  if (name == "paper") return DomScheme::paper;
-  if (name == "sweep") return DomScheme::sweep;
-  throw Error("scheme", name, "\"paper\" or \"sweep\"");
-}
-const char* name(DomScheme scheme) { return scheme == DomScheme::paper ? "paper" : "sweep"; }
-
-DomSpatial dom_spatial_from_name(const std::string& name) {
-  if (name == "step") return DomSpatial::step;
-  if (name == "diamond") return DomSpatial::diamond;
-  if (name == "bounded") return DomSpatial::bounded;
-  throw Error("spatial", name, "\"step\", \"diamond\" or \"bounded\"");
-}
-const char* name(DomSpatial spatial) {
-  return spatial == DomSpatial::step ? "step" : spatial == DomSpatial::diamond ? "diamond" : "bounded";
-}
-
-DomAccelerator dom_accelerator_from_name(const std::string& name) {
-  if (name == "none") return DomAccelerator::none;
-  if (name == "gmres") return DomAccelerator::gmres;
-  throw Error("accelerator", name, "\"none\" or \"gmres\"");
-}
-const char* name(DomAccelerator accelerator) { return accelerator == DomAccelerator::none ? "none" : "gmres"; }
-
-DomStorage dom_storage_from_name(const std::string& name) {
-  if (name == "float32") return DomStorage::float32;
-  if (name == "float16") return DomStorage::float16;
-  throw Error("storage", name, "\"float32\" or \"float16\"");
-}
-const char* name(DomStorage storage) { return storage == DomStorage::float32 ? "float32" : "float16"; }
+DomScheme dom_scheme_from_name(const std::string& name) { return from_name<DomScheme>(kDomSchemes, name, "scheme"); }
+const char* name(DomScheme scheme) { return name_of<DomScheme>(kDomSchemes, scheme); }
+DomSpatial dom_spatial_from_name(const std::string& name) { return from_name<DomSpatial>(kDomSpatials, name, "spatial"); }
+const char* name(DomSpatial spatial) { return name_of<DomSpatial>(kDomSpatials, spatial); }
+DomAccelerator dom_accelerator_from_name(const std::string& name) { return from_name<DomAccelerator>(kDomAccelerators, name, "accelerator"); }
+const char* name(DomAccelerator accelerator) { return name_of<DomAccelerator>(kDomAccelerators, accelerator); }
+DomStorage dom_storage_from_name(const std::string& name) { return from_name<DomStorage>(kDomStorages, name, "storage"); }
+const char* name(DomStorage storage) { return name_of<DomStorage>(kDomStorages, storage); }
 
 namespace {
 

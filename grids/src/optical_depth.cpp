@@ -279,21 +279,8 @@ void compute_sweep(const DenseGrid& density, const LightGeometry& g, DenseGrid& 
 
 }  // namespace
 
-DepthScheme depth_scheme_from_name(const std::string& scheme) {
-  if (scheme == "exact") return DepthScheme::exact;
-  if (scheme == "paper") return DepthScheme::paper;
-  if (scheme == "sweep") return DepthScheme::sweep;
-  throw Error("optical_depth", "\"" + scheme + "\"", "\"exact\", \"paper\" or \"sweep\"");
-}
-
-const char* name(DepthScheme scheme) {
-  switch (scheme) {
-    case DepthScheme::exact: return "exact";
-    case DepthScheme::paper: return "paper";
-    case DepthScheme::sweep: return "sweep";
-  }
-  return "?";
-}
+DepthScheme depth_scheme_from_name(const std::string& scheme) { return from_name<DepthScheme>(kDepthSchemes, scheme, "optical_depth"); }
+const char* name(DepthScheme scheme) { return name_of<DepthScheme>(kDepthSchemes, scheme); }
 
 DenseGrid optical_depth(const DenseGrid& density, const Light& light, const DepthOptions& options, DepthStats* stats) {
   if (options.sweep_layers < 1 || options.sweep_layers > 64)

@@ -123,7 +123,7 @@ MethodInfo propagation_info() {
   info.handles = {"RBF, grid and bounded constant densities, the particles' density", "point, spot, directional",
                   "planes, spheres and meshes lit by unscattered light through the depth volumes, with shadows", false};
   info.settings = {SettingInfo::integer("resolution", 64, 2, 1024, "cells along the longest side of the medium's bounds (RBF and constant)"),
-                   SettingInfo::choice("optical_depth", "sweep", {"exact", "paper", "sweep"}, "how the depth to each light is computed"),
+                   SettingInfo::choice("optical_depth", name(DepthOptions{}.scheme), names_of<DepthScheme>(kDepthSchemes), "how the depth to each light is computed"),
                    SettingInfo::integer("sweep_layers", 4, 1, 64, "sweep: cell layers each short characteristic walks exactly"),
                    SettingInfo::number("step", 0.5, 0.01, 4.0, "ray-march step in cells"),
                    SettingInfo::number("cutoff", 0.0, 0.0, 1e30, "RBF injection cutoff (0: 1e-4 of the largest weight)"),

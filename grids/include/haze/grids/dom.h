@@ -10,6 +10,7 @@
 
 #include <haze/core/light.h>
 #include <haze/core/method.h>
+#include <haze/core/names.h>
 #include <haze/core/phase_matrix.h>
 #include <haze/core/progress.h>
 #include <haze/grids/optical_depth.h>
@@ -35,7 +36,8 @@ enum class DomScheme {
   // iteration are kept (flux-moment form of SN codes).
   sweep,
 };
-DomScheme dom_scheme_from_name(const std::string& name);  // "paper", "sweep"
+inline constexpr Named<DomScheme> kDomSchemes[] = {{DomScheme::paper, "paper"}, {DomScheme::sweep, "sweep"}};
+DomScheme dom_scheme_from_name(const std::string& name);
 const char* name(DomScheme scheme);
 
 // How a cell's radiance leaves through its faces in scheme `sweep` (simd/dom_sweep.h).
@@ -49,14 +51,16 @@ enum class DomSpatial {
   // numerical diffusion damps the ray effects of lamps in fog (docs/DOM.md).
   bounded,
 };
-DomSpatial dom_spatial_from_name(const std::string& name);  // "step", "diamond", "bounded"
+inline constexpr Named<DomSpatial> kDomSpatials[] = {{DomSpatial::step, "step"}, {DomSpatial::diamond, "diamond"}, {DomSpatial::bounded, "bounded"}};
+DomSpatial dom_spatial_from_name(const std::string& name);
 const char* name(DomSpatial spatial);
 
 enum class DomAccelerator {
   none,
   gmres,  // restarted GMRES on the moments (a Krylov method on the source-iteration operator)
 };
-DomAccelerator dom_accelerator_from_name(const std::string& name);  // "none", "gmres"
+inline constexpr Named<DomAccelerator> kDomAccelerators[] = {{DomAccelerator::none, "none"}, {DomAccelerator::gmres, "gmres"}};
+DomAccelerator dom_accelerator_from_name(const std::string& name);
 const char* name(DomAccelerator accelerator);
 
 enum class DomStorage {
@@ -66,7 +70,8 @@ enum class DomStorage {
   // Arithmetic, the iterate and the solution's moments stay float32. Scheme `sweep` only.
   float16,
 };
-DomStorage dom_storage_from_name(const std::string& name);  // "float32", "float16"
+inline constexpr Named<DomStorage> kDomStorages[] = {{DomStorage::float32, "float32"}, {DomStorage::float16, "float16"}};
+DomStorage dom_storage_from_name(const std::string& name);
 const char* name(DomStorage storage);
 
 // A solve split over processes by z planes (haze::mpi implements one over MPI; docs/SCALING.md):

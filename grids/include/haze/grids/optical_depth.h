@@ -5,6 +5,7 @@
 #pragma once
 
 #include <haze/core/light.h>
+#include <haze/core/names.h>
 #include <haze/core/surface.h>
 #include <haze/grids/grid.h>
 
@@ -20,7 +21,8 @@ enum class DepthScheme {
   paper,  // seed 003 eq. 6-7: 6-neighbour weighted gathering, iterated as a wavefront until converged
   sweep,  // short characteristics: one ordered pass outward from the light (BEYOND.md)
 };
-DepthScheme depth_scheme_from_name(const std::string& name);  // "exact", "paper", "sweep"
+inline constexpr Named<DepthScheme> kDepthSchemes[] = {{DepthScheme::exact, "exact"}, {DepthScheme::paper, "paper"}, {DepthScheme::sweep, "sweep"}};
+DepthScheme depth_scheme_from_name(const std::string& name);
 const char* name(DepthScheme scheme);
 
 struct DepthOptions {
