@@ -140,7 +140,7 @@ ExtinctionVolume make_extinction_volume(const Scene& scene, const CellCount& cel
     volume.density.values().assign(grid->samples().begin(), grid->samples().end());
   } else {
     const auto& constant = std::get<ConstantDensity>(desc.density);
-    if (!bounds.bounded()) throw Error("medium.bounds", "unbounded", "bounds for a constant density in the propagation method");
+    if (!bounds.bounded()) throw Error("medium.bounds", "unbounded", "bounds for a constant density on a grid (methods propagation and dom)");
     bounds = clip_to_planes(bounds, scene);
     fitted_grid(volume.density, bounds, cells, largest(desc.sigma_t),
                 [&](DenseGrid& g) { std::fill(g.values().begin(), g.values().end(), static_cast<float>(constant.value)); });

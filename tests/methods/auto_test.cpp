@@ -87,6 +87,15 @@ TEST(AutoMethod, SurfacesInFogGetTheDomThenTheReferenceWithMoreSamplesForLessErr
   EXPECT_EQ(thin_tight.settings["resolution"].get<int>(), 32);
 }
 
+// Unbounded fog over a floor (examples/lamps_fog.json's kind): no grid holds it, so the dom does
+// not bid (it did, and the render it chose failed on the medium's bounds).
+TEST(AutoMethod, UnboundedFogOverSurfacesIsNotGivenAGrid) {
+  Scene scene = box_scene(0.5, 0.8);
+  scene.medium->bounds = Aabb();
+  scene.surfaces.push_back(Surface{Plane{Vec3(0.0, -1.0, 0.0), Vec3(0.0, 1.0, 0.0)}, Rgb(0.5), Rgb(0.0), 1.0});
+  for (double tolerance : {0.1, 0.05}) EXPECT_NE(choose_method(scene, tolerance).method, "dom") << tolerance;
+}
+
 TEST(AutoMethod, RendersWithItsChoiceAndRefusesABadTolerance) {
   const Scene scene = box_scene(0.002, 0.5);
   RenderOptions options;
