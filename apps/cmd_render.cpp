@@ -4,7 +4,7 @@
 #include "mpi_world.h"
 #include "progress_bar.h"
 
-#include <haze/core/auto.h>
+#include <haze/auto/auto.h>
 #include <haze/core/error.h>
 #include <haze/core/stopwatch.h>
 #include <haze/vdb/vdb.h>

@@ -1,4 +1,5 @@
 #include <haze/all.h>
+#include <haze/auto/auto.h>
 #include <haze/analytic/methods.h>
 #include <haze/grids/methods.h>
 #include <haze/particles/methods.h>
@@ -7,6 +8,7 @@
 namespace haze {
 
 void register_all() {
+  register_auto();
   analytic::register_methods();
   grids::register_methods();
   particles::register_methods();

@@ -20,7 +20,5 @@ inline constexpr double kSurfaceOffset = 1e-7;
 MethodInfo quadrature_info();
 // The unbiased volumetric path tracer every fast method is measured against (reference.cpp).
 MethodInfo reference_info();
-// The cheapest method expected to meet a tolerance, chosen from the registry's offers (auto.cpp).
-MethodInfo auto_info();
 
 }  // namespace haze::internal

@@ -17,7 +17,7 @@ struct Registry {
   std::mutex mutex;
   std::map<std::string, MethodInfo> methods;
   Registry() {
-    for (MethodInfo info : {internal::quadrature_info(), internal::reference_info(), internal::auto_info()})
+    for (MethodInfo info : {internal::quadrature_info(), internal::reference_info()})
       methods[info.name] = std::move(info);
   }
 };

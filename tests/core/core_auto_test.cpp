@@ -1,6 +1,6 @@
 // Method auto with core's methods only (this program registers no module): what no registered
 // method offers goes to the reference, and the explanation says which declined and why.
-#include <haze/core/auto.h>
+#include <haze/auto/auto.h>
 
 #include <gtest/gtest.h>
 

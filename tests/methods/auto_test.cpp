@@ -1,7 +1,7 @@
 // Method auto: the scene features it reads (a closed-form optical diameter), the offers of the
 // registered methods they drive, its refusal of a bad tolerance, and that the render follows the
 // choice. Every module's methods are registered (a test program of core alone sees only core's).
-#include <haze/core/auto.h>
+#include <haze/auto/auto.h>
 #include <haze/core/error.h>
 #include <haze/grids/methods.h>
 #include <haze/particles/methods.h>

@@ -1,6 +1,6 @@
 // A host's view (DESIGN.md, "Callers"): the layers L_in, T and C per pixel, and a depth buffer
 // that ends the rays, for every method.
-#include <haze/core/auto.h>
+#include <haze/auto/auto.h>
 #include <haze/core/error.h>
 #include <haze/core/method.h>
 #include <haze/grids/methods.h>

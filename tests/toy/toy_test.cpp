@@ -1,6 +1,6 @@
 // A toy method added in this one file, as a module would add one: the registry, settings
 // validation, the help text and method "auto" all see it through its MethodInfo alone.
-#include <haze/core/auto.h>
+#include <haze/auto/auto.h>
 #include <haze/core/error.h>
 #include <haze/core/method.h>
 

@@ -1,5 +1,6 @@
-// Every module this build of Haze has, registered with core's registries in one call: the methods
-// of analytic, grids and particles (core's own, quadrature, reference and auto, are always there),
+// Every module this build of Haze has, registered with core's registries in one call: method auto
+// and the methods of analytic, grids and particles (core's own, quadrature and reference, are
+// always there),
 // the density types of particles and vdb. The command, Python, the examples and the tests call it.
 #pragma once
 

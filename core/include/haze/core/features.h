@@ -25,7 +25,6 @@ struct SceneFeatures {
   // the chance that light scattered once meets the medium again before it leaves.
   double multiple_share = 0.0;
 };
-SceneFeatures scene_features(const Scene& scene);
 inline bool field_density(const SceneFeatures& f) { return !f.density.empty() && f.density != "constant" && f.density != "rbf" && f.density != "grid"; }
 
 // Single scattering is enough when the multiple-scattering share is under half the tolerance (for

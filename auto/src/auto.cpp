@@ -1,12 +1,10 @@
-// Method "auto" (core/auto.h): scene features, the rules that turn them into a method and settings,
+// Method "auto" (haze/auto/auto.h): scene features, the rules that turn them into a method and settings,
 // and the method that renders with the choice. The thresholds are the trade suite's measurements
 // (docs/TRADEOFFS.md); each rule says which measurement it rests on.
-#include <haze/core/auto.h>
+#include <haze/auto/auto.h>
 
 #include <haze/core/error.h>
 #include <haze/core/medium.h>
-
-#include "builtin_methods.h"
 
 #include <algorithm>
 #include <cmath>
@@ -81,7 +79,7 @@ class AutoMethod final : public Method {
     RenderOptions delegated = options;
     delegated.settings = choice.settings;
     auto solution = std::make_unique<AutoSolution>(haze::prepare(scene, choice.method, delegated));
-    solution->stats = {{"auto", {{"tolerance", tolerance}, {"method", choice.method}, {"settings", choice.settings}, {"why", choice.why}}}};
+    solution->stats = {{kAutoName, {{"tolerance", tolerance}, {"method", choice.method}, {"settings", choice.settings}, {"why", choice.why}}}};
     return solution;
   }
 };
@@ -173,7 +171,7 @@ AutoChoice choose(const Scene& scene, double tolerance) {
 
 }  // namespace
 
-MethodInfo internal::auto_info() {
+MethodInfo auto_info() {
   MethodInfo info;
   info.name = kAutoName;
   info.role = MethodInfo::Role::chooser;
@@ -185,6 +183,8 @@ MethodInfo internal::auto_info() {
   for (double t : {0.05, 0.02, 0.01}) info.trade_sweep.push_back({{"tolerance", t}});
   return info;
 }
+
+void register_auto() { register_method(auto_info()); }
 
 AutoChoice choose_method(const Scene& scene, double tolerance) {
   if (!(tolerance > 0.0 && tolerance < 1.0)) throw Error("tolerance", format("%g", tolerance), "a relative error in (0, 1), e.g. 0.05");

@@ -2,6 +2,7 @@
 // tolerance, chosen from the scene alone (never from a reference image). Each registered method
 // bids through its MethodInfo::offer, whose thresholds and expected times come from the trade
 // measurements (docs/TRADEOFFS.md, `haze bench trade`); the reference takes what nothing offers.
+// Module auto/ (target haze::auto), above core: it chooses among whatever is registered.
 #pragma once
 
 #include <haze/core/features.h>
@@ -24,6 +25,12 @@ struct AutoChoice {
 // The lowest expected time among the registered methods' offers, else the reference with
 // target_noise 0.75 T. Throws haze::Error for a tolerance outside (0, 1).
 AutoChoice choose_method(const Scene& scene, double tolerance);
+// What the offers look at, computed from the scene alone.
+SceneFeatures scene_features(const Scene& scene);
+
+// The registry's entry for method "auto", and its registration (haze::register_all calls it).
+MethodInfo auto_info();
+void register_auto();
 
 }  // namespace haze
 
