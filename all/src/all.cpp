@@ -1,6 +1,6 @@
 #include <haze/all.h>
-#include <haze/auto/auto.h>
 #include <haze/analytic/methods.h>
+#include <haze/auto/auto.h>
 #include <haze/grids/methods.h>
 #include <haze/particles/methods.h>
 #include <haze/vdb/vdb.h>

@@ -67,13 +67,6 @@ std::string method_with_role(MethodInfo::Role role) {
   throw Error("method.role", to_text(static_cast<int>(role)), "a registered method of that role");
 }
 
-bool has_role(const std::string& name, MethodInfo::Role role) {
-  auto& r = registry();
-  std::lock_guard lock(r.mutex);
-  const auto it = r.methods.find(name);
-  return it != r.methods.end() && it->second.role == role;
-}
-
 std::filesystem::path default_cache_dir() {
   if (const char* dir = std::getenv("HAZE_CACHE_DIR"); dir && *dir) return dir;
   if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg && *xdg) return std::filesystem::path(xdg) / "haze";

@@ -22,7 +22,8 @@
 
 namespace haze {
 
-// A method turns a scene into a solution (docs/ARCHITECTURE.md, "The shape for callers"); the solution renders views.
+// A method turns a scene into a solution (docs/ARCHITECTURE.md, "The shape for callers"); the
+// solution renders views.
 class Method {
  public:
   virtual ~Method() = default;
@@ -131,8 +132,6 @@ std::vector<MethodInfo> registered_methods();
 std::unique_ptr<Method> create_method(const std::string& name);
 // The name of the registered method with this role (the first by name); haze::Error when none is.
 std::string method_with_role(MethodInfo::Role role);
-// Whether `name` is a registered method with this role.
-bool has_role(const std::string& name, MethodInfo::Role role);
 
 // A prepared method: render any camera without solving again, update it when the scene changes,
 // read its fields. Made by haze::prepare; movable, not copyable.
