@@ -2,6 +2,7 @@
 
 #include <haze/core/error.h>
 #include <haze/core/method.h>
+#include <haze/core/names.h>
 
 #include <algorithm>
 #include <cstdlib>
@@ -64,7 +65,9 @@ std::string method_with_role(MethodInfo::Role role) {
   std::lock_guard lock(r.mutex);
   for (const auto& [name, info] : r.methods)
     if (info.role == role) return name;
-  throw Error("method.role", to_text(static_cast<int>(role)), "a registered method of that role");
+  constexpr Named<MethodInfo::Role> kRoles[] = {
+      {MethodInfo::Role::solver, "solver"}, {MethodInfo::Role::reference, "reference"}, {MethodInfo::Role::chooser, "chooser"}};
+  throw Error("method.role", name_of<MethodInfo::Role>(kRoles, role), "a registered method of that role");
 }
 
 std::filesystem::path default_cache_dir() {

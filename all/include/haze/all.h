@@ -1,7 +1,7 @@
-// Every module this build of Haze has, registered with core's registries in one call: method auto
-// and the methods of analytic, grids and particles (core's own, quadrature and reference, are
-// always there),
-// the density types of particles and vdb. The command, Python, the examples and the tests call it.
+// Every module this build of Haze has, registered with core's registries in one call: method auto,
+// the methods of analytic, grids and particles (core's own, quadrature and reference, are always
+// there) and the density types of particles and vdb. The command, Python, the examples and the
+// tests call it.
 #pragma once
 
 #pragma GCC visibility push(default)  // the public API: exported from shared builds
