@@ -132,8 +132,9 @@ int render_scene(const RenderArgs& a, const Deadline& deadline) {
     throw Error(a.display == "gl" ? "--display" : "--fields", a.display == "gl" ? "gl" : a.fields, "neither under mpirun (rank 0 holds the image only)");
   RenderResult result;
   std::vector<std::string> fields;
+  options.ranks = world();
   if (split) {
-    result = render_split(scene, method, options, view);
+    result = render(scene, method, options, view);
     if (quiet) return 0;
   } else if (!a.fields.empty()) {  // one solution for the image and the fields (prepared for any view)
     const Solution solution = prepare(scene, method, options);

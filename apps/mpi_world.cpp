@@ -1,4 +1,4 @@
-// MpiWorld and render_split (mpi_world.h): haze::mpi where this build has it.
+// MpiWorld and world (mpi_world.h): haze::mpi where this build has it.
 #include "mpi_world.h"
 
 #include <haze/core/error.h>
@@ -6,7 +6,7 @@
 #include <cstdlib>
 
 #ifdef HAZE_WITH_MPI
-#include <haze/mpi/render.h>
+#include <haze/mpi/methods.h>
 
 #include <mpi.h>
 #endif
@@ -33,6 +33,7 @@ MpiWorld::MpiWorld([[maybe_unused]] int& argc, [[maybe_unused]] char**& argv) {
   int provided = 0;
   MPI_Init_thread(&argc, &argv, MPI_THREAD_FUNNELED, &provided);
   started = true;
+  mpi::register_methods();
 #else
   if (launched_ranks() > 1)
     throw Error("mpirun", to_text(launched_ranks()) + " processes", "one: this haze was built without MPI (scripts/setup installs OpenMPI)");
@@ -61,15 +62,11 @@ int world_ranks() {
   return ranks;
 }
 
-RenderResult render_split([[maybe_unused]] const Scene& scene, const std::string& method, [[maybe_unused]] const RenderOptions& options,
-                          [[maybe_unused]] const View& view) {
-  if (method != "dom")
-    throw Error("--method", method, "dom under mpirun with " + to_text(world_ranks()) + " ranks (the one method split over MPI ranks), or one rank");
+std::shared_ptr<const Ranks> world() {
 #ifdef HAZE_WITH_MPI
-  return mpi::render_dom(MPI_COMM_WORLD, scene, view, options);
-#else
-  throw Error("mpirun", "this haze", "a haze built with MPI");
+  if (started) return mpi::ranks(MPI_COMM_WORLD);
 #endif
+  return nullptr;
 }
 
 }  // namespace haze::app

@@ -1,16 +1,17 @@
 // The `haze` command under mpirun (docs/SCALING.md, "Rendering"): MPI is started when a launcher
-// started this process (OpenMPI's, MPICH's or a PMIx one), and `haze render --method dom` then
-// splits the scene's grid over the ranks; rank 0 alone writes and prints.
+// started this process (OpenMPI's, MPICH's or a PMIx one), and `haze render` then splits the
+// method over the ranks (those haze::mpi splits: dom); rank 0 alone writes and prints.
 #pragma once
 
 #include <haze/core/solution.h>
 
-#include <string>
+#include <memory>
 
 namespace haze::app {
 
-// MPI_Init_thread when launched by mpirun (a haze::Error when this build has no MPI and the
-// launcher started more than one process); MPI_Finalize at the end.
+// MPI_Init_thread and the split methods registered (haze::mpi::register_methods) when launched
+// by mpirun (a haze::Error when this build has no MPI and the launcher started more than one
+// process); MPI_Finalize at the end.
 class MpiWorld {
  public:
   MpiWorld(int& argc, char**& argv);
@@ -22,8 +23,8 @@ class MpiWorld {
 int world_rank();   // 0 without MPI
 int world_ranks();  // 1 without MPI
 
-// `method` over the world's ranks (haze::mpi::render_dom; a haze::Error for any method but dom):
-// the image on rank 0, an empty result on the others.
-RenderResult render_split(const Scene& scene, const std::string& method, const RenderOptions& options, const View& view);
+// The world's ranks for RenderOptions::ranks under mpirun (haze::mpi::ranks of MPI_COMM_WORLD,
+// whose split methods MpiWorld registered), null without it.
+std::shared_ptr<const Ranks> world();
 
 }  // namespace haze::app

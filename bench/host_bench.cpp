@@ -3,7 +3,7 @@
 // prepared before the loop. Stages: the per-pixel layers (Solution::render with the depth), the
 // froxel build (160 x 90 x 64) and the CPU composite of the froxels at 1080p (the GL pass's work).
 // Media: homogeneous fog (analytic, SIMD airlight) and a 128^3 heterogeneous cloud (propagation).
-#include <haze/core/froxels.h>
+#include <haze/froxels/froxels.h>
 #include <haze/core/rng.h>
 #include <haze/all.h>
 

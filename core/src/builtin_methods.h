@@ -7,6 +7,9 @@ namespace haze {
 // The registry's entry for a method (throws haze::Error listing the methods when unknown;
 // method.cpp, for solution.cpp).
 MethodInfo method_info(const std::string& name);
+// The form of method `name` split over processes (register_split); when it has none, null for
+// one rank and a haze::Error naming those there are for more.
+std::unique_ptr<Method> create_split(const std::string& name, int ranks);
 }  // namespace haze
 
 namespace haze::internal {

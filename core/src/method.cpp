@@ -17,6 +17,7 @@ namespace {
 struct Registry {
   std::mutex mutex;
   std::map<std::string, MethodInfo> methods;
+  std::map<std::string, std::function<std::unique_ptr<Method>()>> splits;  // register_split
   Registry() {
     for (MethodInfo info : {internal::quadrature_info(), internal::reference_info()})
       methods[info.name] = std::move(info);
@@ -59,6 +60,31 @@ MethodInfo method_info(const std::string& name) {
 }
 
 std::unique_ptr<Method> create_method(const std::string& name) { return method_info(name).create(); }
+
+AutoOffer offer_from(std::span<const MeasuredOffer> table, double tolerance, const std::string& what, const std::string& otherwise) {
+  for (const MeasuredOffer& row : table)
+    if (tolerance >= row.tolerance) return AutoOffer{true, row.settings, row.seconds, what + ": " + row.measured};
+  return AutoOffer{false, {}, 0.0, otherwise};
+}
+
+void register_split(const std::string& method, std::function<std::unique_ptr<Method>()> create) {
+  if (method.empty() || !create) throw Error("method.name", "\"" + method + "\"", "a name and a factory for its split form");
+  auto& r = registry();
+  std::lock_guard lock(r.mutex);
+  r.splits[method] = std::move(create);
+}
+
+std::unique_ptr<Method> create_split(const std::string& name, int ranks) {
+  auto& r = registry();
+  std::lock_guard lock(r.mutex);
+  const auto it = r.splits.find(name);
+  if (it != r.splits.end()) return it->second();
+  if (ranks == 1) return nullptr;
+  std::string names;
+  for (const auto& [n, create] : r.splits) names += (names.empty() ? "" : ", ") + n;
+  throw Error("method.name", name, "a method split over processes under " + to_text(ranks) + " ranks (" + (names.empty() ? "none is registered" : names) +
+                                       "), or one process");
+}
 
 std::string method_with_role(MethodInfo::Role role) {
   auto& r = registry();

@@ -254,7 +254,8 @@ Solution prepare(const Scene& scene, const std::string& method_name, RenderOptio
       if (info.emission) methods += (methods.empty() ? "" : ", ") + info.name;
     throw Error("medium.emission", "an emitting medium for method " + name, "a method that renders emission: " + methods);
   }
-  state->method = state->info.create();
+  if (options.ranks) state->method = create_split(name, options.ranks->size());
+  if (!state->method) state->method = state->info.create();
   state->scene = scene;
   nlohmann::json settings = method_settings(scene, name, options.settings);
   const ProgressCallback progress = std::move(options.progress);

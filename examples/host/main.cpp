@@ -9,7 +9,7 @@
 //                                --tolerance (default 0.45) or the means differ by more than 3%
 //                                (docs/HOST.md gives the figures)
 #include <haze/core/error.h>
-#include <haze/core/froxels.h>
+#include <haze/froxels/froxels.h>
 #include <haze/core/image.h>
 #include <haze/gl/context.h>
 #include <haze/gl/froxels.h>

@@ -428,49 +428,64 @@ namespace {
 nlohmann::json fine_cell_settings(int resolution, int terms) {
   return {{"resolution", resolution}, {"directions", 64}, {"terms", terms}, {"storage", "float16"}};
 }
-
-AutoOffer dom_offer(int resolution, int directions, int terms, double seconds, std::string why) {
-  return AutoOffer{true, {{"resolution", resolution}, {"directions", directions}, {"terms", terms}}, seconds, std::move(why)};
-}
-
+nlohmann::json cells(int resolution, int directions, int terms) { return {{"resolution", resolution}, {"directions", directions}, {"terms", terms}}; }
 // Surfaces in fog: the diamond bounded in every cell, whose diffusion damps the lamps' ray effects
 // (fog_lamps 2.19% at 48^3 against 2.58% with the fix-up alone; thin_haze 1.61% and 1.59%).
-AutoOffer fog_offer(int resolution, int directions, int terms, double seconds, std::string why) {
-  AutoOffer offer = dom_offer(resolution, directions, terms, seconds, std::move(why));
-  offer.settings["spatial"] = "bounded";
-  return offer;
+nlohmann::json fog_cells(int resolution, int directions, int terms) {
+  nlohmann::json settings = cells(resolution, directions, terms);
+  settings["spatial"] = "bounded";
+  return settings;
 }
 
-// With surfaces, from the trade suite's surface scenes (surface passes in the solve):
-//   cloud_sun (an RBF cloud over a floor, albedo 0.92; measured 2026-12-02 with the diamond's
-//   fix-up): 3.3% at 16^3, 1.9% at 24^3, 1.1% at 32^3 (1.2 s), 0.68% at 48^3 with 64 directions
-//   (2.4 s), 0.49% with 128 (4.0 s), 0.37% at 64^3;
-//   fog_lamps and thin_haze (constant fog over a floor with a sphere inside the grid; multiple
-//   shares 58% and 16%; spatial bounded; measured 2026-12-02): 4.0% and 3.0% at 16^3 (0.35 s),
-//   3.1% and 2.0% at 24^3 (0.8 s), 2.3% and 1.6% at 32^3 (1.7 s), 2.2% and 1.6% at 48^3 (4 s), no
-//   better past it (2.4% and 1.6% at 96^3: the sphere neither blocks nor sends light in the sweeps).
-// Clouds of higher albedo than cloud_sun's take the dense cloud's resolutions (the rule below).
-AutoOffer surface_offer(const SceneFeatures& f, double tolerance) {
-  if (f.homogeneous) {
-    if (tolerance >= 0.05) return fog_offer(16, 32, 9, 0.35, "surfaces in fog: fog_lamps and thin_haze measured 4.0% and 3.0% at 16^3");
-    if (tolerance >= 0.035) return fog_offer(24, 48, 16, 0.8, "surfaces in fog: fog_lamps and thin_haze measured 3.1% and 2.0% at 24^3");
-    if (tolerance >= 0.03) return fog_offer(32, 80, 25, 1.7, "surfaces in fog: fog_lamps and thin_haze measured 2.3% and 1.6% at 32^3");
-    if (f.multiple_share < 0.3 && tolerance >= 0.02)
-      return fog_offer(32, 80, 25, 1.7, "surfaces in thin fog: thin_haze (multiple share 16%) measured 1.6% at 32^3");
-    if (tolerance >= 0.025) return fog_offer(48, 128, 25, 4.0, "surfaces in fog: fog_lamps measured 2.2% at 48^3");
-    return AutoOffer{false, {}, 0.0,
-                     f.multiple_share < 0.3 ? "surfaces in thin fog: 1.6% at best on the suite"
-                                            : "surfaces in fog: 2.2% at best on the suite (a sphere inside the grid is left out of the sweeps)"};
+// Auto's offers, from the trade suite's scenes against their references (haze bench trade, 2
+// threads), cheapest first.
+struct Offers {
+  // Surfaces in fog: fog_lamps and thin_haze (constant fog over a floor with a sphere inside the
+  // grid; multiple shares 58% and 16%). No better past 48^3 (2.4% and 1.6% at 96^3: the sphere
+  // neither blocks nor sends light in the sweeps).
+  std::vector<MeasuredOffer> fog, thin_fog;
+  // A cloud over surfaces: cloud_sun (an RBF cloud over a floor, albedo 0.92, the diamond's
+  // fix-up). Clouds of higher albedo are not measured.
+  std::vector<MeasuredOffer> cloud_over_surfaces;
+  // The dense cloud (albedo 0.99, three channels) against its 262144-spp reference: the diamond
+  // with its fix-up, 64 directions, 9 terms, float16 storage.
+  std::vector<MeasuredOffer> dense_cloud;
+  std::vector<MeasuredOffer> particles;
+
+  Offers() {
+    const MeasuredOffer fog16{0.05, fog_cells(16, 32, 9), 0.35, "fog_lamps and thin_haze measured 4.0% and 3.0% at 16^3 (2026-12-02)"},
+        fog24{0.035, fog_cells(24, 48, 16), 0.8, "fog_lamps and thin_haze measured 3.1% and 2.0% at 24^3 (2026-12-02)"},
+        fog32{0.03, fog_cells(32, 80, 25), 1.7, "fog_lamps and thin_haze measured 2.3% and 1.6% at 32^3 (2026-12-02)"};
+    fog = {fog16, fog24, fog32, {0.025, fog_cells(48, 128, 25), 4.0, "fog_lamps measured 2.2% at 48^3 (2026-12-02)"}};
+    thin_fog = {fog16, fog24, fog32, {0.02, fog_cells(32, 80, 25), 1.7, "thin_haze (multiple share 16%) measured 1.6% at 32^3 (2026-12-02)"}};
+    cloud_over_surfaces = {{0.04, cells(16, 32, 9), 0.20, "cloud_sun measured 3.3% at 16^3 (2026-12-02)"},
+                           {0.025, cells(24, 48, 16), 0.44, "cloud_sun measured 1.9% at 24^3 (2026-12-02)"},
+                           {0.014, cells(32, 80, 25), 1.2, "cloud_sun measured 1.1% at 32^3 (2026-12-02)"},
+                           {0.008, fine_cell_settings(48, 16), 2.4, "cloud_sun measured 0.68% at 48^3 with 64 directions (2026-12-02)"},
+                           {0.006, cells(48, 128, 25), 4.0, "cloud_sun measured 0.49% at 48^3 (2026-12-02)"},
+                           {0.0045, cells(64, 128, 25), 8.9, "cloud_sun measured 0.37% at 64^3 (2026-12-02)"}};
+    dense_cloud = {{0.03, fine_cell_settings(48, 9), 0.67, "the suite's dense cloud measured 2.75% at 48^3 (2026-12-02)"},
+                   {0.02, fine_cell_settings(60, 9), 1.2, "the suite's dense cloud measured 1.75% at 60^3 (2026-12-02)"},
+                   {0.014, fine_cell_settings(72, 9), 2.1, "the suite's dense cloud measured 1.22% at 72^3 (2026-12-02)"},
+                   {0.009, fine_cell_settings(88, 9), 3.4, "the suite's dense cloud measured 0.82% at 88^3 (2026-12-02)"},
+                   {0.005, fine_cell_settings(128, 9), 11.0, "the suite's dense cloud measured 0.45% at 128^3 (2026-12-02)"}};
+    particles = {{0.0, cells(16, 32, 9), 4.0, "the suite's particle cloud measured 0.42% at 16^3 and 32 directions in 4 s"}};
   }
-  if (f.albedo > 0.95) return AutoOffer{false, {}, 0.0, "surfaces under a cloud of albedo over 0.95: not measured"};
-  if (tolerance >= 0.04) return dom_offer(16, 32, 9, 0.20, "a cloud over surfaces: cloud_sun measured 3.3% at 16^3");
-  if (tolerance >= 0.025) return dom_offer(24, 48, 16, 0.44, "a cloud over surfaces: cloud_sun measured 1.9% at 24^3");
-  if (tolerance >= 0.014) return dom_offer(32, 80, 25, 1.2, "a cloud over surfaces: cloud_sun measured 1.1% at 32^3");
-  if (tolerance >= 0.008)
-    return AutoOffer{true, fine_cell_settings(48, 16), 2.4, "a cloud over surfaces: cloud_sun measured 0.68% at 48^3 with 64 directions"};
-  if (tolerance >= 0.006) return dom_offer(48, 128, 25, 4.0, "a cloud over surfaces: cloud_sun measured 0.49% at 48^3");
-  if (tolerance >= 0.0045) return dom_offer(64, 128, 25, 8.9, "a cloud over surfaces: cloud_sun measured 0.37% at 64^3");
-  return AutoOffer{false, {}, 0.0, "a cloud over surfaces: 0.37% at best measured (64^3)"};
+};
+
+AutoOffer dom_offer(const SceneFeatures& f, double tolerance) {
+  static const Offers offers;
+  if (f.density == "particles") return offer_from(offers.particles, tolerance, "on the particles' density", "");
+  if (f.homogeneous && !f.bounded) return AutoOffer{false, {}, 0.0, "an unbounded homogeneous medium has no grid"};
+  if (f.surfaces && f.homogeneous) {
+    const bool thin = f.multiple_share < 0.3;
+    return offer_from(thin ? offers.thin_fog : offers.fog, tolerance, thin ? "surfaces in thin fog" : "surfaces in fog",
+                      thin ? "surfaces in thin fog: 1.6% at best on the suite"
+                           : "surfaces in fog: 2.2% at best on the suite (a sphere inside the grid is left out of the sweeps)");
+  }
+  if (f.surfaces && f.albedo > 0.95) return AutoOffer{false, {}, 0.0, "surfaces under a cloud of albedo over 0.95: not measured"};
+  if (f.surfaces) return offer_from(offers.cloud_over_surfaces, tolerance, "a cloud over surfaces", "a cloud over surfaces: 0.37% at best measured (64^3)");
+  return offer_from(offers.dense_cloud, tolerance, "a cloud", "under its measured 0.45% at 128^3 on the suite's dense cloud");
 }
 
 }  // namespace
@@ -513,25 +528,10 @@ MethodInfo dom_info() {
   // and 0.75% at 96^3), not on cloud_sun (1.18% and 0.68% at 48^3).
   for (int resolution : {48, 60, 88, 128})
     info.trade_sweep.push_back(fine_cell_settings(resolution, 9));
-  // Fog with lamps: bounded everywhere (fog_offer).
+  // Fog with lamps: bounded everywhere (fog_cells).
   info.trade_sweep.push_back({{"resolution", 32}, {"directions", 80}, {"terms", 25}, {"spatial", "bounded"}});
   info.trade_sweep.push_back({{"resolution", 48}, {"directions", 128}, {"terms", 25}, {"spatial", "bounded"}});
-  // The dense cloud (albedo 0.99, three channels) against its 262144-spp reference, the diamond
-  // with its fix-up, 64 directions, 9 terms, float16 storage, 2 threads (haze render, 2026-12-02):
-  // 2.75% at 48^3 (0.67 s), 1.75% at 60^3 (1.2 s), 1.22% at 72^3 (2.1 s), 0.82% at 88^3 (3.4 s),
-  // 0.45% at 128^3 (11 s); particle_cloud: 0.42% at 16^3 and 32 directions in 4 s.
-  info.offer = [](const SceneFeatures& f, double tolerance) {
-    if (f.density == "particles")
-      return AutoOffer{true, {{"resolution", 16}, {"directions", 32}, {"terms", 9}}, 4.0,
-                       "on the particles' density: 0.42% on the suite's particle cloud"};
-    if (f.homogeneous && !f.bounded) return AutoOffer{false, {}, 0.0, "an unbounded homogeneous medium has no grid"};
-    if (f.surfaces) return surface_offer(f, tolerance);
-    if (tolerance < 0.005) return AutoOffer{false, {}, 0.0, "under its measured 0.45% at 128^3 on the suite's dense cloud"};
-    const int resolution = tolerance >= 0.03 ? 48 : tolerance >= 0.02 ? 60 : tolerance >= 0.014 ? 72 : tolerance >= 0.009 ? 88 : 128;
-    const double seconds = resolution == 48 ? 0.67 : resolution == 60 ? 1.2 : resolution == 72 ? 2.1 : resolution == 88 ? 3.4 : 11.0;
-    return AutoOffer{true, fine_cell_settings(resolution, 9), seconds,
-                     to_text(resolution) + "^3 cells, 64 directions: the suite's dense cloud measured 2.75% at 48^3, 1.75% at 60^3, 1.22% at 72^3, 0.82% at 88^3 and 0.45% at 128^3"};
-  };
+  info.offer = dom_offer;
   return info;
 }
 

@@ -420,8 +420,8 @@ MethodInfo network_info() {
   // Trade suite, particle_cloud: 5.5% at any D in 0.45 s.
   info.offer = [](const SceneFeatures& f, double tolerance) {
     if (f.density != "particles") return AutoOffer{false, {}, 0.0, "needs particles"};
-    if (tolerance < 0.06) return AutoOffer{false, {}, 0.0, "measured at 5.5% on the suite's particle cloud"};
-    return AutoOffer{true, {{"directions", 64}}, 0.45, "measured at 5.5% on the suite's particle cloud"};
+    static const MeasuredOffer measured[] = {{0.06, {{"directions", 64}}, 0.45, "measured at 5.5% on the suite's particle cloud"}};
+    return offer_from(measured, tolerance, "particles", "measured at 5.5% on the suite's particle cloud");
   };
   return info;
 }

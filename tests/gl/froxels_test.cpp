@@ -1,7 +1,7 @@
 // The GPU froxel composite (gl/froxels.h) against its CPU form (composite_froxels): the host's
 // colour and window depth as GL textures, the froxels streamed as 3D textures, the same image.
 #include <haze/core/error.h>
-#include <haze/core/froxels.h>
+#include <haze/froxels/froxels.h>
 #include <haze/gl/context.h>
 #include <haze/gl/froxels.h>
 

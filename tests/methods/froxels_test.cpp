@@ -1,8 +1,8 @@
-// Froxels (core/froxels.h) from every kind of solution: at the columns' centres and the slices'
+// Froxels (haze/froxels/froxels.h) from every kind of solution: at the columns' centres and the slices'
 // boundaries they hold the per-pixel layers; between them the composite's error against the
 // per-pixel layers falls as the volume is refined; bad grids are clear errors.
 #include <haze/core/error.h>
-#include <haze/core/froxels.h>
+#include <haze/froxels/froxels.h>
 #include <haze/grids/methods.h>
 #include <haze/particles/methods.h>
 

@@ -1,12 +1,14 @@
-// haze::mpi::render_dom under mpirun -np 1, 2 and 4: the ranks' stretches of every camera ray,
-// composed on rank 0, give method dom's single-process image and layers (1e-5 relative) for rays
-// going up the planes, down them and across; scenes with surfaces are refused on every rank.
+// Method dom split over the ranks (haze/mpi/methods.h: RenderOptions::ranks) under mpirun -np 1,
+// 2 and 4: the ranks' stretches of every camera ray, composed on rank 0, give method dom's
+// single-process image and layers (1e-5 relative) for rays going up the planes, down them and
+// across, from one solution rendering three cameras; scenes with surfaces, and methods without a
+// split form, are refused on every rank.
 #include <haze/core/error.h>
 #include <haze/core/method.h>
 #include <haze/grids/dom.h>
 #include <haze/grids/methods.h>
 #include <haze/mpi/dom.h>
-#include <haze/mpi/render.h>
+#include <haze/mpi/methods.h>
 
 #include <gtest/gtest.h>
 
@@ -54,19 +56,31 @@ double relative_rms(const Image& a, const Image& b) {
 }
 
 // From above (every ray down the planes), from the side (up and down) and from below.
-TEST(MpiRender, MatchesTheSingleProcessRender) {
+RenderOptions split_options() {
   grids::register_methods();
+  register_methods();
+  RenderOptions options;
+  options.threads = 1;
+  options.ranks = ranks(MPI_COMM_WORLD);
+  return options;
+}
+
+TEST(MpiRender, MatchesTheSingleProcessRender) {
+  const RenderOptions options = split_options();
+  const Solution solution = prepare(cloud(Vec3(0.0, 0.0, 3.0), Vec3(0.0)), "", options);
   for (const auto& [camera, look_at] : {std::pair{Vec3(0.3, 0.4, 3.2), Vec3(0.0)}, {Vec3(3.0, 0.4, 0.2), Vec3(0.0, 0.0, 0.1)}, {Vec3(-0.2, 0.3, -3.0), Vec3(0.0)}}) {
     const Scene scene = cloud(camera, look_at);
-    RenderOptions options;
-    options.threads = 1;
     const View view{scene.camera, {}, true};
-    const RenderResult split = render_dom(MPI_COMM_WORLD, scene, view, options);
+    RenderOptions render_options;
+    render_options.threads = 1;
+    const RenderResult split = solution.render(view, render_options);
     if (rank() != 0) {
       EXPECT_EQ(split.radiance.width(), 0);
       continue;
     }
-    const RenderResult single = haze::render(scene, "dom", options, view);
+    RenderOptions single_options;
+    single_options.threads = 1;
+    const RenderResult single = haze::render(scene, "dom", single_options, view);
     ASSERT_TRUE(split.inscatter && single.inscatter);
     const double image = relative_rms(split.radiance, single.radiance), inscatter = relative_rms(*split.inscatter, *single.inscatter),
                  transmittance = relative_rms(*split.transmittance, *single.transmittance);
@@ -88,10 +102,29 @@ TEST(MpiRender, RefusesSurfacesOnEveryRank) {
   Scene scene = cloud(Vec3(0.3, 0.4, 3.2), Vec3(0.0));
   scene.surfaces.push_back(Surface{Plane{Vec3(0.0, -1.0, 0.0), Vec3(0.0, 1.0, 0.0)}});
   try {
-    render_dom(MPI_COMM_WORLD, scene, View{scene.camera}, {});
+    render(scene, "dom", split_options());
     FAIL() << "no error";
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("surfaces: got 1 surfaces, expected none with the DOM split over MPI ranks"), std::string::npos) << e.what();
+  }
+}
+
+TEST(MpiRender, RefusesMethodsWithoutASplitFormUnderManyRanks) {
+  Scene scene = cloud(Vec3(0.3, 0.4, 3.2), Vec3(0.0));
+  scene.lights.pop_back();  // the sky, which propagation does not take
+  const int ranks = split_options().ranks->size();
+  if (ranks == 1) {  // one rank: the method's own form, for want of a split one
+    RenderOptions options = split_options();
+    options.settings = {{"resolution", 12}};
+    EXPECT_NO_THROW(render(scene, "propagation", options));
+    return;
+  }
+  try {
+    render(scene, "propagation", split_options());
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    EXPECT_EQ(std::string(e.what()), "method.name: got propagation, expected a method split over processes under " + std::to_string(ranks) +
+                                         " ranks (dom), or one process");
   }
 }
 

@@ -15,6 +15,7 @@
 #include <functional>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -67,6 +68,18 @@ struct AutoOffer {
   std::string why;  // one line: the measurement the offer rests on, or why not
 };
 using AutoRule = std::function<AutoOffer(const SceneFeatures& features, double tolerance)>;
+
+// A measured point of a method's trade curve that an offer rests on: offered where the tolerance
+// asked is at least `tolerance` (the error measured, with a margin).
+struct MeasuredOffer {
+  double tolerance = 0.0;
+  nlohmann::json settings;
+  double seconds = 0.0;  // measured, 2 threads
+  std::string measured;  // the scene, the error, the settings and the date: "cloud_sun 3.3% at 16^3 (2026-12-02)"
+};
+// The first of `table` (cheapest first) that `tolerance` meets, its why "<what>: <measured>"; else
+// declined, with `otherwise` as the why.
+AutoOffer offer_from(std::span<const MeasuredOffer> table, double tolerance, const std::string& what, const std::string& otherwise);
 
 struct MethodInfo {
   // What a method is to the tools that pick among methods (method auto, `haze demo`, `haze bench
@@ -130,6 +143,10 @@ void register_method(MethodInfo info);
 std::vector<MethodInfo> registered_methods();
 // Throws haze::Error listing the available methods when the name is unknown.
 std::unique_ptr<Method> create_method(const std::string& name);
+// A module's form of `method` split over RenderOptions::ranks (haze::mpi: dom's), which
+// haze::prepare makes in place of the method's own when the options give ranks; a second
+// registration replaces the first.
+void register_split(const std::string& method, std::function<std::unique_ptr<Method>()> create);
 // The name of the registered method with this role (the first by name); haze::Error when none is.
 std::string method_with_role(MethodInfo::Role role);
 

@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include <filesystem>
+#include <memory>
 #include <optional>
 #include <span>
 #include <string>
@@ -21,6 +22,15 @@
 #pragma GCC visibility push(default)  // the public API: exported from shared builds
 
 namespace haze {
+
+// The processes one solve is split over (docs/SCALING.md): haze::mpi::ranks wraps an MPI
+// communicator as one.
+class Ranks {
+ public:
+  virtual ~Ranks() = default;
+  virtual int rank() const = 0;
+  virtual int size() const = 0;
+};
 
 struct RenderOptions {
   int threads = 0;  // 0: every core oneTBB offers; otherwise a cap
@@ -38,6 +48,12 @@ struct RenderOptions {
   // Bytes a method may allocate for its solution, checked before it allocates (a haze::Error
   // naming what would not fit); 0: the memory the system has available.
   std::size_t max_memory = 0;
+  // Null: this process alone. Else every rank prepares, renders and updates alike (collective
+  // calls, the same arguments) through the method's form split over them (register_split;
+  // haze::mpi registers dom's), whose renders return the image on rank 0 and an empty result on
+  // the others; max_memory then caps each rank. A method without a split form is refused when
+  // there is more than one rank.
+  std::shared_ptr<const Ranks> ranks = nullptr;
 };
 
 // $HAZE_CACHE_DIR, else $XDG_CACHE_HOME/haze, else $HOME/.cache/haze, else the temporary directory.

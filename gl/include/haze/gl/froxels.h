@@ -1,10 +1,10 @@
-// The froxel composite on the GPU (docs/HOST.md, "Froxels"): a froxel volume (core/froxels.h) as
+// The froxel composite on the GPU (docs/HOST.md, "Froxels"): a froxel volume (haze/froxels/froxels.h) as
 // two 3D textures streamed through Texture, and a fullscreen GLSL pass that reads the host's colour
 // and depth textures and writes, per pixel, L_in(d) + T(d) * colour, the same lookup as
 // Froxels::sample (trilinear: bilinear between columns, linear in the slice coordinate).
 #pragma once
 
-#include <haze/core/froxels.h>
+#include <haze/froxels/froxels.h>
 #include <haze/core/image.h>
 #include <haze/gl/texture.h>
 

@@ -1,5 +1,5 @@
 #include <haze/core/error.h>
-#include <haze/core/froxels.h>
+#include <haze/froxels/froxels.h>
 
 #include <glm/ext/matrix_clip_space.hpp>
 #include <glm/ext/matrix_transform.hpp>
