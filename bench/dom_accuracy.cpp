@@ -39,7 +39,7 @@ void slab(std::FILE* csv, int directions, int terms, int nz, bool delta_m = true
   double error[3];
   for (int i = 0; i < 3; ++i) {
     scene.camera = slab_camera(1.0, mus[i], true);
-    error[i] = render_dom(scene, volume, depths, solution, 0.25).at(0, 0).r / published[i] - 1.0;
+    error[i] = render_dom(scene, volume, depths, solution, 0.25, {}, View{scene.camera}).radiance.at(0, 0).r / published[i] - 1.0;
   }
   std::printf("| %d | %d%s | %d | %+.2f%% | %+.2f%% | %+.2f%% | %.2f | %d |\n", directions, solution.terms(),
               solution.delta_m_fraction > 0.0 ? ", delta-M" : "", nz, 100 * error[0],
@@ -63,7 +63,7 @@ void thick_slab(std::FILE* csv, const ThickSlab& p, int per_depth, DomSpatial sp
   double error[3];  // the top at mu 1, 0.5 and 0.1, thick_slabs()'s first three views
   for (int i = 0; i < 3; ++i) {
     scene.camera = slab_camera(p.tau, p.views[static_cast<size_t>(i)].mu, true);
-    error[i] = render_dom(scene, volume, depths, solution, 0.25).at(0, 0).r / p.views[static_cast<size_t>(i)].uu - 1.0;
+    error[i] = render_dom(scene, volume, depths, solution, 0.25, {}, View{scene.camera}).radiance.at(0, 0).r / p.views[static_cast<size_t>(i)].uu - 1.0;
   }
   const std::string label = std::string(p.label) + ": " + p.description;
   std::printf("| %s | %s | %d | %+.2f%% | %+.2f%% | %+.2f%% | %.2f | %d |\n", label.c_str(), name(spatial), per_depth, 100 * error[0], 100 * error[1],

@@ -7,7 +7,7 @@
 
 namespace haze {
 
-MajorantGrid::MajorantGrid(const Medium& medium, int cells) : bounds_(medium.bounds()) {
+MajorantGrid::MajorantGrid(const DensityField& medium, int cells) : bounds_(medium.bounds()) {
   if (medium.homogeneous() || !bounds_.bounded()) {
     density_.assign(1, medium.max_density(bounds_));
     return;

@@ -10,7 +10,13 @@
 
 namespace haze {
 
+Medium::Medium(std::shared_ptr<const DensityField> field, const MediumDesc& desc)
+    : field_(std::move(field)), sigma_t_(desc.sigma_t), albedo_(desc.albedo), phase_(desc.phase), emission_(desc.emission) {
+  if (!field_) throw Error("medium.density", "a field without data", "a density field");
+}
+
 double Medium::density_integral(const Vec3& a, const Vec3& b) const {
+  if (const std::optional<double> exact = field_->density_integral(a, b)) return *exact;
   double length = glm::length(b - a);
   if (length == 0.0) return 0.0;
   Ray ray{a, (b - a) / length};
@@ -44,10 +50,11 @@ Rgb Medium::emission(const Vec3& x) const {
   return emitted_radiance(emission_, x, emission_.strength > 0.0 && !emission_.grid ? density(x) : 0.0);
 }
 
-std::shared_ptr<const MajorantGrid> Medium::make_majorants() const { return std::make_shared<MajorantGrid>(*this); }
-
 const MajorantGrid& Medium::majorants() const {
-  std::call_once(majorants_once_, [&] { majorants_ = make_majorants(); });
+  std::call_once(majorants_once_, [&] {
+    majorants_ = field_->majorants();
+    if (!majorants_) majorants_ = std::make_shared<MajorantGrid>(*field_);
+  });
   return *majorants_;
 }
 
@@ -68,16 +75,15 @@ Rgb Medium::transmittance_along(const Vec3& x, const Vec3& direction, double dis
 
 namespace {
 
-class ConstantMedium final : public Medium {
+class ConstantField final : public DensityField {
  public:
-  ConstantMedium(const MediumDesc& desc, double value)
-      : Medium(desc.sigma_t, desc.albedo, desc.phase), bounds_(desc.bounds), value_(value) {}
+  ConstantField(const Aabb& bounds, double value) : bounds_(bounds), value_(value) {}
   Aabb bounds() const override { return bounds_; }
   double density(const Vec3& x) const override { return bounds_.contains(x) ? value_ : 0.0; }
   double max_density(const Aabb&) const override { return value_; }
   double feature_size() const override { return kInfinity; }
   bool homogeneous() const override { return true; }
-  double density_integral(const Vec3& a, const Vec3& b) const override {
+  std::optional<double> density_integral(const Vec3& a, const Vec3& b) const override {
     double length = glm::length(b - a);
     if (length == 0.0) return 0.0;
     double t0 = 0.0, t1 = length;
@@ -91,9 +97,9 @@ class ConstantMedium final : public Medium {
 };
 
 // Evaluates the RBF sum directly (seed 003 eq. 2); grids/ injects it into a grid for speed.
-class RbfMedium final : public Medium {
+class RbfField final : public DensityField {
  public:
-  RbfMedium(const MediumDesc& desc, const RbfDensity& rbf) : Medium(desc.sigma_t, desc.albedo, desc.phase), blobs_(rbf.blobs) {
+  RbfField(const MediumDesc& desc, const RbfDensity& rbf) : blobs_(rbf.blobs) {
     bounds_ = medium_bounds(desc);
     feature_ = kInfinity;
     for (const auto& b : blobs_) {
@@ -126,7 +132,7 @@ class RbfMedium final : public Medium {
   // distance from the line and tc its foot, whose integral is an erf difference (taken as an erfc
   // difference on either tail, where the erfs cancel). O(blobs), where Simpson's steps of 1/4 of
   // the sharpest blob took seconds per ray past sharpness 1000.
-  double density_integral(const Vec3& a, const Vec3& b) const override {
+  std::optional<double> density_integral(const Vec3& a, const Vec3& b) const override {
     const double length = glm::length(b - a);
     if (!(length > 0.0)) return 0.0;
     const Ray ray{a, (b - a) / length};
@@ -149,11 +155,10 @@ class RbfMedium final : public Medium {
   double max_ = 0.0, feature_ = kInfinity;
 };
 
-class GridMedium final : public Medium {
+class GridField final : public DensityField {
  public:
   // A grid's own values are copied; a view of the caller's memory is only viewed.
-  GridMedium(const MediumDesc& desc, const GridDensity& grid)
-      : Medium(desc.sigma_t, desc.albedo, desc.phase), bounds_(desc.bounds), resolution_(grid.resolution), owned_(grid.values) {
+  GridField(const MediumDesc& desc, const GridDensity& grid) : bounds_(desc.bounds), resolution_(grid.resolution), owned_(grid.values) {
     values_ = grid.view.data() ? grid.view : std::span<const float>(owned_);
     if (!bounds_.bounded()) throw Error("medium.bounds", "unbounded", "bounds for a grid density");
     const size_t cells = static_cast<size_t>(resolution_[0]) * static_cast<size_t>(resolution_[1]) * static_cast<size_t>(resolution_[2]);
@@ -196,30 +201,6 @@ class GridMedium final : public Medium {
   double max_ = 0.0, feature_ = 1.0;
 };
 
-// A module's density field (FieldDensity) with the medium's coefficients.
-class FieldMedium final : public Medium {
- public:
-  FieldMedium(const MediumDesc& desc, std::shared_ptr<const DensityField> field)
-      : Medium(desc.sigma_t, desc.albedo, desc.phase), field_(std::move(field)) {}
-  Aabb bounds() const override { return field_->bounds(); }
-  double density(const Vec3& x) const override { return field_->density(x); }
-  double max_density(const Aabb& region) const override { return field_->max_density(region); }
-  double feature_size() const override { return field_->feature_size(); }
-  double density_integral(const Vec3& a, const Vec3& b) const override {
-    if (const std::optional<double> exact = field_->density_integral(a, b)) return *exact;
-    return Medium::density_integral(a, b);
-  }
-
- protected:
-  std::shared_ptr<const MajorantGrid> make_majorants() const override {
-    if (auto own = field_->majorants()) return own;
-    return Medium::make_majorants();
-  }
-
- private:
-  std::shared_ptr<const DensityField> field_;
-};
-
 }  // namespace
 
 Aabb medium_bounds(const MediumDesc& desc) {
@@ -233,91 +214,6 @@ Aabb medium_bounds(const MediumDesc& desc) {
     box.hi = glm::max(box.hi, b.center + Vec3(6.0 / b.sharpness));
   }
   return box;
-}
-
-namespace {
-bool finite(const Vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
-bool finite_non_negative(const Rgb& c) { return finite(c) && c.r >= 0.0 && c.g >= 0.0 && c.b >= 0.0; }
-bool radiometric(const Rgb& c) { return finite_non_negative(c) && std::max({c.r, c.g, c.b}) <= kMaxRadiometric; }
-double largest(const Rgb& c) { return std::max({c.r, c.g, c.b}); }
-}  // namespace
-
-void check_medium(const MediumDesc& desc, const std::string& path) {
-  const Aabb& b = desc.bounds;
-  const bool unbounded = b.lo == Vec3(-kInfinity) && b.hi == Vec3(kInfinity);
-  if (!unbounded && !(within_reach(b.lo) && within_reach(b.hi) && b.lo.x < b.hi.x && b.lo.y < b.hi.y && b.lo.z < b.hi.z))
-    throw Error(path + ".bounds", to_text(b.lo) + " to " + to_text(b.hi),
-                "a box with lo < hi on every axis within 1e9 of the origin (haze::kMaxCoordinate), or unbounded");
-  if (!(finite_non_negative(desc.sigma_t) && largest(desc.sigma_t) <= kMaxExtinction))
-    throw Error(path + ".sigma_t", to_text(desc.sigma_t), "values in [0, 1e9] (haze::kMaxExtinction)");
-  if (!(finite_non_negative(desc.albedo) && desc.albedo.r <= 1.0 && desc.albedo.g <= 1.0 && desc.albedo.b <= 1.0))
-    throw Error(path + ".albedo", to_text(desc.albedo), "values in [0, 1]");
-  const Emission& e = desc.emission;
-  auto check = [&](double v, const std::string& field, double max, const char* expected) {
-    if (!(std::isfinite(v) && v >= 0.0 && v <= max)) throw Error(path + field, to_text(v), expected);
-  };
-  check(e.strength, ".emission.strength", kMaxRadiometric, "a strength in [0, 1e15] (haze::kMaxRadiometric)");
-  if (!(radiometric(e.color) && largest(e.color) * e.strength <= kMaxRadiometric))
-    throw Error(path + ".emission.color", to_text(e.color), "values >= 0 whose product with the strength is at most 1e15 (haze::kMaxRadiometric)");
-  check(e.blackbody_intensity, ".blackbody.intensity", kMaxRadiometric, "an intensity in [0, 1e15] (haze::kMaxRadiometric)");
-  if (!(radiometric(e.blackbody_tint) && largest(e.blackbody_tint) * e.blackbody_intensity <= kMaxRadiometric))
-    throw Error(path + ".blackbody.tint", to_text(e.blackbody_tint), "values >= 0 whose product with the intensity is at most 1e15 (haze::kMaxRadiometric)");
-  check(e.temperature, ".blackbody.temperature", 1e6, "kelvin in [0, 1e6]");
-  if (e.emits() && unbounded && !(desc.sigma_t.r > 0.0 && desc.sigma_t.g > 0.0 && desc.sigma_t.b > 0.0) &&
-      !std::holds_alternative<RbfDensity>(desc.density) && !std::holds_alternative<FieldDensity>(desc.density))
-    throw Error(path + ".sigma_t", to_text(desc.sigma_t), "> 0 in every channel for an unbounded medium that emits (else its radiance is infinite)");
-  // Extinction sigma_t rho past kMaxExtinction, blamed on the density value that reaches it.
-  const double sigma_max = largest(desc.sigma_t);
-  auto extinction = [&](double density, const std::string& field) {
-    if (sigma_max * density > kMaxExtinction)
-      throw Error(field, to_text(density), "a density whose product with sigma_t (" + to_text(sigma_max) +
-                                               ") is at most 1e9 (haze::kMaxExtinction: extinction per unit length)");
-  };
-  if (const auto* c = std::get_if<ConstantDensity>(&desc.density)) {
-    if (!(std::isfinite(c->value) && c->value >= 0.0)) throw Error(path + ".density.value", to_text(c->value), "a finite density >= 0");
-    extinction(c->value, path + ".density.value");
-  } else if (const auto* rbf = std::get_if<RbfDensity>(&desc.density)) {
-    if (rbf->blobs.empty()) throw Error(path + ".density.blobs", "[]", "at least one blob");
-    for (size_t i = 0; i < rbf->blobs.size(); ++i) {
-      const RbfBlob& blob = rbf->blobs[i];
-      const std::string at = path + ".density.blobs[" + std::to_string(i) + "]";
-      if (!within_reach(blob.center)) throw Error(at + ".center", to_text(blob.center), "a point within 1e9 of the origin (haze::kMaxCoordinate)");
-      if (!(std::isfinite(blob.weight) && blob.weight >= 0.0)) throw Error(at + ".weight", to_text(blob.weight), "a finite weight >= 0");
-      extinction(blob.weight, at + ".weight");
-      if (!(std::isfinite(blob.sharpness) && blob.sharpness > 0.0)) throw Error(at + ".sharpness", to_text(blob.sharpness), "a finite sharpness > 0");
-      // Unbounded, the medium reaches 6 / sharpness past each centre (medium_bounds): a blob of
-      // sharpness 1e-300 made quadrature's steps 1e298 long and its image NaN.
-      if (unbounded && 6.0 / blob.sharpness > kMaxCoordinate)
-        throw Error(at + ".sharpness", to_text(blob.sharpness), "a sharpness >= 6e-9 (the blob reaching 6 / sharpness, at most 1e9), or medium.bounds");
-    }
-  } else if (const auto* f = std::get_if<FieldDensity>(&desc.density)) {
-    if (!f->field) throw Error(path + ".density", "a " + f->type + " field without data", "a density field");
-    const Aabb fb = f->field->bounds();
-    if (!(within_reach(fb.lo) && within_reach(fb.hi)))
-      throw Error(path + ".density", "a " + f->type + " field from " + to_text(fb.lo) + " to " + to_text(fb.hi),
-                  "a field within 1e9 of the origin (haze::kMaxCoordinate)");
-    extinction(f->field->max_density(fb), path + ".density");
-  } else {
-    const auto& grid = std::get<GridDensity>(desc.density);
-    if (unbounded) throw Error(path + ".bounds", "unbounded", "bounds for a grid density");
-    size_t cells = 1;
-    for (int a = 0; a < 3; ++a) {
-      if (grid.resolution[a] < 1)
-        throw Error(path + ".density.resolution[" + std::to_string(a) + "]", to_text(grid.resolution[a]), "at least 1 cell");
-      cells *= static_cast<size_t>(grid.resolution[a]);
-    }
-    const std::span<const float> samples = grid.samples();
-    const std::string field = path + ".density." + (grid.view.data() ? "view" : "values");
-    if (samples.size() != cells)
-      throw Error(field, to_text(samples.size()) + " values",
-                  to_text(cells) + " (resolution " + to_text(grid.resolution[0]) + " x " + to_text(grid.resolution[1]) + " x " +
-                      to_text(grid.resolution[2]) + ")");
-    for (size_t i = 0; i < samples.size(); ++i)
-      if (!(std::isfinite(samples[i]) && samples[i] >= 0.0f))
-        throw Error(field + "[" + std::to_string(i) + "]", to_text(samples[i]), "a finite density >= 0");
-      else if (sigma_max * static_cast<double>(samples[i]) > kMaxExtinction)
-        extinction(static_cast<double>(samples[i]), field + "[" + std::to_string(i) + "]");
-  }
 }
 
 GridDensity sample_grid(const DensityField& field, int resolution, int threads) {
@@ -338,20 +234,16 @@ GridDensity sample_grid(const DensityField& field, int resolution, int threads) 
   return grid;
 }
 
-std::unique_ptr<Medium> make_medium(const MediumDesc& desc) {
-  std::unique_ptr<Medium> medium;
-  if (auto* c = std::get_if<ConstantDensity>(&desc.density)) {
-    medium = std::make_unique<ConstantMedium>(desc, c->value);
-  } else if (auto* r = std::get_if<RbfDensity>(&desc.density)) {
-    medium = std::make_unique<RbfMedium>(desc, *r);
-  } else if (auto* f = std::get_if<FieldDensity>(&desc.density)) {
+std::shared_ptr<const DensityField> density_field(const MediumDesc& desc) {
+  if (const auto* c = std::get_if<ConstantDensity>(&desc.density)) return std::make_shared<ConstantField>(desc.bounds, c->value);
+  if (const auto* r = std::get_if<RbfDensity>(&desc.density)) return std::make_shared<RbfField>(desc, *r);
+  if (const auto* f = std::get_if<FieldDensity>(&desc.density)) {
     if (!f->field) throw Error("medium.density", "a " + f->type + " field without data", "a density field");
-    medium = std::make_unique<FieldMedium>(desc, f->field);
-  } else {
-    medium = std::make_unique<GridMedium>(desc, std::get<GridDensity>(desc.density));
+    return f->field;
   }
-  medium->emission_ = desc.emission;
-  return medium;
+  return std::make_shared<GridField>(desc, std::get<GridDensity>(desc.density));
 }
+
+std::unique_ptr<Medium> make_medium(const MediumDesc& desc) { return std::make_unique<Medium>(density_field(desc), desc); }
 
 }  // namespace haze

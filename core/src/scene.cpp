@@ -89,15 +89,14 @@ namespace {
 
 std::string text(const json& v) { return json_text(v); }
 
-// A number check: the predicate and the words for the error message.
+// A number check: the predicate and the words for the error message. The reader checks types and
+// finiteness; ranges are check_scene's (scene_check.cpp), which from_json calls last, and the
+// phase constructors'.
 struct Check {
   bool (*ok)(double);
   const char* expected;
 };
 constexpr Check kFinite{[](double) { return true; }, "a finite number"};
-constexpr Check kNonNegative{[](double x) { return x >= 0.0; }, "a finite number >= 0"};
-constexpr Check kPositive{[](double x) { return x > 0.0; }, "a finite number > 0"};
-constexpr Check kUnit{[](double x) { return x >= 0.0 && x <= 1.0; }, "a finite number in [0, 1]"};
 // The phase constructors check |g| <= 0.9999 themselves; this only words the type error.
 constexpr Check kG{[](double) { return true; }, "a number with |g| <= 0.9999"};
 
@@ -129,10 +128,11 @@ Vec3 read_vec3(const json& v, const std::string& path) {
   return out;
 }
 
+// Made unit length where it can be (check_scene refuses one that cannot).
 Vec3 read_direction(const json& v, const std::string& path) {
   Vec3 d = read_vec3(v, path);
-  if (!make_unit(d)) throw Error(path, text(v), kDirectionText);
-  return d;
+  Vec3 unit = d;
+  return make_unit(unit) ? unit : d;
 }
 
 // A colour-like quantity: one number for all channels or an [r, g, b] array, each checked.
@@ -234,26 +234,18 @@ Camera read_camera(const Object& o) {
   if (type == "pinhole") {
     o.allow({"type", "position", "look_at", "up", "fov_y_deg", "width_px", "height_px"});
     c.type = Camera::Type::pinhole;
-    c.fov_y_deg = o.number("fov_y_deg", 40.0, {[](double x) { return x > 0.0 && x < 180.0; },
-                                                "an angle in degrees in (0, 180)"});
+    c.fov_y_deg = o.number("fov_y_deg", 40.0, kFinite);
   } else {
     o.allow({"type", "position", "look_at", "up", "height", "width_px", "height_px"});
     c.type = Camera::Type::orthographic;
-    c.height = o.number("height", 2.0, kPositive);
+    c.height = o.number("height", 2.0, kFinite);
   }
   c.position = o.vec3("position");
   c.look_at = o.vec3("look_at");
   c.up = o.vec3("up", Vec3(0.0, 1.0, 0.0));
   c.width_px = o.integer("width_px", 64, 1, kMaxImagePx);
   c.height_px = o.integer("height_px", 64, 1, kMaxImagePx);
-
-  Vec3 view = c.look_at - c.position;
-  if (!make_unit(view))
-    throw Error(o.at("look_at"), text(*o.find("look_at")), "a point different from camera.position");
-  const std::string up_text = o.find("up") ? text(*o.find("up")) : "[0, 1, 0] (the default)";
-  if (!make_unit(c.up)) throw Error(o.at("up"), up_text, kDirectionText);
-  if (glm::length(glm::cross(view, c.up)) < 1e-6)
-    throw Error(o.at("up"), up_text, "a vector not parallel to the view direction (look_at - position)");
+  if (Vec3 up = c.up; make_unit(up)) c.up = up;
   return c;
 }
 
@@ -271,19 +263,6 @@ Aabb read_bounds(const json& v, const std::string& path) {
                     to_text(box.hi[a]));
   }
   return box;
-}
-
-void check_grid_values(const GridDensity& grid, const std::string& path, const fs::path& file) {
-  const std::vector<float>& values = grid.values;
-  for (std::size_t i = 0; i < values.size(); ++i) {
-    if (std::isfinite(values[i]) && values[i] >= 0.0f) continue;
-    const auto nx = static_cast<std::size_t>(grid.resolution[0]), ny = static_cast<std::size_t>(grid.resolution[1]);
-    std::string cell = "(" + std::to_string(i % nx) + ", " + std::to_string(i / nx % ny) + ", " +
-                       std::to_string(i / (nx * ny)) + ")";
-    throw Error(path, to_text(values[i]) + " at cell " + cell + " (index " + std::to_string(i) + ") of " +
-                          file.string(),
-                "finite density values >= 0");
-  }
 }
 
 // The existing file o.file names, relative to the scene's folder, as an absolute path (so that
@@ -345,7 +324,6 @@ GridDensity read_grid(const Object& o, const fs::path& base_dir) {
       v = std::bit_cast<float>(bits);
     }
   }
-  check_grid_values(grid, file_path, file);
   return grid;
 }
 
@@ -378,7 +356,7 @@ Density read_density(const json& j, const std::string& path, bool bounded, const
   }
   if (type == "constant") {
     o.allow({"type", "value"});
-    return ConstantDensity{o.number("value", 1.0, kNonNegative)};
+    return ConstantDensity{o.number("value", 1.0, kFinite)};
   }
   if (type == "grid") {
     o.allow({"type", "resolution", "file"});
@@ -396,8 +374,8 @@ Density read_density(const json& j, const std::string& path, bool bounded, const
     b.allow({"center", "weight", "sharpness"});
     RbfBlob blob;
     blob.center = b.vec3("center");
-    blob.weight = b.number("weight", 1.0, kNonNegative);
-    blob.sharpness = b.number("sharpness", 1.0, kPositive);
+    blob.weight = b.number("weight", 1.0, kFinite);
+    blob.sharpness = b.number("sharpness", 1.0, kFinite);
     rbf.blobs.push_back(blob);
   }
   return rbf;
@@ -439,7 +417,7 @@ PhaseFunction read_phase(const Object& o) {
   if (!values.is_array()) throw Error(o.at("values"), text(values), expected);
   std::vector<double> table;
   for (std::size_t i = 0; i < values.size(); ++i)
-    table.push_back(read_number(values[i], index_path(o.at("values"), i), kNonNegative));
+    table.push_back(read_number(values[i], index_path(o.at("values"), i), kFinite));
   return make_phase(o, [&] { return PhaseFunction::tabulated(std::move(table)); });
 }
 
@@ -459,16 +437,16 @@ Emission read_emission(const Object& medium, const Density& density) {
   if (const json* j = medium.find("emission")) {
     const Object o(*j, medium.at("emission"));
     o.allow({"strength", "color", "grid"});
-    e.strength = o.number("strength", 1.0, kNonNegative);
-    e.color = o.color("color", Rgb(1.0), kNonNegative);
+    e.strength = o.number("strength", 1.0, kFinite);
+    e.color = o.color("color", Rgb(1.0), kFinite);
     if (o.find("grid")) e.grid = sibling_grid(o, density);
   }
   if (const json* j = medium.find("blackbody")) {
     const Object o(*j, medium.at("blackbody"));
     o.allow({"intensity", "tint", "temperature", "grid"});
-    e.blackbody_intensity = o.number("intensity", 1.0, kNonNegative);
-    e.blackbody_tint = o.color("tint", Rgb(1.0), kNonNegative);
-    e.temperature = o.number("temperature", 1000.0, {[](double t) { return t >= 0.0 && t <= 1e6; }, "kelvin in [0, 1e6]"});
+    e.blackbody_intensity = o.number("intensity", 1.0, kFinite);
+    e.blackbody_tint = o.color("tint", Rgb(1.0), kFinite);
+    e.temperature = o.number("temperature", 1000.0, kFinite);
     if (o.find("grid")) e.temperature_grid = sibling_grid(o, density);
   }
   return e;
@@ -479,8 +457,8 @@ MediumDesc read_medium(const Object& o, const fs::path& base_dir) {
   MediumDesc m;
   if (const json* b = o.find("bounds")) m.bounds = read_bounds(*b, o.at("bounds"));
   m.density = read_density(o.need("density", "a density object with a \"type\""), o.at("density"), m.bounds.bounded(), base_dir);
-  m.sigma_t = o.color("sigma_t", kNonNegative);
-  m.albedo = o.color("albedo", Rgb(0.8), kUnit);
+  m.sigma_t = o.color("sigma_t", kFinite);
+  m.albedo = o.color("albedo", Rgb(0.8), kFinite);
   if (const json* p = o.find("phase")) m.phase = read_phase(Object(*p, o.at("phase")));
   m.emission = read_emission(o, m.density);
   return m;
@@ -490,25 +468,24 @@ Light read_light(const Object& o) {
   std::string type = o.type({"point", "spot", "directional", "sky"});
   if (type == "point") {
     o.allow({"type", "position", "intensity"});
-    return PointLight{o.vec3("position"), o.color("intensity", kNonNegative)};
+    return PointLight{o.vec3("position"), o.color("intensity", kFinite)};
   }
   if (type == "spot") {
     o.allow({"type", "position", "direction", "intensity", "exponent", "cone_deg"});
     SpotLight s;
     s.position = o.vec3("position");
     s.direction = o.direction("direction");
-    s.intensity = o.color("intensity", kNonNegative);
-    s.exponent = o.number("exponent", 1.0, kNonNegative);
-    s.cone_deg = o.number("cone_deg", 45.0, {[](double x) { return x > 0.0 && x <= 90.0; },
-                                            "a half-angle in degrees in (0, 90]"});
+    s.intensity = o.color("intensity", kFinite);
+    s.exponent = o.number("exponent", 1.0, kFinite);
+    s.cone_deg = o.number("cone_deg", 45.0, kFinite);
     return s;
   }
   if (type == "directional") {
     o.allow({"type", "direction", "irradiance"});
-    return DirectionalLight{o.direction("direction"), o.color("irradiance", kNonNegative)};
+    return DirectionalLight{o.direction("direction"), o.color("irradiance", kFinite)};
   }
   o.allow({"type", "radiance"});
-  return SkyLight{o.color("radiance", kNonNegative)};
+  return SkyLight{o.color("radiance", kFinite)};
 }
 
 // A mesh's placement: {"translate": [x, y, z], "rotate_deg": [x, y, z], "scale": s or [x, y, z]}
@@ -543,7 +520,7 @@ Surface read_surface(const Object& o, const fs::path& base_dir) {
     s.shape = Plane{o.vec3("point"), o.direction("normal")};
   } else if (type == "sphere") {
     o.allow({"type", "center", "radius", "kd", "ks", "shininess"});
-    s.shape = Sphere{o.vec3("center"), o.number("radius", kPositive)};
+    s.shape = Sphere{o.vec3("center"), o.number("radius", kFinite)};
   } else {
     o.allow({"type", "file", "transform", "kd", "ks", "shininess", "shaded"});
     const fs::path file = existing_file(o, base_dir, "an OBJ file name (relative to the scene file's folder)");
@@ -560,10 +537,9 @@ Surface read_surface(const Object& o, const fs::path& base_dir) {
       }
     }
   }
-  // kd and ks are reflectances (albedos): above 1 a surface would create energy.
-  s.kd = o.color("kd", Rgb(0.5), kUnit);
-  s.ks = o.color("ks", Rgb(0.0), kUnit);
-  s.shininess = o.number("shininess", 1.0, kNonNegative);
+  s.kd = o.color("kd", Rgb(0.5), kFinite);
+  s.ks = o.color("ks", Rgb(0.0), kFinite);
+  s.shininess = o.number("shininess", 1.0, kFinite);
   return s;
 }
 
@@ -617,7 +593,7 @@ Scene parse(const json& j, const fs::path& base_dir) {
   }
   scene.lights = read_array<Light>(top, "lights", read_light);
   scene.surfaces = read_array<Surface>(top, "surfaces", [&](const Object& o) { return read_surface(o, base_dir); });
-  scene.background = top.color("background", Rgb(0.0), kNonNegative);
+  scene.background = top.color("background", Rgb(0.0), kFinite);
   if (const json* m = top.find("method")) {
     Object method(*m, "method");
     read_string(method.need("name", "a non-empty method name"), "method.name", "a non-empty method name");
@@ -652,8 +628,8 @@ std::vector<std::string> registered_densities() {
 MaterialDesc read_material(const nlohmann::json& j, const std::string& path) {
   const Object o(j, path);
   MaterialDesc m;
-  m.sigma_t = o.color("sigma_t", kNonNegative);
-  m.albedo = o.color("albedo", Rgb(0.8), kUnit);
+  m.sigma_t = o.color("sigma_t", kFinite);
+  m.albedo = o.color("albedo", Rgb(0.8), kFinite);
   if (const json* p = o.find("phase")) m.phase = read_phase(Object(*p, o.at("phase")));
   return m;
 }
@@ -694,7 +670,9 @@ std::filesystem::path existing_file(const nlohmann::json& j, const std::string& 
 
 Scene Scene::from_json(const nlohmann::json& json, const std::filesystem::path& base_dir) {
   try {
-    return parse(json, base_dir);
+    Scene scene = parse(json, base_dir);
+    check_scene(scene);
+    return scene;
   } catch (const nlohmann::json::exception& e) {
     // The readers check types before every access, so this is a bug; still never let it escape raw.
     throw Error(std::string("scene: unexpected JSON error: ") + e.what());

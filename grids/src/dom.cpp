@@ -189,11 +189,6 @@ std::vector<PixelLayers> gather_scattered(const Scene& delta, const ExtinctionVo
 
 }  // namespace
 
-Image render_dom(const Scene& scene, const ExtinctionVolume& volume, const std::vector<DenseGrid>& delta_depths,
-                 const DomSolution& solution, double step_cells, const RenderOptions& options) {
-  return render_dom(scene, volume, delta_depths, solution, step_cells, options, View{scene.camera}).radiance;
-}
-
 RenderResult render_dom(const Scene& scene, const ExtinctionVolume& volume, const std::vector<DenseGrid>& delta_depths,
                         const DomSolution& solution, double step_cells, const RenderOptions& options, const View& view) {
   Rgb sky;
@@ -206,7 +201,7 @@ RenderResult render_dom(const Scene& scene, const ExtinctionVolume& volume, cons
   const std::vector<PixelLayers> scattered = gather_scattered(delta, volume, delta_depths, solution, step_cells, sky, view, gather_options);
   RenderOptions march_options = options;
   march_options.progress = progress ? [&](double f) { return progress(0.7 + 0.3 * f); } : ProgressCallback();
-  return render_dom(scene, volume, delta_depths, solution.delta_m_fraction, step_cells, march_options, view, scattered);
+  return add_unscattered(scene, volume, delta_depths, solution.delta_m_fraction, step_cells, march_options, view, scattered);
 }
 
 std::vector<PixelLayers> gather_planes(const Scene& scene, const ExtinctionVolume& volume, const std::vector<DenseGrid>& delta_depths,
@@ -224,8 +219,8 @@ std::vector<PixelLayers> gather_planes(const Scene& scene, const ExtinctionVolum
   return gather_scattered(delta, volume, delta_depths, part, step_cells, sky, view, options, &planes);
 }
 
-RenderResult render_dom(const Scene& scene, const ExtinctionVolume& volume, const std::vector<DenseGrid>& delta_depths, double delta_m_fraction,
-                        double step_cells, const RenderOptions& options, const View& view, const std::vector<PixelLayers>& scattered) {
+RenderResult add_unscattered(const Scene& scene, const ExtinctionVolume& volume, const std::vector<DenseGrid>& delta_depths, double delta_m_fraction,
+                             double step_cells, const RenderOptions& options, const View& view, const std::vector<PixelLayers>& scattered) {
   Rgb sky;
   Scene delta = without_sky(scene, sky);
   delta.background += sky;

@@ -168,7 +168,7 @@ class SplitDomSolution final : public MethodSolution {
     }
     RenderOptions march_options = options;
     march_options.progress = progress ? [&](double x) { return progress(0.9 + 0.1 * x); } : ProgressCallback();
-    RenderResult result = grids::render_dom(scene, fields_.volume, fields_.delta_depths, grown_.delta_m_fraction, fields_.step_cells, march_options, view, scattered);
+    RenderResult result = grids::add_unscattered(scene, fields_.volume, fields_.delta_depths, grown_.delta_m_fraction, fields_.step_cells, march_options, view, scattered);
     result.stats = {{"rank_gather_seconds", std::move(gathered)}, {"render_seconds", watch.lap()}};
     return result;
   }

@@ -123,9 +123,9 @@ TEST(Solution, CallerGridsAreCheckedAndViewed) {
   EXPECT_EQ(message({{8, 8, 8}, std::vector<float>(100, 1.0f)}), "medium.density.values: 100 values; expected 512 (resolution 8 x 8 x 8)");
   std::vector<float> samples(4 * 4 * 4, 0.5f);
   samples[17] = -1.0f;
-  EXPECT_EQ(message(GridDensity::viewing({4, 4, 4}, samples)), "medium.density.view[17]: -1; expected a finite density >= 0");
+  EXPECT_EQ(message(GridDensity::viewing({4, 4, 4}, samples)), "medium.density.view[17]: -1 at cell (1, 0, 1); expected a finite density >= 0");
   samples[17] = std::nanf("");
-  EXPECT_EQ(message(GridDensity::viewing({4, 4, 4}, samples)), "medium.density.view[17]: nan; expected a finite density >= 0");
+  EXPECT_EQ(message(GridDensity::viewing({4, 4, 4}, samples)), "medium.density.view[17]: nan at cell (1, 0, 1); expected a finite density >= 0");
   EXPECT_EQ(message(GridDensity::viewing({4, 4, 0}, samples)), "medium.density.resolution[2]: 0; expected at least 1 cell");
 
   samples[17] = 0.5f;

@@ -120,7 +120,7 @@ TEST(VolumeDisplay, AddsTheDomMultipleScatteringTermWithinOnePercent) {
   settings.directions = 48;
   settings.terms = 16;
   const grids::DomSolution solution = grids::solve_dom(f.volume, scene.lights, f.depths, settings);
-  const Image reference = grids::render_dom(scene, f.volume, f.depths, solution);
+  const Image reference = grids::render_dom(scene, f.volume, f.depths, solution, 0.5, {}, View{scene.camera}).radiance;
   VolumeDisplay display(scene, f.volume, f.depths);
   const Image single = display.render(scene.camera);
   display.show_dom(solution);

@@ -70,9 +70,9 @@ TEST(Extremes, ValuesPastTheLimitsNameTheirField) {
       {"lights[0].position", [](Scene& s) { s.lights[0] = PointLight{Vec3(1e155, 0.0, 0.0), Rgb(1.0)}; }},
       {"lights[0].position", [](Scene& s) { s.lights[0] = PointLight{Vec3(0.0, 2e9, 0.0), Rgb(1.0)}; }},
       // Intensity 1e20 crashed the DOM (NaN in GMRES), colours past the float maximum gave Inf.
-      {"lights[0].intensity", [](Scene& s) { s.lights[0] = PointLight{Vec3(0.0), Rgb(1e20, 1.0, 1.0)}; }},
+      {"lights[0].intensity[0]", [](Scene& s) { s.lights[0] = PointLight{Vec3(0.0), Rgb(1e20, 1.0, 1.0)}; }},
       {"lights[1].irradiance", [](Scene& s) { s.lights[1] = DirectionalLight{Vec3(0.0, -1.0, 0.0), Rgb(1e155)}; }},
-      {"background", [](Scene& s) { s.background = Rgb(3.5e38, 0.0, 0.0); }},
+      {"background[0]", [](Scene& s) { s.background = Rgb(3.5e38, 0.0, 0.0); }},
       {"surfaces[0].kd", [](Scene& s) { s.surfaces[0].kd = Rgb(1e16); }},
       {"surfaces[0].shininess", [](Scene& s) { s.surfaces[0].shininess = 1e6; }},
       // The camera 1e36 away hung the DOM; look_at at -1.7e308 gave NaN in quadrature.

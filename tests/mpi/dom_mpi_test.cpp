@@ -86,7 +86,8 @@ TEST(MpiDom, MatchesTheSingleProcessSolver) {
   scene.camera.position = Vec3(0.3, 0.4, 3.2);
   scene.camera.width_px = scene.camera.height_px = 24;
   scene.lights = s.lights;
-  const Image a = grids::render_dom(scene, s.volume, s.depths, single), b = grids::render_dom(scene, s.volume, s.depths, whole);
+  const Image a = grids::render_dom(scene, s.volume, s.depths, single, 0.5, {}, View{scene.camera}).radiance,
+              b = grids::render_dom(scene, s.volume, s.depths, whole, 0.5, {}, View{scene.camera}).radiance;
   double diff = 0.0, ref = 0.0;
   for (int y = 0; y < 24; ++y)
     for (int x = 0; x < 24; ++x) {

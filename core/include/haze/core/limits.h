@@ -10,7 +10,7 @@ namespace haze {
 // a directional light). Float32 keeps 1e-7 of a coordinate: at 1e9, a hundred units.
 inline constexpr double kMaxCoordinate = 1e9;
 inline bool within_reach(const Vec3& p) { return max_abs(p) <= kMaxCoordinate; }  // false for NaN
-// Light intensity, irradiance and radiance, emission, background and the surfaces' kd and ks.
+// Light intensity, irradiance and radiance, emission and background.
 inline constexpr double kMaxRadiometric = 1e15;
 // sigma_t times the density's largest value: extinction per unit length.
 inline constexpr double kMaxExtinction = 1e9;

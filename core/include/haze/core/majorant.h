@@ -20,12 +20,12 @@ struct MajorantSegment {
   size_t cell;     // the grid cell, (z * ny + y) * nx + x
 };
 
-class Medium;
+class DensityField;
 
 class MajorantGrid {
  public:
   // One cell for homogeneous media; `cells` per axis for heterogeneous ones.
-  MajorantGrid(const Medium& medium, int cells = 16);
+  MajorantGrid(const DensityField& field, int cells = 16);
   // Given bounds: density[(z * n[1] + y) * n[0] + x] bounds the density over cell (x, y, z).
   MajorantGrid(const Aabb& bounds, const std::array<int, 3>& n, std::vector<double> density);
 

@@ -1,5 +1,6 @@
-// The Medium interface every renderer in Haze works on, and the media a scene file describes.
-// sigma_t(x) = sigma_t_scale * density(x) per RGB channel; sigma_s = albedo * sigma_t (docs/SCENES.md, "medium").
+// Media: one density field (DensityField: the scene's constant, RBF and grid densities, and the
+// modules' fields) times the coefficients, sigma_t(x) = sigma_t_scale * density(x) per RGB channel,
+// sigma_s = albedo * sigma_t (docs/SCENES.md, "medium"); and the media a scene file describes.
 #pragma once
 
 #include <haze/core/math.h>
@@ -49,15 +50,20 @@ struct GridDensity {
   static GridDensity viewing(const std::array<int, 3>& resolution, std::span<const float> samples) { return {resolution, {}, samples}; }
 };
 
-// A density a module supplies in its own form (the particles' Gaussians): core renders it through
-// this interface, the grid methods sample it at their cells' centres.
+// A density field: the one interface every medium's density answers through, the scene's own
+// (constant, RBF and grid: make_medium makes them fields) and a module's (the particles' Gaussians,
+// a VDB grid: FieldDensity). Core renders any of them through Medium; the grid methods sample a
+// module's at their cells' centres.
 class DensityField {
  public:
   virtual ~DensityField() = default;
-  virtual Aabb bounds() const = 0;  // where the density may be non-zero (finite)
+  // Where the density may be non-zero: finite, but for a constant density without bounds.
+  virtual Aabb bounds() const = 0;
   virtual double density(const Vec3& x) const = 0;
   virtual double max_density(const Aabb& region) const = 0;  // an upper bound over the region
   virtual double feature_size() const = 0;                   // a length over which it changes little
+  // Constant within its bounds.
+  virtual bool homogeneous() const { return false; }
   // integral along a -> b; by default Medium's composite Simpson.
   virtual std::optional<double> density_integral(const Vec3& /*a*/, const Vec3& /*b*/) const { return std::nullopt; }
   // Its own majorant grid (Medium::majorants); by default built from max_density.
@@ -108,26 +114,29 @@ struct MediumDesc {
   Emission emission;
 };
 
+// A medium: one density field times the coefficients (sigma_t(x) = sigma_t_scale density(x),
+// sigma_s = albedo sigma_t), its phase function and emission. Made by make_medium.
 class Medium {
  public:
-  virtual ~Medium() = default;
+  Medium(std::shared_ptr<const DensityField> field, const MediumDesc& desc);
 
   // Where the density may be non-zero; unbounded media return the default Aabb.
-  virtual Aabb bounds() const = 0;
-  virtual double density(const Vec3& x) const = 0;
+  Aabb bounds() const { return field_->bounds(); }
+  double density(const Vec3& x) const { return field_->density(x); }
   // An upper bound of density over region (intersected with bounds()): a majorant.
-  virtual double max_density(const Aabb& region) const = 0;
+  double max_density(const Aabb& region) const { return field_->max_density(region); }
   // A length over which the density changes little: the step numerical quadrature should use.
-  virtual double feature_size() const = 0;
-  virtual bool homogeneous() const { return false; }
-  // integral of density along the segment a -> b, clipped to bounds(). Exact for constant density;
-  // otherwise composite Simpson with steps of at most feature_size() / 4.
-  virtual double density_integral(const Vec3& a, const Vec3& b) const;
+  double feature_size() const { return field_->feature_size(); }
+  bool homogeneous() const { return field_->homogeneous(); }
+  // integral of density along the segment a -> b, clipped to bounds(): the field's own where it
+  // has one (exact for constant and RBF densities), else composite Simpson with steps of at most
+  // feature_size() / 4.
+  double density_integral(const Vec3& a, const Vec3& b) const;
   // The majorant iterator along a ray (pbrt-v4's SampleT_maj over a DDA majorant grid): segments
-  // of the ray with an upper bound of the density on each. Built on first use from max_density
-  // (16^3 cells; one for homogeneous or unbounded media), thread-safe; a medium with a better
-  // structure overrides make_majorants.
+  // of the ray with an upper bound of the density on each. The field's own, or built on first use
+  // from max_density (16^3 cells; one for homogeneous or unbounded media); thread-safe.
   const MajorantGrid& majorants() const;
+  const DensityField& field() const { return *field_; }
 
   const Rgb& sigma_t_scale() const { return sigma_t_; }
   const Rgb& albedo() const { return albedo_; }
@@ -144,13 +153,8 @@ class Medium {
   // sky): an unbounded medium then absorbs every channel it extinguishes.
   Rgb transmittance_along(const Vec3& x, const Vec3& direction, double distance) const;
 
- protected:
-  Medium(const Rgb& sigma_t, const Rgb& albedo, const PhaseFunction& phase)
-      : sigma_t_(sigma_t), albedo_(albedo), phase_(phase) {}
-  virtual std::shared_ptr<const MajorantGrid> make_majorants() const;
-
  private:
-  friend std::unique_ptr<Medium> make_medium(const MediumDesc& desc);
+  std::shared_ptr<const DensityField> field_;
   Rgb sigma_t_, albedo_;
   PhaseFunction phase_;
   Emission emission_;
@@ -168,8 +172,12 @@ GridDensity sample_grid(const DensityField& field, int resolution, int threads =
 // `path`.<field>, the value and what was expected.
 void check_medium(const MediumDesc& desc, const std::string& path = "medium");
 
-// The medium a scene describes (constant, RBF or grid density in core's direct form). haze::prepare
-// checks it first (check_medium); here only a grid's sample count is.
+// The density a scene describes as a field: constant (within the bounds), the RBF sum evaluated
+// directly (seed 003 eq. 2), the grid trilinear between cell centres (its own values copied, a
+// view only viewed), or the module's field. Only a grid's sample count is checked here.
+std::shared_ptr<const DensityField> density_field(const MediumDesc& desc);
+// The medium a scene describes: Medium(density_field(desc), desc). haze::prepare checks it first
+// (check_medium).
 std::unique_ptr<Medium> make_medium(const MediumDesc& desc);
 
 // make_medium(desc)->bounds() without building the medium: desc.bounds, or for an RBF density

@@ -240,16 +240,15 @@ DomSolution solve_dom(const ExtinctionVolume& volume, const std::vector<Light>& 
 // (PhaseMatrix::row) and projected on the kept eigenvectors.
 Eigen::VectorXd inscatter_weights(const DomSolution& solution, const Vec3& w);
 
-// The image of a solved scene: unscattered light (surfaces lit through `delta_depths`, as
-// solve_dom takes them; the background plus any sky) through
-// the medium, plus, along each camera ray, the single-scattered light and the in-scattered diffuse
-// radiance sum_k c_k m_k (c from inscatter_weights toward the eye), both carried by the delta-M
-// scaled extinction when the solve used it (the formal solution of the scaled equation; with f = 0
-// it is the propagation marcher's estimator plus the gather). One solution serves any camera.
-Image render_dom(const Scene& scene, const ExtinctionVolume& volume, const std::vector<DenseGrid>& delta_depths,
-                 const DomSolution& solution, double step_cells = 0.5, const RenderOptions& options = {});
-// The same for `view` (its camera and depth; with view.layers, L_in, T and C per pixel: the
-// gathered and unscattered light summed, seen through the unscattered march's transmittance).
+// The image of a solved scene seen in `view` (its camera and depth; with view.layers, L_in, T and
+// C per pixel: the gathered and unscattered light summed, seen through the unscattered march's
+// transmittance): unscattered light (surfaces lit through `delta_depths`, as solve_dom takes them;
+// the background plus any sky) through the medium, plus, along each camera ray, the
+// single-scattered light and the in-scattered diffuse radiance sum_k c_k m_k (c from
+// inscatter_weights toward the eye), both carried by the delta-M scaled extinction when the solve
+// used it (the formal solution of the scaled equation; with f = 0 it is the propagation marcher's
+// estimator plus the gather). One solution serves any camera. Method dom's one render path: the
+// gather (gather_planes' over all planes) and then add_unscattered.
 RenderResult render_dom(const Scene& scene, const ExtinctionVolume& volume, const std::vector<DenseGrid>& delta_depths,
                         const DomSolution& solution, double step_cells, const RenderOptions& options, const View& view);
 
@@ -262,10 +261,11 @@ RenderResult render_dom(const Scene& scene, const ExtinctionVolume& volume, cons
 std::vector<PixelLayers> gather_planes(const Scene& scene, const ExtinctionVolume& volume, const std::vector<DenseGrid>& delta_depths,
                                        const DomSolution& part, double step_cells, std::array<int, 2> planes, const View& view,
                                        const RenderOptions& options);
-// The image given the scattered light per pixel (composed stretches, or render_dom's own gather):
-// the unscattered march of the whole volume, plus `scattered`.
-RenderResult render_dom(const Scene& scene, const ExtinctionVolume& volume, const std::vector<DenseGrid>& delta_depths, double delta_m_fraction,
-                        double step_cells, const RenderOptions& options, const View& view, const std::vector<PixelLayers>& scattered);
+// render_dom's second part, the image given the scattered light per pixel (render_dom's own
+// gather, or a split solve's composed stretches): the unscattered march of the whole volume, plus
+// `scattered`.
+RenderResult add_unscattered(const Scene& scene, const ExtinctionVolume& volume, const std::vector<DenseGrid>& delta_depths, double delta_m_fraction,
+                             double step_cells, const RenderOptions& options, const View& view, const std::vector<PixelLayers>& scattered);
 
 // Everything method "dom" computes before it renders, from the scene and the method's settings in
 // options.settings (resolution, directions, terms, scheme, accelerator, iterations, tolerance,
