@@ -1,230 +1,31 @@
-// Scene files (docs/SCENES.md). Every field is checked here, once, so that renderers can trust a
-// Scene: a bad value throws haze::Error naming its JSON path, the value and what was expected.
+// Scene files (docs/SCENES.md): the schema, read through the JSON toolkit (json_object.h) and the
+// grid file reader (grid_file.h), the modules' density types (register_density,
+// register_medium_density), and loading a file. Types are checked as fields are read, ranges by
+// check_scene last, so that renderers can trust a Scene: a bad value throws haze::Error naming its
+// JSON path, the value and what was expected.
+#include "grid_file.h"
+#include "json_object.h"
+
 #include <haze/core/error.h>
 #include <haze/core/scene.h>
 
 #include <algorithm>
-#include <bit>
-#include <climits>
-#include <cstdint>
 #include <fstream>
 #include <initializer_list>
 #include <iterator>
 #include <map>
 #include <memory>
 #include <mutex>
-#include <set>
-#include <new>
 #include <string_view>
 #include <utility>
 
 namespace haze {
 
-namespace {
+using namespace internal;
 
-using json = nlohmann::json;
-namespace fs = std::filesystem;
+namespace {
 
 constexpr int kMaxImagePx = 16384;
-constexpr int kMaxGridAxis = 16384;
-// Downstream code may index a grid with int: keep nx * ny * nz within int range.
-constexpr std::uint64_t kMaxGridCells = INT_MAX;
-
-const char* const kVec3Text = "an [x, y, z] array of 3 finite numbers";
-const char* const kDirectionText = "a non-zero [x, y, z] array of 3 finite numbers";
-
-std::string key_path(const std::string& path, std::string_view key) {
-  return path.empty() ? std::string(key) : path + "." + std::string(key);
-}
-std::string index_path(const std::string& path, std::size_t i) { return path + "[" + std::to_string(i) + "]"; }
-
-std::string join(std::initializer_list<std::string_view> names, std::string_view quote = "") {
-  std::string out;
-  for (auto name : names) {
-    if (!out.empty()) out += ", ";
-    out.append(quote).append(name).append(quote);
-  }
-  return out;
-}
-
-// A string as JSON, at most `most` of its characters.
-std::string quoted(const std::string& s, size_t most) {
-  return json(s.substr(0, most)).dump(-1, ' ', false, json::error_handler_t::replace) + (s.size() > most ? "..." : "");
-}
-
-// Appends v as JSON text until `out` holds `limit` characters, no deeper than 16 levels: a value
-// may be megabytes long or nested 100,000 deep, so it is never dumped whole.
-void brief(const json& v, std::string& out, size_t limit, int depth) {
-  if (out.size() >= limit) return;
-  if (v.is_string()) {
-    out += quoted(v.get_ref<const std::string&>(), limit - out.size());
-  } else if (v.is_number_float() && !std::isfinite(v.get<double>())) {
-    out += to_text(v.get<double>());  // nlohmann dumps NaN and inf as null
-  } else if (!v.is_structured()) {
-    out += v.dump();
-  } else if (depth >= 16) {
-    out += v.is_array() ? "[...]" : "{...}";
-  } else {
-    out += v.is_array() ? '[' : '{';
-    for (auto it = v.begin(); it != v.end(); ++it) {
-      if (it != v.begin()) out += ", ";
-      if (out.size() >= limit) return;
-      if (v.is_object()) out += quoted(it.key(), limit) + ": ";
-      brief(*it, out, limit, depth + 1);
-    }
-    out += v.is_array() ? ']' : '}';
-  }
-}
-
-}  // namespace
-
-std::string json_text(const nlohmann::json& v) {
-  std::string s;
-  brief(v, s, 81, 0);
-  if (s.size() > 80) s = s.substr(0, 77) + "...";
-  return s;
-}
-
-namespace {
-
-std::string text(const json& v) { return json_text(v); }
-
-// A number check: the predicate and the words for the error message. The reader checks types and
-// finiteness; ranges are check_scene's (scene_check.cpp), which from_json calls last, and the
-// phase constructors'.
-struct Check {
-  bool (*ok)(double);
-  const char* expected;
-};
-constexpr Check kFinite{[](double) { return true; }, "a finite number"};
-// The phase constructors check |g| <= 0.9999 themselves; this only words the type error.
-constexpr Check kG{[](double) { return true; }, "a number with |g| <= 0.9999"};
-
-double read_number(const json& v, const std::string& path, Check check) {
-  if (!v.is_number()) throw Error(path, text(v), check.expected);
-  double x = v.get<double>();
-  if (!std::isfinite(x) || !check.ok(x)) throw Error(path, text(v), check.expected);
-  return x;
-}
-
-int read_int(const json& v, const std::string& path, int lo, int hi) {
-  const std::string expected = "an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]";
-  if (!v.is_number_integer()) throw Error(path, text(v), expected);
-  // Unsigned JSON integers may not fit int64_t; compare before converting.
-  if (v.is_number_unsigned()) {
-    auto u = v.get<std::uint64_t>();
-    if (u > static_cast<std::uint64_t>(hi) || static_cast<std::int64_t>(u) < lo) throw Error(path, text(v), expected);
-    return static_cast<int>(u);
-  }
-  auto i = v.get<std::int64_t>();
-  if (i < lo || i > hi) throw Error(path, text(v), expected);
-  return static_cast<int>(i);
-}
-
-Vec3 read_vec3(const json& v, const std::string& path) {
-  if (!v.is_array() || v.size() != 3) throw Error(path, text(v), kVec3Text);
-  Vec3 out;
-  for (int i = 0; i < 3; ++i) out[i] = read_number(v[i], index_path(path, i), kFinite);
-  return out;
-}
-
-// Made unit length where it can be (check_scene refuses one that cannot).
-Vec3 read_direction(const json& v, const std::string& path) {
-  Vec3 d = read_vec3(v, path);
-  Vec3 unit = d;
-  return make_unit(unit) ? unit : d;
-}
-
-// A colour-like quantity: one number for all channels or an [r, g, b] array, each checked.
-Rgb read_color(const json& v, const std::string& path, Check check) {
-  if (v.is_number()) return Rgb(read_number(v, path, check));
-  if (!v.is_array() || v.size() != 3)
-    throw Error(path, text(v), std::string(check.expected) + ", or an [r, g, b] array of such numbers");
-  Rgb out;
-  for (int i = 0; i < 3; ++i) out[i] = read_number(v[i], index_path(path, i), check);
-  return out;
-}
-
-std::string read_string(const json& v, const std::string& path, const std::string& expected) {
-  if (!v.is_string() || v.get_ref<const std::string&>().empty()) throw Error(path, text(v), expected);
-  return v.get<std::string>();
-}
-
-// A JSON object being read, with its path for error messages.
-class Object {
- public:
-  Object(const json& j, std::string path) : j_(j), path_(std::move(path)) {
-    if (!j_.is_object()) throw Error(path_.empty() ? "(scene)" : path_, text(j_), "a JSON object {...}");
-  }
-
-  std::string at(std::string_view key) const { return key_path(path_, key); }
-  const json* find(const char* key) const {
-    auto it = j_.find(key);
-    return it == j_.end() ? nullptr : &*it;
-  }
-  const json& need(const char* key, const std::string& expected) const {
-    if (const json* v = find(key)) return *v;
-    throw Error(at(key), "missing", expected);
-  }
-
-  // Unknown fields are almost always typos ("albdeo"): reject them and name the allowed ones.
-  void allow(std::initializer_list<std::string_view> fields) const {
-    for (const auto& [key, value] : j_.items()) {
-      if (std::find(fields.begin(), fields.end(), key) != fields.end()) continue;
-      std::string where = path_.empty() ? "the scene" : path_;
-      if (!type_.empty()) where += " (type \"" + type_ + "\")";
-      throw Error(at(key), "unknown field \"" + key + "\"", "a field of " + where + ": " + join(fields));
-    }
-  }
-
-  // The "type" field, one of `types`; `fallback` when absent, or required when fallback is null.
-  std::string type(std::initializer_list<std::string_view> types, const char* fallback = nullptr,
-                   const std::vector<std::string>& more = {}) const {
-    std::string expected = "one of " + join(types, "\"");
-    for (const std::string& t : more) expected += ", \"" + t + "\"";
-    const json* v = find("type");
-    if (!v && !fallback) throw Error(at("type"), "missing", expected);
-    auto known = [&](const json& t) {
-      if (!t.is_string()) return false;
-      const std::string& name = t.get_ref<const std::string&>();
-      return std::find(types.begin(), types.end(), name) != types.end() || std::find(more.begin(), more.end(), name) != more.end();
-    };
-    if (v && !known(*v)) throw Error(at("type"), text(*v), expected);
-    type_ = v ? v->get<std::string>() : fallback;
-    return type_;
-  }
-
-  void name_type(const std::string& type) const { type_ = type; }  // for allow()'s message, where type() was not called
-
-  double number(const char* key, Check check) const { return read_number(need(key, check.expected), at(key), check); }
-  double number(const char* key, double fallback, Check check) const {
-    const json* v = find(key);
-    return v ? read_number(*v, at(key), check) : fallback;
-  }
-  int integer(const char* key, int fallback, int lo, int hi) const {
-    const json* v = find(key);
-    return v ? read_int(*v, at(key), lo, hi) : fallback;
-  }
-  Vec3 vec3(const char* key) const { return read_vec3(need(key, kVec3Text), at(key)); }
-  Vec3 vec3(const char* key, const Vec3& fallback) const {
-    const json* v = find(key);
-    return v ? read_vec3(*v, at(key)) : fallback;
-  }
-  Vec3 direction(const char* key) const { return read_direction(need(key, kDirectionText), at(key)); }
-  Rgb color(const char* key, Check check) const {
-    return read_color(need(key, std::string(check.expected) + ", or an [r, g, b] array of such numbers"), at(key),
-                      check);
-  }
-  Rgb color(const char* key, const Rgb& fallback, Check check) const {
-    const json* v = find(key);
-    return v ? read_color(*v, at(key), check) : fallback;
-  }
-
- private:
-  const json& j_;
-  std::string path_;
-  mutable std::string type_;  // once type() has read it: allow() names it, as the fields depend on it
-};
 
 Camera read_camera(const Object& o) {
   Camera c;
@@ -263,68 +64,6 @@ Aabb read_bounds(const json& v, const std::string& path) {
                     to_text(box.hi[a]));
   }
   return box;
-}
-
-// The existing file o.file names, relative to the scene's folder, as an absolute path (so that
-// messages say exactly where Haze looked).
-fs::path existing_file(const Object& o, const fs::path& base_dir, const std::string& expected) {
-  const std::string name = read_string(o.need("file", expected), o.at("file"), expected);
-  // A NUL would end the name early for the C library: "a.raw\u0000.vdb" is not "a.raw".
-  if (name.find('\0') != std::string::npos) throw Error(o.at("file"), text(o.need("file", expected)), "a file name without NUL characters");
-  fs::path file = name;
-  if (file.is_relative()) file = base_dir / file;
-  std::error_code ec;
-  if (fs::path absolute = fs::absolute(file, ec); !ec) file = absolute;
-  file = file.lexically_normal();
-  if (!fs::is_regular_file(file, ec))
-    throw Error(o.at("file"), text(o.need("file", expected)) + " (resolved to " + file.string() + ")",
-                "an existing file, but there is none at that path");
-  return file;
-}
-
-GridDensity read_grid(const Object& o, const fs::path& base_dir) {
-  GridDensity grid;
-  const std::string res_path = o.at("resolution");
-  const std::string res_expected = "[nx, ny, nz], integers in [1, " + std::to_string(kMaxGridAxis) + "]";
-  const json& res = o.need("resolution", res_expected);
-  if (!res.is_array() || res.size() != 3) throw Error(res_path, text(res), res_expected);
-  std::uint64_t cells = 1;
-  for (std::size_t i = 0; i < 3; ++i) {
-    grid.resolution[i] = read_int(res[i], index_path(res_path, i), 1, kMaxGridAxis);
-    cells *= static_cast<std::uint64_t>(grid.resolution[i]);
-  }
-  if (cells > kMaxGridCells)
-    throw Error(res_path, text(res), "at most " + std::to_string(kMaxGridCells) + " cells in all (nx * ny * nz)");
-
-  const std::string file_path = o.at("file");
-  const char* file_expected = "a float32 little-endian file name (relative to the scene file's folder)";
-  const fs::path file = existing_file(o, base_dir, file_expected);
-  std::error_code ec;
-  const std::uint64_t expected_bytes = cells * 4;
-  const std::uint64_t actual_bytes = fs::file_size(file, ec);
-  if (ec) throw Error(file_path, file.string(), "a readable file (" + ec.message() + ")");
-  if (actual_bytes != expected_bytes)
-    throw Error(file_path, file.string() + " of " + std::to_string(actual_bytes) + " bytes",
-                std::to_string(expected_bytes) + " bytes (nx * ny * nz * 4 = " + std::to_string(grid.resolution[0]) +
-                    " * " + std::to_string(grid.resolution[1]) + " * " + std::to_string(grid.resolution[2]) +
-                    " * 4)");
-
-  try {
-    grid.values.resize(static_cast<std::size_t>(cells));
-  } catch (const std::bad_alloc&) {
-    throw Error(file_path, file.string(), "a grid that fits in memory (" + std::to_string(expected_bytes) + " bytes)");
-  }
-  std::ifstream in(file, std::ios::binary);
-  in.read(reinterpret_cast<char*>(grid.values.data()), static_cast<std::streamsize>(expected_bytes));
-  if (!in) throw Error(file_path, file.string(), "a readable file of " + std::to_string(expected_bytes) + " bytes");
-  if constexpr (std::endian::native == std::endian::big) {
-    for (auto& v : grid.values) {
-      auto bits = std::bit_cast<std::uint32_t>(v);
-      bits = (bits >> 24) | ((bits >> 8) & 0xff00u) | ((bits << 8) & 0xff0000u) | (bits << 24);
-      v = std::bit_cast<float>(bits);
-    }
-  }
-  return grid;
 }
 
 struct MediumDensityRegistry {
@@ -636,38 +375,6 @@ MaterialDesc read_material(const nlohmann::json& j, const std::string& path) {
 
 Emission read_emission(const nlohmann::json& j, const std::string& path, const Density& density) { return read_emission(Object(j, path), density); }
 
-namespace scene_fields {
-
-void allow(const nlohmann::json& j, const std::string& path, std::initializer_list<std::string_view> fields, const std::string& type) {
-  const Object o(j, path);
-  o.name_type(type);
-  o.allow(fields);
-}
-
-int integer(const nlohmann::json& j, const std::string& path, const char* key, int fallback, int lo, int hi, const std::string& meaning) {
-  const Object o(j, path);
-  try {
-    return o.integer(key, fallback, lo, hi);
-  } catch (const Error& e) {
-    if (meaning.empty()) throw;
-    throw Error(e.field(), e.value(), e.expected() + ": " + meaning);
-  }
-}
-
-std::string text(const nlohmann::json& j, const std::string& path, const char* key, const std::string& fallback, const std::string& expected) {
-  const Object o(j, path);
-  const json* v = o.find(key);
-  if (!v && !fallback.empty()) return fallback;
-  return read_string(v ? *v : o.need(key, expected), o.at(key), expected);
-}
-
-std::filesystem::path existing_file(const nlohmann::json& j, const std::string& path, const std::filesystem::path& directory,
-                                    const std::string& expected) {
-  return haze::existing_file(Object(j, path), directory, expected);
-}
-
-}  // namespace scene_fields
-
 Scene Scene::from_json(const nlohmann::json& json, const std::filesystem::path& base_dir) {
   try {
     Scene scene = parse(json, base_dir);
@@ -679,62 +386,6 @@ Scene Scene::from_json(const nlohmann::json& json, const std::filesystem::path& 
   }
 }
 
-namespace {
-
-// The scene file's JSON, checked as it is parsed (nlohmann's parser callback): arrays and objects
-// nested at most kMaxJsonDepth deep (a million-deep file would overflow a recursive reader), and no
-// key twice in one object (nlohmann keeps the last silently). Errors name the JSON path.
-constexpr std::size_t kMaxJsonDepth = 256;
-struct JsonChecks {
-  struct Level {
-    bool array = false;
-    long index = -1;      // an array's element being read
-    std::string key;      // an object's key being read
-    std::set<std::string> keys;
-  };
-  std::string file;
-  std::shared_ptr<std::vector<Level>> levels = std::make_shared<std::vector<Level>>();  // the callback is copied
-
-  std::string where() const {
-    std::string out;
-    for (const Level& l : *levels) out += l.array ? "[" + std::to_string(l.index) + "]" : (out.empty() ? "" : ".") + l.key;
-    return out.empty() ? "(scene)" : out;
-  }
-  bool operator()(int, json::parse_event_t event, json& parsed) const {
-    using Event = json::parse_event_t;
-    std::vector<Level>& stack = *levels;
-    const auto element = [&] {
-      if (!stack.empty() && stack.back().array) ++stack.back().index;
-    };
-    switch (event) {
-      case Event::object_start:
-      case Event::array_start:
-        element();
-        if (stack.size() >= kMaxJsonDepth)
-          throw Error(file, "arrays and objects nested deeper than " + std::to_string(kMaxJsonDepth) + " at " + where(),
-                      "at most " + std::to_string(kMaxJsonDepth) + " levels");
-        stack.push_back({event == Event::array_start, -1, {}, {}});
-        break;
-      case Event::key: {
-        Level& object = stack.back();
-        object.key = parsed.get<std::string>();
-        if (!object.keys.insert(object.key).second) throw Error(where(), "given twice", "each key once in an object");
-        break;
-      }
-      case Event::value:
-        element();
-        break;
-      case Event::object_end:
-      case Event::array_end:
-        stack.pop_back();
-        break;
-    }
-    return true;
-  }
-};
-
-}  // namespace
-
 Scene Scene::load(const std::filesystem::path& path) {
   std::error_code ec;
   if (!fs::is_regular_file(path, ec)) throw Error(path.string(), "missing", "an existing scene file");
@@ -742,34 +393,7 @@ Scene Scene::load(const std::filesystem::path& path) {
   std::string content((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   if (!in.good() && !in.eof()) throw Error(path.string(), "unreadable", "a readable scene file");
 
-  nlohmann::json j;
-  // Line and column of byte `pos` (0-based) of the file.
-  auto place = [&](std::size_t pos) {
-    pos = std::min(pos, content.size());
-    const std::string_view head = std::string_view(content).substr(0, pos);
-    const std::size_t last_newline = head.rfind('\n');
-    return "line " + std::to_string(1 + std::count(head.begin(), head.end(), '\n')) + ", column " +
-           std::to_string(pos - (last_newline == std::string_view::npos ? 0 : last_newline + 1) + 1);
-  };
-  try {
-    j = nlohmann::json::parse(content, JsonChecks{path.string()});
-  } catch (const nlohmann::json::out_of_range& e) {
-    // A number beyond a double's range ("number overflow parsing '1e999'"): where it is.
-    std::string detail = e.what();
-    const std::size_t open = detail.find('\''), close = detail.rfind('\'');
-    const std::string token = open != std::string::npos && close > open ? detail.substr(open + 1, close - open - 1) : std::string();
-    const std::size_t at = token.empty() ? std::string::npos : content.find(token);
-    throw Error(path.string(), (at == std::string::npos ? std::string() : "at " + place(at) + ": ") + "the number " + token,
-                "numbers within a double's range (up to about 1.8e308)");
-  } catch (const nlohmann::json::parse_error& e) {
-    // Drop nlohmann's "[json.exception.parse_error.101] " tag: the rest is the useful part.
-    std::string detail = e.what();
-    if (auto tag_end = detail.find("] "); detail.starts_with("[json.exception") && tag_end != std::string::npos)
-      detail.erase(0, tag_end + 2);
-    // nlohmann's byte is 1-based: the character where parsing failed.
-    throw Error(path.string(), "invalid JSON at " + place(e.byte > 0 ? e.byte - 1 : 0) + " (byte " + std::to_string(e.byte) + ")",
-                "valid JSON (" + detail + ")");
-  }
+  const nlohmann::json j = parse_checked(content, path.string());
   fs::path base = path.parent_path();
   return from_json(j, base.empty() ? fs::path(".") : base);
 }
