@@ -503,7 +503,7 @@ int run(const TradeArgs& a) {
 }  // namespace
 
 Command add_bench(CLI::App& app) {
-  auto* bench = app.add_subcommand("bench", "Measurements: the speed/accuracy trade of every method");
+  auto* bench = app.add_subcommand("bench", "Measurements: the speed/accuracy trade of every method, a host's frame");
   bench->require_subcommand(1);
   auto* sub = bench->add_subcommand("trade", "Time and error against the reference for every method and setting on the trade suite");
   auto a = std::make_shared<TradeArgs>();
@@ -515,7 +515,8 @@ Command add_bench(CLI::App& app) {
   sub->add_option("--tolerances", a->tolerances, "The tolerances method auto is run at")->capture_default_str();
   sub->add_option("--scene", a->only, "Only these scenes of the suite (by file stem); the others' rows stay");
   sub->add_flag("--report-only", a->report_only, "Rewrite TRADEOFFS.md from the rows in --out, rendering nothing");
-  return {bench, [a] { return run(*a); }};
+  const Command frame = add_bench_frame(*bench);
+  return {bench, [a, frame] { return frame.sub->parsed() ? frame.run() : run(*a); }};
 }
 
 }  // namespace haze::app

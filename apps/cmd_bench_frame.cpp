@@ -1,0 +1,167 @@
+// haze bench frame: a host renderer's frame (docs/HOST.md, "Frame time"; tracker issue 51). Each
+// scene of bench/frame names its method: one solution is prepared, then the camera moves every
+// frame on an orbit around it while the host's floor (y = -1.5) is its depth buffer, and each
+// stage is timed frame by frame: the froxel build (build_froxels, 160 x 90 x 64 by default), the
+// CPU composite of the froxels over the host's colour and depth, and the per-pixel layers
+// (Solution::render with the depth). Medians over the frames.
+#include "commands.h"
+
+#include <haze/core/error.h>
+#include <haze/core/stopwatch.h>
+#include <haze/froxels/froxels.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+#include <limits>
+#include <memory>
+
+namespace haze::app {
+namespace {
+
+struct FrameArgs {
+  std::string scenes = HAZE_FRAME_SCENES_DIR;
+  std::vector<std::string> only;    // --scene: these scenes only (by file stem)
+  std::vector<std::string> stages;  // --stage: these stages only
+  int frames = 30, threads = 2, width = 1920, height = 1080;
+  std::vector<int> froxels{160, 90, 64};
+  double stage_seconds = 60.0;  // a stage stops before this many seconds have passed, after 3 frames at least
+  bool json = false;
+};
+
+constexpr const char* kStages[] = {"froxel_build", "composite", "per_pixel"};
+
+// Frame f's camera: an orbit of radius 6 at height 1.5 around the origin, 0.1 rad a frame.
+Camera pose(const Camera& base, int f) {
+  Camera c = base;
+  const double a = 0.1 * f;
+  c.position = Vec3(6.0 * std::sin(a), 1.5, 6.0 * std::cos(a)), c.look_at = Vec3(0.0, 0.5, 0.0);
+  return c;
+}
+
+// The host's floor at y = -1.5 as the distance along each pixel's ray (+inf above the horizon).
+std::vector<float> floor_depth(const Camera& camera) {
+  std::vector<float> depth;
+  depth.reserve(static_cast<size_t>(camera.width_px) * static_cast<size_t>(camera.height_px));
+  for (int y = 0; y < camera.height_px; ++y)
+    for (int x = 0; x < camera.width_px; ++x) {
+      const Ray ray = camera.pixel_ray(x, y);
+      depth.push_back(ray.direction.y < 0.0 ? static_cast<float>((-1.5 - ray.origin.y) / ray.direction.y) : std::numeric_limits<float>::infinity());
+    }
+  return depth;
+}
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+struct StageRow {
+  std::string scene, method, stage;
+  std::vector<double> ms;  // per frame
+  double items = 0.0;      // froxels or pixels a frame
+};
+
+// Times `stage` frame by frame; `frame(f)` runs frame f's work and returns its milliseconds.
+template <class Frame>
+std::vector<double> time_frames(const FrameArgs& a, Frame frame) {
+  std::vector<double> ms;
+  const Stopwatch total;
+  for (int f = 0; f < a.frames; ++f) {
+    ms.push_back(frame(f));
+    if (f >= 2 && total.seconds() > a.stage_seconds) break;
+  }
+  return ms;
+}
+
+std::vector<StageRow> run_scene(const std::filesystem::path& file, const FrameArgs& a) {
+  Scene scene = Scene::load(file);
+  scene.camera.width_px = a.width, scene.camera.height_px = a.height;
+  RenderOptions options;
+  options.threads = a.threads;
+  const Solution solution = prepare(scene, "", options);
+  const FroxelGrid grid{a.froxels[0], a.froxels[1], a.froxels[2]};
+  RenderOptions frame;
+  frame.threads = a.threads;
+  const Image host(a.width, a.height);
+  const auto wanted = [&](const std::string& stage) { return a.stages.empty() || std::count(a.stages.begin(), a.stages.end(), stage) > 0; };
+  std::vector<StageRow> rows;
+  const std::string name = file.stem().string(), method = solution.method();
+  const double pixels = static_cast<double>(a.width) * a.height;
+  if (wanted(kStages[0]))
+    rows.push_back({name, method, kStages[0], time_frames(a, [&](int f) {
+                      const Camera camera = pose(scene.camera, f);
+                      const Stopwatch watch;
+                      const Froxels froxels = build_froxels(solution, camera, grid, frame);
+                      return 1e3 * watch.seconds();
+                    }), static_cast<double>(grid.nx) * grid.ny * grid.nz});
+  if (wanted(kStages[1]))
+    rows.push_back({name, method, kStages[1], time_frames(a, [&](int f) {
+                      const Camera camera = pose(scene.camera, f);
+                      const std::vector<float> depth = floor_depth(camera);
+                      const Froxels froxels = build_froxels(solution, camera, grid, frame);
+                      const Stopwatch watch;
+                      const Image out = composite_froxels(froxels, host, depth);
+                      return 1e3 * watch.seconds();
+                    }), pixels});
+  if (wanted(kStages[2]))
+    rows.push_back({name, method, kStages[2], time_frames(a, [&](int f) {
+                      const Camera camera = pose(scene.camera, f);
+                      const std::vector<float> depth = floor_depth(camera);
+                      const Stopwatch watch;
+                      const RenderResult r = solution.render(View{camera, depth, true}, frame);
+                      return 1e3 * watch.seconds();
+                    }), pixels});
+  return rows;
+}
+
+int run(const FrameArgs& a) {
+  for (const std::string& s : a.stages)
+    if (std::find(std::begin(kStages), std::end(kStages), s) == std::end(kStages))
+      throw Error("--stage", s, "froxel_build, composite or per_pixel");
+  std::vector<std::filesystem::path> files;
+  std::error_code ec;
+  for (const auto& entry : std::filesystem::directory_iterator(a.scenes, ec))
+    if (entry.path().extension() == ".json" && (a.only.empty() || std::count(a.only.begin(), a.only.end(), entry.path().stem().string())))
+      files.push_back(entry.path());
+  if (ec) throw Error("--scenes", a.scenes, "a directory of frame scenes (" + ec.message() + ")");
+  if (files.empty()) throw Error("--scenes", a.scenes, "a directory holding the scenes asked for (bench/frame)");
+  std::sort(files.begin(), files.end());
+  nlohmann::json out = nlohmann::json::array();
+  if (!a.json)
+    std::printf("%dx%d, %d x %d x %d froxels, %d threads; medians over the frames\n%-18s %-12s %-13s %10s %7s %12s\n", a.width, a.height,
+                a.froxels[0], a.froxels[1], a.froxels[2], a.threads, "scene", "method", "stage", "median ms", "frames", "ns per item");
+  for (const auto& file : files)
+    for (const StageRow& r : run_scene(file, a)) {
+      const double m = median(r.ms), ns = 1e6 * m / r.items;
+      out.push_back({{"scene", r.scene}, {"method", r.method}, {"stage", r.stage}, {"median_ms", m},
+                     {"frames", r.ms.size()}, {"items", r.items}, {"ns_per_item", ns}});
+      if (!a.json)
+        std::printf("%-18s %-12s %-13s %10.1f %7zu %12.2f\n", r.scene.c_str(), r.method.c_str(), r.stage.c_str(), m, r.ms.size(), ns);
+      std::fflush(stdout);
+    }
+  if (a.json) std::cout << out.dump(2) << "\n";
+  return 0;
+}
+
+}  // namespace
+
+Command add_bench_frame(CLI::App& bench) {
+  auto* sub = bench.add_subcommand("frame", "A host renderer's 1080p frame: froxel build, CPU composite and per-pixel layers, the camera moving");
+  auto a = std::make_shared<FrameArgs>();
+  sub->add_option("--scenes", a->scenes, "Directory of the frame scenes, each naming its method")->capture_default_str();
+  sub->add_option("--scene", a->only, "Only these scenes (by file stem)");
+  sub->add_option("--stage", a->stages, "Only these stages: froxel_build, composite, per_pixel");
+  sub->add_option("--frames", a->frames, "Frames per stage")->capture_default_str()->check(CLI::Range(1, 100000));
+  sub->add_option("--stage-seconds", a->stage_seconds, "A stage stops after this long (3 frames at least)")->capture_default_str()->check(CLI::PositiveNumber);
+  sub->add_option("--threads", a->threads, "Thread cap (0: all cores)")->capture_default_str()->check(CLI::NonNegativeNumber);
+  sub->add_option("--width", a->width, "Image width")->capture_default_str()->check(CLI::Range(1, 16384));
+  sub->add_option("--height", a->height, "Image height")->capture_default_str()->check(CLI::Range(1, 16384));
+  sub->add_option("--froxels", a->froxels, "Froxel columns across, down and slices")->expected(3)->capture_default_str()->check(CLI::Range(1, 4096));
+  sub->add_flag("--json", a->json, "Print a JSON list of {scene, method, stage, median_ms, frames, items, ns_per_item}");
+  return {sub, [a] { return run(*a); }};
+}
+
+}  // namespace haze::app

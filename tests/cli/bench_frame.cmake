@@ -1,0 +1,28 @@
+# haze bench frame --json at a small size (issue 51's measure): one row per scene of bench/frame and
+# stage, each naming its scene's method, with a median over the frames asked for; an unknown stage
+# is refused. The figures themselves are benchmarks, not asserted. Arguments: -DHAZE.
+execute_process(COMMAND ${HAZE} bench frame --json --width 48 --height 27 --froxels 8 5 4 --frames 2 --threads 1
+                RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "haze bench frame failed (${rc}):\n${out}\n${err}")
+endif()
+string(JSON rows LENGTH "${out}")
+if(NOT rows EQUAL 9)
+  message(FATAL_ERROR "expected 9 rows (3 scenes x 3 stages), got ${rows}:\n${out}")
+endif()
+math(EXPR last "${rows} - 1")
+foreach(i RANGE ${last})
+  string(JSON scene GET "${out}" ${i} scene)
+  string(JSON method GET "${out}" ${i} method)
+  string(JSON stage GET "${out}" ${i} stage)
+  string(JSON median GET "${out}" ${i} median_ms)
+  string(JSON frames GET "${out}" ${i} frames)
+  if(NOT frames EQUAL 2 OR NOT median GREATER 0 OR NOT scene MATCHES "_${method}$" OR NOT stage MATCHES "^(froxel_build|composite|per_pixel)$")
+    message(FATAL_ERROR "row ${i}: scene ${scene}, method ${method}, stage ${stage}, median ${median} ms over ${frames} frames")
+  endif()
+endforeach()
+execute_process(COMMAND ${HAZE} bench frame --stage froxels RESULT_VARIABLE rc ERROR_VARIABLE err)
+string(FIND "${err}" "--stage: got froxels, expected froxel_build, composite or per_pixel" at)
+if(rc EQUAL 0 OR at EQUAL -1)
+  message(FATAL_ERROR "haze bench frame --stage froxels: expected the --stage error, got (${rc}):\n${err}")
+endif()
