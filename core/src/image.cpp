@@ -25,6 +25,17 @@ Image::Image(int width, int height) {
   pixels_.assign(3 * static_cast<size_t>(width) * static_cast<size_t>(height), 0.0f);
 }
 
+template <class Float>
+void check_span(const BasicImageSpan<Float>& span, const std::string& field) {
+  if (!span.data || span.width < 1 || span.height < 1)
+    throw Error(field, to_text(span.width) + " x " + to_text(span.height) + (span.data ? "" : " without data"), "an image of at least 1 x 1 pixels");
+  if (span.channels != 3 && span.channels != 4) throw Error(field + ".channels", to_text(span.channels), "3 (RGB) or 4 (RGBA)");
+  if (span.stride && span.stride < static_cast<std::size_t>(span.width) * static_cast<std::size_t>(span.channels))
+    throw Error(field + ".stride", to_text(span.stride) + " floats", "at least width x channels = " + to_text(span.width * span.channels));
+}
+template void check_span(const BasicImageSpan<float>&, const std::string&);
+template void check_span(const BasicImageSpan<const float>&, const std::string&);
+
 Rgb Image::mean() const {
   Rgb sum(0.0);
   for (size_t i = 0; i < pixels_.size(); i += 3) sum += Rgb(pixels_[i], pixels_[i + 1], pixels_[i + 2]);

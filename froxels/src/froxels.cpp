@@ -1,4 +1,5 @@
 #include <haze/core/error.h>
+#include <haze/core/progress.h>
 #include <haze/froxels/froxels.h>
 
 #include <glm/ext/matrix_clip_space.hpp>
@@ -104,16 +105,69 @@ Froxels build_froxels(const Solution& solution, const Camera& camera, const Frox
   return out;
 }
 
-Image composite_froxels(const Froxels& froxels, const Image& host_colour, std::span<const float> depth) {
-  const int w = host_colour.width(), h = host_colour.height();
+void composite_froxels(const Froxels& froxels, ConstImageSpan colour, std::span<const float> depth, ImageSpan out, int threads) {
+  check_span(colour, "colour");
+  check_span(out, "out");
+  const int w = colour.width, h = colour.height;
+  if (out.width != w || out.height != h)
+    throw Error("out", to_text(out.width) + " x " + to_text(out.height), "the colour's size, " + to_text(w) + " x " + to_text(h));
   if (depth.size() != static_cast<size_t>(w) * static_cast<size_t>(h))
     throw Error("depth", std::to_string(depth.size()) + " values", "one per pixel of the colour, " + std::to_string(w) + " x " + std::to_string(h));
-  Image out(w, h);
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) {
-      const PixelLayers p = froxels.sample((x + 0.5) / w, (y + 0.5) / h, depth[static_cast<size_t>(y) * static_cast<size_t>(w) + static_cast<size_t>(x)]);
-      out.set(x, y, p.inscatter + p.transmittance * host_colour.at(x, y));
+  const FroxelGrid& g = froxels.grid;
+  const size_t nx = static_cast<size_t>(g.nx), plane = nx * static_cast<size_t>(g.ny);
+  if (froxels.inscatter.size() != plane * static_cast<size_t>(g.nz) || froxels.transmittance.size() != froxels.inscatter.size())
+    throw Error("froxels", to_text(froxels.inscatter.size()) + " froxels", "nx x ny x nz = " + to_text(plane * static_cast<size_t>(g.nz)));
+  // Froxels::sample's lookup in float32: slice(d) = nz log(d / near) / log(far / near) - 1.
+  const float near = static_cast<float>(g.near), log_near = std::log(near), slices_per_log = static_cast<float>(g.nz / std::log(g.far / g.near));
+  const float last_slice = static_cast<float>(g.nz - 1);
+  const Vec3f* const L = froxels.inscatter.data();
+  const Vec3f* const T = froxels.transmittance.data();
+  parallel_for(h, threads, 8, [&](long long y0, long long y1) {
+    for (auto py = static_cast<int>(y0); py < y1; ++py) {
+      const float y = std::clamp((static_cast<float>(py) + 0.5f) / static_cast<float>(h) * static_cast<float>(g.ny) - 0.5f, 0.0f, static_cast<float>(g.ny - 1));
+      const int j = std::min(static_cast<int>(y), std::max(g.ny - 2, 0));
+      const float b = g.ny > 1 ? y - static_cast<float>(j) : 0.0f;
+      const float* in = colour.pixel(0, py);
+      float* to = out.pixel(0, py);
+      const float* row_depth = depth.data() + static_cast<size_t>(py) * static_cast<size_t>(w);
+      for (int px = 0; px < w; ++px, in += colour.channels, to += out.channels) {
+        const float x = std::clamp((static_cast<float>(px) + 0.5f) / static_cast<float>(w) * static_cast<float>(g.nx) - 0.5f, 0.0f, static_cast<float>(g.nx - 1));
+        const int i = std::min(static_cast<int>(x), std::max(g.nx - 2, 0));
+        const float a = g.nx > 1 ? x - static_cast<float>(i) : 0.0f;
+        const float d = row_depth[px];
+        const float z = d > near ? std::min(slices_per_log * (std::log(d) - log_near) - 1.0f, last_slice) : -1.0f;
+        const int k = static_cast<int>(std::floor(z));
+        const float c = z - static_cast<float>(k);
+        const size_t at = static_cast<size_t>(j) * nx + static_cast<size_t>(i);
+        const size_t dx = g.nx > 1 ? 1 : 0, dy = g.ny > 1 ? nx : 0;
+        const float w00 = (1.0f - a) * (1.0f - b), w10 = a * (1.0f - b), w01 = (1.0f - a) * b, w11 = a * b;
+        // Slice kk's bilinear L_in and T (kk < 0: near, nothing in-scattered yet).
+        const auto column = [&](int kk, Vec3f& l, Vec3f& t) {
+          if (kk < 0) {
+            l = Vec3f(0.0f), t = Vec3f(1.0f);
+            return;
+          }
+          const size_t o = static_cast<size_t>(kk) * plane + at;
+          l = w00 * L[o] + w10 * L[o + dx] + w01 * L[o + dy] + w11 * L[o + dx + dy];
+          t = w00 * T[o] + w10 * T[o + dx] + w01 * T[o + dy] + w11 * T[o + dx + dy];
+        };
+        Vec3f l, t;
+        column(k, l, t);
+        if (c > 0.0f && k + 1 < g.nz) {
+          Vec3f l1, t1;
+          column(k + 1, l1, t1);
+          l = (1.0f - c) * l + c * l1, t = (1.0f - c) * t + c * t1;
+        }
+        for (int ch = 0; ch < 3; ++ch) to[ch] = l[ch] + t[ch] * in[ch];
+      }
     }
+  });
+}
+
+Image composite_froxels(const Froxels& froxels, const Image& host_colour, std::span<const float> depth, int threads) {
+  Image out(host_colour.width(), host_colour.height());
+  composite_froxels(froxels, ConstImageSpan{host_colour.data().data(), host_colour.width(), host_colour.height()}, depth,
+                    ImageSpan{out.data().data(), out.width(), out.height()}, threads);
   return out;
 }
 

@@ -1,7 +1,9 @@
 // Froxels (haze/froxels/froxels.h) from every kind of solution: at the columns' centres and the slices'
 // boundaries they hold the per-pixel layers; between them the composite's error against the
-// per-pixel layers falls as the volume is refined; bad grids are clear errors.
+// per-pixel layers falls as the volume is refined; the float32 threaded composite into a caller's
+// memory agrees with the float64 lookup it replaces; bad grids and spans are clear errors.
 #include <haze/core/error.h>
+#include <haze/core/rng.h>
 #include <haze/froxels/froxels.h>
 #include <haze/grids/methods.h>
 #include <haze/particles/methods.h>
@@ -90,6 +92,68 @@ TEST(Froxels, CompositeConvergesToThePerPixelLayers) {
     previous = error;
   }
   EXPECT_LT(previous, 0.02);
+}
+
+// The composite into the caller's memory (float32, rows over threads, RGBA rows with padding, in
+// place over the colour) against Froxels::sample's float64 lookup, pixel by pixel, over depths
+// before near, inside every slice, past far and the background; and for a single column and slice.
+TEST(Froxels, CompositeIntoCallerMemoryMatchesTheFloat64Lookup) {
+  Rng rng(7, 0);
+  for (const FroxelGrid grid : {FroxelGrid{12, 7, 9, 0.2, 30.0}, FroxelGrid{1, 1, 1, 0.5, 5.0}}) {
+    Froxels froxels;
+    froxels.grid = grid;
+    for (int n = 0; n < grid.nx * grid.ny * grid.nz; ++n) {
+      froxels.inscatter.push_back(Vec3f(rng.uniform(), rng.uniform(), rng.uniform()));
+      froxels.transmittance.push_back(Vec3f(rng.uniform(), rng.uniform(), rng.uniform()));
+    }
+    const int w = 37, h = 23;
+    const size_t stride = 4 * w + 5;
+    std::vector<float> rgba(stride * h), depth;
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) {
+        for (int c = 0; c < 4; ++c) rgba[y * stride + 4 * x + c] = static_cast<float>(rng.uniform());
+        const double u = rng.uniform();
+        depth.push_back(u < 0.1 ? std::numeric_limits<float>::infinity() : static_cast<float>(0.1 * std::pow(400.0, u)));
+      }
+    const std::vector<float> before = rgba;
+    const ImageSpan image{rgba.data(), w, h, 4, stride};
+    composite_froxels(froxels, ConstImageSpan{rgba.data(), w, h, 4, stride}, depth, image, 2);
+    double worst = 0.0;
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) {
+        const float* c = &before[y * stride + 4 * x];
+        const PixelLayers p = froxels.sample((x + 0.5) / w, (y + 0.5) / h, depth[static_cast<size_t>(y * w + x)]);
+        const Rgb want = p.inscatter + p.transmittance * Rgb(c[0], c[1], c[2]);
+        const float* got = image.pixel(x, y);
+        worst = std::max(worst, relative_to(Rgb(got[0], got[1], got[2]), want));
+        EXPECT_EQ(got[3], c[3]) << "alpha left as it is";
+      }
+    EXPECT_LT(worst, 1e-5) << grid.nx << " x " << grid.ny << " x " << grid.nz;
+    for (size_t y = 0; y < static_cast<size_t>(h); ++y)
+      for (size_t pad = 4 * w; pad < stride; ++pad) EXPECT_EQ(rgba[y * stride + pad], before[y * stride + pad]) << "row padding written";
+  }
+}
+
+TEST(Froxels, BadSpansAreClearErrors) {
+  Froxels froxels;
+  froxels.grid = {2, 2, 2, 0.1, 10.0};
+  froxels.inscatter.assign(8, Vec3f(0.0f)), froxels.transmittance.assign(8, Vec3f(1.0f));
+  std::vector<float> colour(4 * 3 * 2), depth(4 * 2, 1.0f);
+  auto message = [&](ConstImageSpan in, ImageSpan out, std::span<const float> d) {
+    try {
+      composite_froxels(froxels, in, d, out);
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  const ConstImageSpan in{colour.data(), 4, 2};
+  const ImageSpan out{colour.data(), 4, 2};
+  EXPECT_EQ(message(in, ImageSpan{colour.data(), 4, 2, 2}, depth), "out.channels: got 2, expected 3 (RGB) or 4 (RGBA)");
+  EXPECT_EQ(message(in, ImageSpan{colour.data(), 4, 2, 3, 6}, depth), "out.stride: got 6 floats, expected at least width x channels = 12");
+  EXPECT_EQ(message(in, ImageSpan{colour.data(), 3, 2}, depth), "out: got 3 x 2, expected the colour's size, 4 x 2");
+  EXPECT_EQ(message(ConstImageSpan{nullptr, 4, 2}, out, depth), "colour: got 4 x 2 without data, expected an image of at least 1 x 1 pixels");
+  EXPECT_EQ(message(in, out, std::span<const float>(depth).first(7)), "depth: got 7 values, expected one per pixel of the colour, 4 x 2");
 }
 
 TEST(Froxels, BadGridsAreClearErrors) {

@@ -4,6 +4,7 @@
 
 #include <haze/core/math.h>
 
+#include <cstddef>
 #include <filesystem>
 #include <map>
 #include <string>
@@ -40,6 +41,24 @@ class Image {
   int width_ = 0, height_ = 0;
   std::vector<float> pixels_;
 };
+
+// A caller's float32 image in its own memory, as a GL pixel-buffer upload takes it: `channels`
+// floats a pixel (3: RGB; 4: RGBA, the fourth left as it is), rows top to bottom `stride` floats
+// apart (0: width * channels). Viewed, never owned.
+template <class Float>
+struct BasicImageSpan {
+  Float* data = nullptr;
+  int width = 0, height = 0, channels = 3;
+  std::size_t stride = 0;
+  std::size_t row_floats() const { return stride ? stride : static_cast<std::size_t>(width) * static_cast<std::size_t>(channels); }
+  Float* pixel(int x, int y) const { return data + static_cast<std::size_t>(y) * row_floats() + static_cast<std::size_t>(x) * static_cast<std::size_t>(channels); }
+};
+using ImageSpan = BasicImageSpan<float>;
+using ConstImageSpan = BasicImageSpan<const float>;
+// Throws haze::Error naming `field` unless the span has data, a size >= 1, 3 or 4 channels, and
+// rows at least width * channels floats apart.
+template <class Float>
+void check_span(const BasicImageSpan<Float>& span, const std::string& field);
 
 // Writes linear float RGB ("R", "G", "B"); with std_error, also its layer "stderr.R/G/B".
 void write_exr(const std::filesystem::path& path, const Image& image, const Image* std_error = nullptr);

@@ -50,9 +50,15 @@ struct Froxels {
 // (0, far)) are a haze::Error naming `froxels.<field>`.
 Froxels build_froxels(const Solution& solution, const Camera& camera, const FroxelGrid& grid = {}, const RenderOptions& options = {});
 
-// The CPU form of the GLSL composite pass: per pixel of the host's colour, L_in(d) + T(d) * colour
-// at its depth d (distance along the ray, +inf for the background: far's values then).
-Image composite_froxels(const Froxels& froxels, const Image& host_colour, std::span<const float> depth);
+// The CPU form of the GLSL composite pass, what a renderer without a GPU runs each frame: per
+// pixel of the host's colour, L_in(d) + T(d) * colour at its depth d (distance along the pixel's
+// ray, row-major as the colour's pixels; +inf for the background: far's values then), written
+// into `out` (the colour's size; it may be the colour's own memory, an RGBA pixel's fourth float
+// left as it is). Float32 throughout, the rows split over `threads` (0: every core oneTBB
+// offers); within 1e-5 relative of Froxels::sample's float64 lookup (tests/methods/froxels_test.cpp).
+void composite_froxels(const Froxels& froxels, ConstImageSpan colour, std::span<const float> depth, ImageSpan out, int threads = 0);
+// The same into a new image.
+Image composite_froxels(const Froxels& froxels, const Image& host_colour, std::span<const float> depth, int threads = 0);
 
 }  // namespace haze
 
