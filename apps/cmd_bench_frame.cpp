@@ -87,7 +87,8 @@ std::vector<StageRow> run_scene(const std::filesystem::path& file, const FrameAr
   RenderOptions frame;
   frame.threads = a.threads;
   const Image host(a.width, a.height);
-  Image composed(a.width, a.height);  // the renderer's own target, reused frame after frame
+  Image composed(a.width, a.height);  // the renderer's own target and froxels, reused frame after frame
+  Froxels froxels;
   const auto wanted = [&](const std::string& stage) { return a.stages.empty() || std::count(a.stages.begin(), a.stages.end(), stage) > 0; };
   std::vector<StageRow> rows;
   const std::string name = file.stem().string(), method = solution.method();
@@ -96,14 +97,14 @@ std::vector<StageRow> run_scene(const std::filesystem::path& file, const FrameAr
     rows.push_back({name, method, kStages[0], time_frames(a, [&](int f) {
                       const Camera camera = pose(scene.camera, f);
                       const Stopwatch watch;
-                      const Froxels froxels = build_froxels(solution, camera, grid, frame);
+                      build_froxels(solution, camera, froxels, grid, frame);
                       return 1e3 * watch.seconds();
                     }), static_cast<double>(grid.nx) * grid.ny * grid.nz});
   if (wanted(kStages[1]))
     rows.push_back({name, method, kStages[1], time_frames(a, [&](int f) {
                       const Camera camera = pose(scene.camera, f);
                       const std::vector<float> depth = floor_depth(camera);
-                      const Froxels froxels = build_froxels(solution, camera, grid, frame);
+                      build_froxels(solution, camera, froxels, grid, frame);
                       const Stopwatch watch;
                       composite_froxels(froxels, ConstImageSpan{host.data().data(), a.width, a.height}, depth,
                                         ImageSpan{composed.data().data(), a.width, a.height}, a.threads);

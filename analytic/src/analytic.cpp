@@ -243,16 +243,14 @@ class AnalyticSolution final : public MethodSolution {
   // and never falls back for a short segment). Its error is the table's relative to L(t0, t1),
   // not to L_in(d): at most 1e-3 of the whole ray's in-scatter (froxels composite it over the
   // host's colour, where that is what matters).
-  std::optional<std::vector<PixelLayers>> render_distances(const View& view, std::span<const double> distances,
-                                                           const RenderOptions& options) const override {
-    if (!scene_.surfaces.empty() || !airlight_) return std::nullopt;
+  bool render_distances(const View& view, std::span<const double> distances, const RenderOptions& options, std::span<PixelLayers> out) const override {
+    if (!scene_.surfaces.empty() || !airlight_) return false;
     for (const auto& light : lights_)
-      if (light.spot()) return std::nullopt;
+      if (light.spot()) return false;
     const Camera& camera = view.camera;
     const auto width = static_cast<size_t>(camera.width_px), n = distances.size();
     const Aabb bounds = medium_->bounds();
     const AirlightKernel add_airlight = kernel_;
-    std::vector<PixelLayers> out(width * static_cast<size_t>(camera.height_px) * n);
     parallel_for(camera.height_px, options.threads, 1, [&](long long y0, long long y1) {
       std::vector<Ray> rays(width);
       std::vector<float> ox, oy, oz, dx, dy, dz, seg, unit;
@@ -260,6 +258,7 @@ class AnalyticSolution final : public MethodSolution {
       std::vector<double> t0s(width), t1s(width);
       std::vector<size_t> first(width + 1);  // the row's segments: column x's are [first[x], first[x + 1])
       for (auto y = static_cast<int>(y0); y < y1; ++y) {
+        std::fill_n(out.begin() + static_cast<std::ptrdiff_t>(static_cast<size_t>(y) * width * n), width * n, PixelLayers{});
         for (auto* v : {&ox, &oy, &oz, &dx, &dy, &dz, &seg}) v->clear();
         camera.row_rays(y, rays.data());
         auto push = [&](const Ray& ray, double from, double to) {
@@ -303,7 +302,7 @@ class AnalyticSolution final : public MethodSolution {
         }
       }
     });
-    return out;
+    return true;
   }
 
  private:

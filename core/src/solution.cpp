@@ -155,18 +155,25 @@ RenderResult Solution::render(const View& view, const RenderOptions& options) co
 }
 
 std::vector<PixelLayers> Solution::render_distances(const View& view, std::span<const double> distances, const RenderOptions& options) const {
+  std::vector<PixelLayers> out(static_cast<size_t>(view.camera.width_px) * static_cast<size_t>(view.camera.height_px) * distances.size());
+  render_distances(view, distances, out, options);
+  return out;
+}
+
+void Solution::render_distances(const View& view, std::span<const double> distances, std::span<PixelLayers> out, const RenderOptions& options) const {
   for (size_t k = 0; k < distances.size(); ++k)
     if (!(distances[k] > 0.0) || (k > 0 && !(distances[k] >= distances[k - 1])))
       throw Error("distances[" + std::to_string(k) + "]", to_text(distances[k]), "ascending distances > 0");
+  const size_t rays = static_cast<size_t>(view.camera.width_px) * static_cast<size_t>(view.camera.height_px), n = distances.size();
+  if (out.size() != rays * n)
+    throw Error("out", to_text(out.size()) + " entries", to_text(rays * n) + " (width_px x height_px x " + to_text(n) + " distances)");
   const State& s = *state_;
   const View at{view.camera, {}, true};
   if (s.options.single_view && !(view.camera == s.scene.camera))
     throw Error("view.camera", "another camera than the scene's", "the scene's camera for a solution prepared with single_view");
   RenderOptions o = s.options;
   o.threads = options.threads;
-  if (auto fast = s.naming_lights([&] { return s.solution->render_distances(at, distances, o); })) return std::move(*fast);
-  const size_t rays = static_cast<size_t>(view.camera.width_px) * static_cast<size_t>(view.camera.height_px), n = distances.size();
-  std::vector<PixelLayers> out(rays * n);
+  if (s.naming_lights([&] { return s.solution->render_distances(at, distances, o, out); })) return;
   std::vector<float> depth(rays);
   RenderOptions slice = options;
   for (size_t k = 0; k < n; ++k) {
@@ -178,7 +185,6 @@ std::vector<PixelLayers> Solution::render_distances(const View& view, std::span<
       out[i * n + k] = {r.inscatter->at(x, y), r.transmittance->at(x, y), r.surface->at(x, y)};
     }
   }
-  return out;
 }
 
 UpdateReport Solution::update(const SceneChange& change, const RenderOptions& options) {

@@ -7,6 +7,7 @@
 #include <glm/trigonometric.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <memory>
 
@@ -86,22 +87,27 @@ PixelLayers Froxels::sample(double u, double v, double d) const {
   return out;
 }
 
-Froxels build_froxels(const Solution& solution, const Camera& camera, const FroxelGrid& grid, const RenderOptions& options) {
+void build_froxels(const Solution& solution, const Camera& camera, Froxels& out, const FroxelGrid& grid, const RenderOptions& options) {
   check(grid);
-  Froxels out;
   out.grid = grid;
-  const size_t columns = static_cast<size_t>(grid.nx) * static_cast<size_t>(grid.ny);
-  out.inscatter.resize(columns * static_cast<size_t>(grid.nz));
-  out.transmittance.resize(out.inscatter.size());
-  std::vector<double> boundaries;
-  for (int k = 0; k < grid.nz; ++k) boundaries.push_back(grid.boundary(k));
-  const std::vector<PixelLayers> layers = solution.render_distances(View{column_camera(camera, grid.nx, grid.ny)}, boundaries, options);
-  const auto nz = static_cast<size_t>(grid.nz);
+  const size_t columns = static_cast<size_t>(grid.nx) * static_cast<size_t>(grid.ny), nz = static_cast<size_t>(grid.nz);
+  out.inscatter.resize(columns * nz);
+  out.transmittance.resize(columns * nz);
+  out.layers.resize(columns * nz);
+  std::array<double, 4096> boundaries;
+  for (int k = 0; k < grid.nz; ++k) boundaries[static_cast<size_t>(k)] = grid.boundary(k);
+  solution.render_distances(View{column_camera(camera, grid.nx, grid.ny)}, std::span<const double>(boundaries.data(), nz), out.layers, options);
   for (size_t column = 0; column < columns; ++column)
     for (size_t k = 0; k < nz; ++k) {
-      const PixelLayers& p = layers[column * nz + k];
+      const PixelLayers& p = out.layers[column * nz + k];
       out.inscatter[k * columns + column] = Vec3f(p.inscatter), out.transmittance[k * columns + column] = Vec3f(p.transmittance);
     }
+}
+
+Froxels build_froxels(const Solution& solution, const Camera& camera, const FroxelGrid& grid, const RenderOptions& options) {
+  Froxels out;
+  build_froxels(solution, camera, out, grid, options);
+  out.layers = {};
   return out;
 }
 

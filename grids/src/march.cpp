@@ -227,7 +227,7 @@ void march_row(const Marcher& m, const MarchVolume& v, const View& view, int y, 
 
 // Row y's stretches between consecutive distances, one packet, chained per ray (march_distances).
 void march_row_distances(const Marcher& m, const MarchVolume& v, const View& view, std::span<const double> distances, int y,
-                         std::vector<PixelLayers>& out) {
+                         std::span<PixelLayers> out) {
   const Camera& camera = view.camera;
   const auto width = static_cast<size_t>(camera.width_px), n = distances.size();
   std::vector<Ray> rays(width);
@@ -278,20 +278,19 @@ void march_row_distances(const Marcher& m, const MarchVolume& v, const View& vie
 
 }  // namespace
 
-std::optional<std::vector<PixelLayers>> march_distances(const Scene& scene, const ExtinctionVolume& volume, const std::vector<DenseGrid>& depths,
-                                                        const MarchSettings& settings, const RenderOptions& options, const View& view,
-                                                        std::span<const double> distances, const std::vector<DenseGrid>* visibility) {
+bool march_distances(const Scene& scene, const ExtinctionVolume& volume, const std::vector<DenseGrid>& depths, const MarchSettings& settings,
+                     const RenderOptions& options, const View& view, std::span<const double> distances, std::span<PixelLayers> out,
+                     const std::vector<DenseGrid>* visibility) {
   const Vec3 h = volume.density.cell_size();
   const Marcher marcher(scene, volume, depths, settings.step_cells * std::min({h.x, h.y, h.z}), options.threads, visibility, false);
   std::vector<MarchLight> lights;
   MarchVolume simd_view;
-  if (settings.scalar || !simd_volume(marcher, lights, simd_view)) return std::nullopt;
+  if (settings.scalar || !simd_volume(marcher, lights, simd_view)) return false;
   const Camera& camera = view.camera;
-  std::vector<PixelLayers> out(static_cast<size_t>(camera.width_px) * static_cast<size_t>(camera.height_px) * distances.size());
   parallel_for(camera.height_px, options.threads, 1, [&](long long y0, long long y1) {
     for (auto y = static_cast<int>(y0); y < y1; ++y) march_row_distances(marcher, simd_view, view, distances, y, out);
   });
-  return out;
+  return true;
 }
 
 Image march_image(const Scene& scene, const ExtinctionVolume& volume, const std::vector<DenseGrid>& depths,

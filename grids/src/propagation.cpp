@@ -44,9 +44,8 @@ class PropagationSolution final : public GridSolution {
     return result;
   }
   bool renders_layers() const override { return true; }
-  std::optional<std::vector<PixelLayers>> render_distances(const View& view, std::span<const double> distances,
-                                                           const RenderOptions& options) const override {
-    return march_distances(view_scene(scene_, view.camera), volume_, depths_, march_, options, view, distances, &visibility_);
+  bool render_distances(const View& view, std::span<const double> distances, const RenderOptions& options, std::span<PixelLayers> out) const override {
+    return march_distances(view_scene(scene_, view.camera), volume_, depths_, march_, options, view, distances, out, &visibility_);
   }
 
   // A new density (re-injected by region where it can: replace_volume) redoes every light's depth,

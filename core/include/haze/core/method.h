@@ -172,6 +172,9 @@ class Solution {
   // one-pass path where it has one (analytic with point lights and no surfaces; propagation), else
   // one layered render per distance. What build_froxels (froxels.h) calls.
   std::vector<PixelLayers> render_distances(const View& view, std::span<const double> distances, const RenderOptions& options = {}) const;
+  // The same into the caller's `out` (width_px x height_px x distances.size() entries), which a
+  // frame loop reuses.
+  void render_distances(const View& view, std::span<const double> distances, std::span<PixelLayers> out, const RenderOptions& options = {}) const;
   // Redoes only what the change reaches (the method says what in the report); a change nothing
   // can be reused for prepares again (report.rebuilt). The scene's camera may change freely: it
   // is not part of a solution. A change that throws haze::Error (checked before anything is

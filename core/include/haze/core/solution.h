@@ -133,12 +133,11 @@ class MethodSolution {
   // Whether render honours View::depth and View::layers; a method that does not is refused such
   // views with a haze::Error (every method Haze registers does).
   virtual bool renders_layers() const { return false; }
-  // L_in and T along each of the view's rays to each of `distances` (ascending, > 0), as
-  // out[ray * distances.size() + k], in one pass; std::nullopt where the method has no such path
-  // for this scene (Solution::render_distances then renders once per distance).
-  virtual std::optional<std::vector<PixelLayers>> render_distances(const View&, std::span<const double>, const RenderOptions&) const {
-    return std::nullopt;
-  }
+  // L_in and T along each of the view's rays to each of `distances` (ascending, > 0), into
+  // out[ray * distances.size() + k] (every entry written; out's size checked by the caller), in one
+  // pass; false where the method has no such path for this scene (Solution::render_distances then
+  // renders once per distance).
+  virtual bool render_distances(const View&, std::span<const double>, const RenderOptions&, std::span<PixelLayers> /*out*/) const { return false; }
   // Applies `change` in place, given `scene` with the change applied, and reports what it redid;
   // std::nullopt when nothing can be reused (the Solution then prepares again). The default.
   virtual std::optional<UpdateReport> update(const Scene& scene, const SceneChange& change, const RenderOptions& options);

@@ -35,6 +35,9 @@ struct Froxels {
   // Column (i, j) is the camera's ray through film position ((i + 0.5) W / nx, (j + 0.5) H / ny)
   // of its W x H image, rows top to bottom.
   std::vector<Vec3f> inscatter, transmittance;
+  // What the build renders the columns into (Solution::render_distances), kept so that a frame
+  // loop building into the same Froxels allocates nothing.
+  std::vector<PixelLayers> layers;
 
   // The layers at film position (u, v) in [0, 1]^2 of the image (u across, v down) and distance d
   // along the ray: bilinear between column centres (clamped at the edges), linear in slice(d)
@@ -49,6 +52,8 @@ struct Froxels {
 // sampled at the columns' nearest pixels. Bad grids (a count below 1 or above 4096, near not in
 // (0, far)) are a haze::Error naming `froxels.<field>`.
 Froxels build_froxels(const Solution& solution, const Camera& camera, const FroxelGrid& grid = {}, const RenderOptions& options = {});
+// The same into the caller's `out`, whose memory is reused when its grid's size is unchanged.
+void build_froxels(const Solution& solution, const Camera& camera, Froxels& out, const FroxelGrid& grid = {}, const RenderOptions& options = {});
 
 // The CPU form of the GLSL composite pass, what a renderer without a GPU runs each frame: per
 // pixel of the host's colour, L_in(d) + T(d) * colour at its depth d (distance along the pixel's
