@@ -128,45 +128,47 @@ void composite_froxels(const Froxels& froxels, ConstImageSpan colour, std::span<
   const float last_slice = static_cast<float>(g.nz - 1);
   const Vec3f* const L = froxels.inscatter.data();
   const Vec3f* const T = froxels.transmittance.data();
-  parallel_for(h, threads, 8, [&](long long y0, long long y1) {
-    for (auto py = static_cast<int>(y0); py < y1; ++py) {
-      const float y = std::clamp((static_cast<float>(py) + 0.5f) / static_cast<float>(h) * static_cast<float>(g.ny) - 0.5f, 0.0f, static_cast<float>(g.ny - 1));
-      const int j = std::min(static_cast<int>(y), std::max(g.ny - 2, 0));
-      const float b = g.ny > 1 ? y - static_cast<float>(j) : 0.0f;
-      const float* in = colour.pixel(0, py);
-      float* to = out.pixel(0, py);
-      const float* row_depth = depth.data() + static_cast<size_t>(py) * static_cast<size_t>(w);
-      for (int px = 0; px < w; ++px, in += colour.channels, to += out.channels) {
-        const float x = std::clamp((static_cast<float>(px) + 0.5f) / static_cast<float>(w) * static_cast<float>(g.nx) - 0.5f, 0.0f, static_cast<float>(g.nx - 1));
-        const int i = std::min(static_cast<int>(x), std::max(g.nx - 2, 0));
-        const float a = g.nx > 1 ? x - static_cast<float>(i) : 0.0f;
-        const float d = row_depth[px];
-        const float z = d > near ? std::min(slices_per_log * (std::log(d) - log_near) - 1.0f, last_slice) : -1.0f;
-        const int k = static_cast<int>(std::floor(z));
-        const float c = z - static_cast<float>(k);
-        const size_t at = static_cast<size_t>(j) * nx + static_cast<size_t>(i);
-        const size_t dx = g.nx > 1 ? 1 : 0, dy = g.ny > 1 ? nx : 0;
-        const float w00 = (1.0f - a) * (1.0f - b), w10 = a * (1.0f - b), w01 = (1.0f - a) * b, w11 = a * b;
-        // Slice kk's bilinear L_in and T (kk < 0: near, nothing in-scattered yet).
-        const auto column = [&](int kk, Vec3f& l, Vec3f& t) {
-          if (kk < 0) {
-            l = Vec3f(0.0f), t = Vec3f(1.0f);
-            return;
-          }
-          const size_t o = static_cast<size_t>(kk) * plane + at;
-          l = w00 * L[o] + w10 * L[o + dx] + w01 * L[o + dy] + w11 * L[o + dx + dy];
-          t = w00 * T[o] + w10 * T[o + dx] + w01 * T[o + dy] + w11 * T[o + dx + dy];
-        };
-        Vec3f l, t;
-        column(k, l, t);
-        if (c > 0.0f && k + 1 < g.nz) {
-          Vec3f l1, t1;
-          column(k + 1, l1, t1);
-          l = (1.0f - c) * l + c * l1, t = (1.0f - c) * t + c * t1;
+  const auto composite_row = [&](int py) {
+    const float y = std::clamp((static_cast<float>(py) + 0.5f) / static_cast<float>(h) * static_cast<float>(g.ny) - 0.5f, 0.0f, static_cast<float>(g.ny - 1));
+    const int j = std::min(static_cast<int>(y), std::max(g.ny - 2, 0));
+    const float b = g.ny > 1 ? y - static_cast<float>(j) : 0.0f;
+    const float* in = colour.pixel(0, py);
+    float* to = out.pixel(0, py);
+    const float* row_depth = depth.data() + static_cast<size_t>(py) * static_cast<size_t>(w);
+    for (int px = 0; px < w; ++px, in += colour.channels, to += out.channels) {
+      const float x = std::clamp((static_cast<float>(px) + 0.5f) / static_cast<float>(w) * static_cast<float>(g.nx) - 0.5f, 0.0f, static_cast<float>(g.nx - 1));
+      const int i = std::min(static_cast<int>(x), std::max(g.nx - 2, 0));
+      const float a = g.nx > 1 ? x - static_cast<float>(i) : 0.0f;
+      const float d = row_depth[px];
+      const float z = d > near ? std::min(slices_per_log * (std::log(d) - log_near) - 1.0f, last_slice) : -1.0f;
+      const int k = static_cast<int>(std::floor(z));
+      const float c = z - static_cast<float>(k);
+      const size_t at = static_cast<size_t>(j) * nx + static_cast<size_t>(i);
+      const size_t dx = g.nx > 1 ? 1 : 0, dy = g.ny > 1 ? nx : 0;
+      const float w00 = (1.0f - a) * (1.0f - b), w10 = a * (1.0f - b), w01 = (1.0f - a) * b, w11 = a * b;
+      // Slice kk's bilinear L_in and T (kk < 0: near, nothing in-scattered yet).
+      const auto column = [&](int kk, Vec3f& l, Vec3f& t) {
+        if (kk < 0) {
+          l = Vec3f(0.0f), t = Vec3f(1.0f);
+          return;
         }
-        for (int ch = 0; ch < 3; ++ch) to[ch] = l[ch] + t[ch] * in[ch];
+        const size_t o = static_cast<size_t>(kk) * plane + at;
+        l = w00 * L[o] + w10 * L[o + dx] + w01 * L[o + dy] + w11 * L[o + dx + dy];
+        t = w00 * T[o] + w10 * T[o + dx] + w01 * T[o + dy] + w11 * T[o + dx + dy];
+      };
+      Vec3f l, t;
+      column(k, l, t);
+      if (c > 0.0f && k + 1 < g.nz) {
+        Vec3f l1, t1;
+        column(k + 1, l1, t1);
+        l = (1.0f - c) * l + c * l1, t = (1.0f - c) * t + c * t1;
       }
+      for (int ch = 0; ch < 3; ++ch) to[ch] = l[ch] + t[ch] * in[ch];
     }
+  };
+  // A body of one reference: std::function keeps it without allocating.
+  parallel_for(h, threads, 8, [&composite_row](long long y0, long long y1) {
+    for (auto py = static_cast<int>(y0); py < y1; ++py) composite_row(py);
   });
 }
 
