@@ -296,7 +296,7 @@ class AnalyticSolution final : public MethodSolution {
             const double d = distances[k];
             if (!(d > t0)) continue;  // before the medium
             const double inside = std::min(d, t1) - t0;
-            layers.transmittance = glm::exp(-sigma_t_ * inside);
+            layers.transmittance = grey_ ? Rgb(std::exp(-sigma_t_.r * inside)) : glm::exp(-sigma_t_ * inside);
             layers.inscatter = d < t1 ? glm::max(Rgb(0.0), whole - layers.transmittance * airlight[rest++]) : whole;
           }
         }

@@ -97,11 +97,15 @@ void build_froxels(const Solution& solution, const Camera& camera, Froxels& out,
   std::array<double, 4096> boundaries;
   for (int k = 0; k < grid.nz; ++k) boundaries[static_cast<size_t>(k)] = grid.boundary(k);
   solution.render_distances(View{column_camera(camera, grid.nx, grid.ny)}, std::span<const double>(boundaries.data(), nz), out.layers, options);
-  for (size_t column = 0; column < columns; ++column)
-    for (size_t k = 0; k < nz; ++k) {
-      const PixelLayers& p = out.layers[column * nz + k];
-      out.inscatter[k * columns + column] = Vec3f(p.inscatter), out.transmittance[k * columns + column] = Vec3f(p.transmittance);
-    }
+  // Column-major layers to slice-major froxels, a slice's row of froxels at a time.
+  const auto transpose = [&](long long k0, long long k1) {
+    for (auto k = static_cast<size_t>(k0); k < static_cast<size_t>(k1); ++k)
+      for (size_t column = 0; column < columns; ++column) {
+        const PixelLayers& p = out.layers[column * nz + k];
+        out.inscatter[k * columns + column] = Vec3f(p.inscatter), out.transmittance[k * columns + column] = Vec3f(p.transmittance);
+      }
+  };
+  parallel_for(grid.nz, options.threads, 1, [&transpose](long long k0, long long k1) { transpose(k0, k1); });
 }
 
 Froxels build_froxels(const Solution& solution, const Camera& camera, const FroxelGrid& grid, const RenderOptions& options) {
