@@ -30,7 +30,10 @@ std::shared_ptr<const Ranks> ranks(MPI_Comm comm);
 // "rank_first_collision_seconds"), "rank_gather_seconds", "rank_bytes_sent". The other ranks'
 // renders return an empty result. Scenes with surfaces are refused (haze::Error on every rank):
 // the split solve carries no light between medium and surfaces yet. Cancelling through
-// options.progress on any rank cancels every rank (haze::Cancelled). Safe to call more than once.
+// options.progress on any rank cancels every rank (haze::Cancelled). A split solution's calls are
+// collective: every rank makes them in the same order, from the thread that initialized MPI
+// (MPI_THREAD_FUNNELED), one at a time, not from several threads at once as other solutions
+// allow. Safe to call more than once.
 void register_methods();
 
 }  // namespace haze::mpi
