@@ -3,8 +3,8 @@
 // frame on an orbit around it while the host's floor (y = -1.5) is its depth buffer, and each
 // stage is timed frame by frame: the froxel build (build_froxels, 160 x 90 x 64 by default), the
 // CPU composite of the froxels over the host's colour and depth into the renderer's own image,
-// reused from frame to frame, and the per-pixel layers
-// (Solution::render with the depth). Medians over the frames.
+// reused from frame to frame, and the per-pixel layers (Solution::render with the depth). Medians
+// over the frames.
 #include "commands.h"
 
 #include <haze/core/error.h>
@@ -84,8 +84,6 @@ std::vector<StageRow> run_scene(const std::filesystem::path& file, const FrameAr
   options.threads = a.threads;
   const Solution solution = prepare(scene, "", options);
   const FroxelGrid grid{a.froxels[0], a.froxels[1], a.froxels[2]};
-  RenderOptions frame;
-  frame.threads = a.threads;
   const Image host(a.width, a.height);
   Image composed(a.width, a.height);  // the renderer's own target and froxels, reused frame after frame
   Froxels froxels;
@@ -97,14 +95,14 @@ std::vector<StageRow> run_scene(const std::filesystem::path& file, const FrameAr
     rows.push_back({name, method, kStages[0], time_frames(a, [&](int f) {
                       const Camera camera = pose(scene.camera, f);
                       const Stopwatch watch;
-                      build_froxels(solution, camera, froxels, grid, frame);
+                      build_froxels(solution, camera, froxels, grid, options);
                       return 1e3 * watch.seconds();
                     }), static_cast<double>(grid.nx) * grid.ny * grid.nz});
   if (wanted(kStages[1]))
     rows.push_back({name, method, kStages[1], time_frames(a, [&](int f) {
                       const Camera camera = pose(scene.camera, f);
                       const std::vector<float> depth = floor_depth(camera);
-                      build_froxels(solution, camera, froxels, grid, frame);
+                      build_froxels(solution, camera, froxels, grid, options);
                       const Stopwatch watch;
                       composite_froxels(froxels, ConstImageSpan{host.data().data(), a.width, a.height}, depth,
                                         ImageSpan{composed.data().data(), a.width, a.height}, a.threads);
@@ -115,7 +113,7 @@ std::vector<StageRow> run_scene(const std::filesystem::path& file, const FrameAr
                       const Camera camera = pose(scene.camera, f);
                       const std::vector<float> depth = floor_depth(camera);
                       const Stopwatch watch;
-                      const RenderResult r = solution.render(View{camera, depth, true}, frame);
+                      const RenderResult r = solution.render(View{camera, depth, true}, options);
                       return 1e3 * watch.seconds();
                     }), pixels});
   return rows;
