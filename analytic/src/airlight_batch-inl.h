@@ -6,8 +6,12 @@
 #define HAZE_ANALYTIC_AIRLIGHT_BATCH_INL_H_
 #endif
 
+#include <haze/analytic/airlight_batch.h>
+
 #include <hwy/contrib/math/math-inl.h>
 #include <hwy/highway.h>
+
+#include <algorithm>
 
 HWY_BEFORE_NAMESPACE();
 namespace haze::analytic::HWY_NAMESPACE {
@@ -78,6 +82,80 @@ HWY_NOINLINE size_t AirlightBatch(const float* HWY_RESTRICT table, int na, int n
     hn::StoreU(hn::IfThenElseZero(redo, hn::Set(d, 1.0f)), d, fallback + i);
   }
   return i;
+}
+
+// The unit tail g(d) = G(d) / (sigma_s I) of rays whose light projects to t_c along them at
+// distance h_c from their lines, at distances `at` (airlight_batch.h, TailRow).
+template <class D, class V>
+HWY_INLINE V UnitTail(D d, const float* HWY_RESTRICT table, int na, int ne, float eta_max, V t_c, V h_c, V sigma, V at) {
+  const V zero = hn::Zero(d);
+  const V t = hn::Sub(t_c, at);
+  const V d_sv = hn::Sqrt(hn::MulAdd(t, t, hn::Mul(h_c, h_c)));
+  const V h = hn::Max(hn::Max(h_c, hn::Mul(hn::Set(d, 1e-6f), d_sv)), hn::Set(d, 1e-20f));
+  // w = (xi + r) / h without cancellation (xi = -t), floored where the point sits on the light.
+  const auto behind = hn::Le(t, zero);
+  const V w0 = hn::Max(hn::Div(hn::IfThenElse(behind, hn::Sub(d_sv, t), h), hn::IfThenElse(behind, h, hn::Add(d_sv, t))), hn::Set(d, 1e-30f));
+  V scale;
+  const V log_tail = LogTail(d, table, na, ne, eta_max, hn::Mul(sigma, h), hn::Log(d, w0), w0, scale);
+  return hn::Div(hn::Mul(hn::Exp(d, hn::NegMulAdd(sigma, d_sv, log_tail)), scale), h);
+}
+
+// s_c = sum over the row's lights of weight[c] g(at), for the vector of rays at i.
+template <class D, class V>
+HWY_INLINE void SumTails(D d, const float* HWY_RESTRICT table, int na, int ne, float eta_max, const TailRow& row, size_t i, V at,
+                         V& s0, V& s1, V& s2) {
+  s0 = s1 = s2 = hn::Zero(d);
+  for (size_t l = 0; l < row.light_count; ++l) {
+    const TailLight& light = row.lights[l];
+    const V g = UnitTail(d, table, na, ne, eta_max, hn::LoadU(d, light.t + i), hn::LoadU(d, light.h + i), hn::Set(d, light.sigma_t), at);
+    s0 = hn::MulAdd(hn::Set(d, light.weight[0]), g, s0);
+    s1 = hn::MulAdd(hn::Set(d, light.weight[1]), g, s1);
+    s2 = hn::MulAdd(hn::Set(d, light.weight[2]), g, s2);
+  }
+}
+
+HWY_NOINLINE void TailSums(const float* HWY_RESTRICT table, int na, int ne, float eta_max, const TailRow& row, const float* at,
+                           float* const* sums) {
+  const hn::ScalableTag<float> d;
+  for (size_t i = 0; i < row.count; i += hn::Lanes(d)) {
+    hn::Vec<decltype(d)> s0, s1, s2;
+    SumTails(d, table, na, ne, eta_max, row, i, hn::LoadU(d, at + i), s0, s1, s2);
+    hn::StoreU(s0, d, sums[0] + i), hn::StoreU(s1, d, sums[1] + i), hn::StoreU(s2, d, sums[2] + i);
+  }
+}
+
+HWY_NOINLINE void AirlightSlice(const float* HWY_RESTRICT table, int na, int ne, float eta_max, const TailRow& row, float distance,
+                                float* HWY_RESTRICT inscatter, float* HWY_RESTRICT transmittance) {
+  const hn::ScalableTag<float> d;
+  using V = hn::Vec<decltype(d)>;
+  const size_t lanes = hn::Lanes(d);
+  const bool grey = row.sigma_t[0] == row.sigma_t[1] && row.sigma_t[1] == row.sigma_t[2];
+  const V zero = hn::Zero(d), one = hn::Set(d, 1.0f), at_slice = hn::Set(d, distance);
+  HWY_ALIGN float tail[3 * HWY_MAX_BYTES / sizeof(float)];
+  for (size_t i = 0; i < row.count; i += lanes) {
+    const V t0 = hn::LoadU(d, row.t0 + i), t1 = hn::LoadU(d, row.t1 + i);
+    const auto outside = hn::Or(hn::Le(at_slice, t0), hn::Le(t1, t0));
+    const V at = hn::Min(hn::Max(at_slice, t0), t1), inside = hn::Sub(at, t0);
+    V s0, s1, s2;
+    SumTails(d, table, na, ne, eta_max, row, i, at, s0, s1, s2);
+    const V T0 = hn::Exp(d, hn::Mul(hn::Set(d, -row.sigma_t[0]), inside));
+    const V T1 = grey ? T0 : hn::Exp(d, hn::Mul(hn::Set(d, -row.sigma_t[1]), inside));
+    const V T2 = grey ? T0 : hn::Exp(d, hn::Mul(hn::Set(d, -row.sigma_t[2]), inside));
+    const V l0 = hn::IfThenZeroElse(outside, hn::Max(zero, hn::NegMulAdd(T0, s0, hn::LoadU(d, row.whole[0] + i))));
+    const V l1 = hn::IfThenZeroElse(outside, hn::Max(zero, hn::NegMulAdd(T1, s1, hn::LoadU(d, row.whole[1] + i))));
+    const V l2 = hn::IfThenZeroElse(outside, hn::Max(zero, hn::NegMulAdd(T2, s2, hn::LoadU(d, row.whole[2] + i))));
+    const V u0 = hn::IfThenElse(outside, one, T0), u1 = hn::IfThenElse(outside, one, T1), u2 = hn::IfThenElse(outside, one, T2);
+    if (i + lanes <= row.count) {
+      hn::StoreInterleaved3(l0, l1, l2, d, inscatter + 3 * i);
+      hn::StoreInterleaved3(u0, u1, u2, d, transmittance + 3 * i);
+    } else {  // the row's last, partial vector
+      const size_t n = 3 * (row.count - i);
+      hn::StoreInterleaved3(l0, l1, l2, d, tail);
+      std::copy_n(tail, n, inscatter + 3 * i);
+      hn::StoreInterleaved3(u0, u1, u2, d, tail);
+      std::copy_n(tail, n, transmittance + 3 * i);
+    }
+  }
 }
 
 }  // namespace haze::analytic::HWY_NAMESPACE

@@ -17,6 +17,8 @@
 namespace haze::analytic {
 
 HWY_EXPORT(AirlightBatch);
+HWY_EXPORT(TailSums);
+HWY_EXPORT(AirlightSlice);
 
 namespace {
 
@@ -64,7 +66,63 @@ float airlight_double(const AirlightTable& table, const AirlightChannel& l, cons
   return value;
 }
 
+// The kernel's UnitTail for one ray.
+float unit_tail_scalar(const AirlightTable& table, float t_c, float h_c, float sigma, float at) {
+  const float t = t_c - at, d_sv = std::sqrt(t * t + h_c * h_c);
+  const float h = std::max({h_c, 1e-6f * d_sv, 1e-20f});
+  const float w0 = std::max(t <= 0.0f ? (d_sv - t) / h : h / (d_sv + t), 1e-30f);
+  float scale;
+  const float log_tail = log_tail_scalar(table, sigma * h, std::log(w0), w0, scale);
+  return std::exp(log_tail - sigma * d_sv) * scale / h;
+}
+
+void sum_tails_scalar(const AirlightTable& table, const TailRow& row, size_t i, float at, float s[3]) {
+  s[0] = s[1] = s[2] = 0.0f;
+  for (size_t l = 0; l < row.light_count; ++l) {
+    const TailLight& light = row.lights[l];
+    const float g = unit_tail_scalar(table, light.t[i], light.h[i], light.sigma_t, at);
+    for (int c = 0; c < 3; ++c) s[c] += light.weight[c] * g;
+  }
+}
+
 }  // namespace
+
+void tail_sums(const AirlightTable& table, const TailRow& row, const float* d, float* const sums[3]) {
+  HWY_DYNAMIC_DISPATCH(TailSums)(table.log_fine_values().data(), table.a_samples(), table.fine_eta_samples(),
+                                 static_cast<float>(AirlightTable::kEtaMax), row, d, sums);
+}
+
+void airlight_slice(const AirlightTable& table, const TailRow& row, float distance, float* inscatter, float* transmittance) {
+  HWY_DYNAMIC_DISPATCH(AirlightSlice)(table.log_fine_values().data(), table.a_samples(), table.fine_eta_samples(),
+                                      static_cast<float>(AirlightTable::kEtaMax), row, distance, inscatter, transmittance);
+}
+
+void tail_sums_reference(const AirlightTable& table, const TailRow& row, const float* d, float* const sums[3]) {
+  for (size_t i = 0; i < row.count; ++i) {
+    float s[3];
+    sum_tails_scalar(table, row, i, d[i], s);
+    for (int c = 0; c < 3; ++c) sums[c][i] = s[c];
+  }
+}
+
+void airlight_slice_reference(const AirlightTable& table, const TailRow& row, float distance, float* inscatter, float* transmittance) {
+  for (size_t i = 0; i < row.count; ++i) {
+    const float t0 = row.t0[i], t1 = row.t1[i];
+    float* l = inscatter + 3 * i;
+    float* T = transmittance + 3 * i;
+    if (distance <= t0 || t1 <= t0) {
+      l[0] = l[1] = l[2] = 0.0f, T[0] = T[1] = T[2] = 1.0f;
+      continue;
+    }
+    const float at = std::min(distance, t1);
+    float s[3];
+    sum_tails_scalar(table, row, i, at, s);
+    for (int c = 0; c < 3; ++c) {
+      T[c] = std::exp(-row.sigma_t[c] * (at - t0));
+      l[c] = std::max(0.0f, row.whole[c][i] - T[c] * s[c]);
+    }
+  }
+}
 
 void add_airlight_reference(const AirlightTable& table, const AirlightChannel& light, const SegmentBatch& batch, float* out) {
   for (size_t i = 0; i < batch.count; ++i) {

@@ -237,75 +237,70 @@ class AnalyticSolution final : public MethodSolution {
   }
   bool renders_layers() const override { return true; }
 
-  // Point lights without surfaces, one airlight tail per ray and distance: with [t0, t1] the
-  // ray's stretch in the medium, L_in(d) = L(t0, t1) - e^(-sigma_t (d - t0)) L(d, t1), each term
-  // a segment to the medium's end (infinite in unbounded fog, where the kernel evaluates one tail
-  // and never falls back for a short segment). Its error is the table's relative to L(t0, t1),
-  // not to L_in(d): at most 1e-3 of the whole ray's in-scatter (froxels composite it over the
-  // host's colour, where that is what matters).
-  bool render_distances(const View& view, std::span<const double> distances, const RenderOptions& options, std::span<PixelLayers> out) const override {
-    if (!scene_.surfaces.empty() || !airlight_) return false;
+  // Point lights without surfaces, a row of rays per slice in SIMD lanes (airlight_slice): with
+  // [t0, t1] a ray's stretch in the medium, L_in(d) = sum of sigma_s I (g(t0) - T(d) g(d)), one
+  // unit tail per ray, light and distance, the ray's geometry toward each light in float64 once.
+  // Its error is the table's relative to the whole ray's in-scatter, not to L_in(d): at most 1e-3
+  // of it (froxels composite it over the host's colour, where that is what matters). The float64
+  // kernel setting renders once per distance instead.
+  bool render_distances(const View& view, std::span<const double> distances, const RenderOptions& options, DistanceLayers out) const override {
+    if (!scene_.surfaces.empty() || !airlight_ || kernel_ != &add_airlight) return false;
     for (const auto& light : lights_)
       if (light.spot()) return false;
-    const Camera& camera = view.camera;
-    const auto width = static_cast<size_t>(camera.width_px), n = distances.size();
-    const Aabb bounds = medium_->bounds();
-    const AirlightKernel add_airlight = kernel_;
-    parallel_for(camera.height_px, options.threads, 1, [&](long long y0, long long y1) {
-      std::vector<Ray> rays(width);
-      std::vector<float> ox, oy, oz, dx, dy, dz, seg, unit;
-      std::vector<Rgb> airlight;     // per segment: L(start, t1)
-      std::vector<double> t0s(width), t1s(width);
-      std::vector<size_t> first(width + 1);  // the row's segments: column x's are [first[x], first[x + 1])
-      for (auto y = static_cast<int>(y0); y < y1; ++y) {
-        std::fill_n(out.begin() + static_cast<std::ptrdiff_t>(static_cast<size_t>(y) * width * n), width * n, PixelLayers{});
-        for (auto* v : {&ox, &oy, &oz, &dx, &dy, &dz, &seg}) v->clear();
-        camera.row_rays(y, rays.data());
-        auto push = [&](const Ray& ray, double from, double to) {
-          const Vec3 start = ray.at(from);
-          ox.push_back(static_cast<float>(start.x)), oy.push_back(static_cast<float>(start.y)), oz.push_back(static_cast<float>(start.z));
-          dx.push_back(static_cast<float>(ray.direction.x)), dy.push_back(static_cast<float>(ray.direction.y));
-          dz.push_back(static_cast<float>(ray.direction.z)), seg.push_back(std::isfinite(to) ? static_cast<float>(to - from) : INFINITY);
-        };
-        for (size_t x = 0; x < width; ++x) {
-          first[x] = ox.size();
-          double& t0 = t0s[x] = 0.0;
-          double& t1 = t1s[x] = kInfinity;
-          if (!bounds.clip(rays[x], t0, t1) || !(t1 > t0)) {
-            t1 = t0;  // no medium: L_in 0, T 1 everywhere
-            continue;
-          }
-          push(rays[x], t0, t1);
-          for (size_t k = 0; k < n; ++k)
-            if (distances[k] > t0 && distances[k] < t1) push(rays[x], distances[k], t1);
-        }
-        first[width] = ox.size();
-        const SegmentBatch batch{ox.data(), oy.data(), oz.data(), dx.data(), dy.data(), dz.data(), seg.data(), ox.size()};
-        airlight.assign(batch.count, Rgb(0.0));
-        for (const auto& light : lights_)
-          light_airlight(add_airlight, light, batch, unit, [&](const Rgb& scale) {
-            for (size_t i = 0; i < batch.count; ++i) airlight[i] += scale * static_cast<double>(unit[i]);
-          });
-        for (size_t x = 0; x < width; ++x) {
-          const double t0 = t0s[x], t1 = t1s[x];
-          if (!(t1 > t0)) continue;
-          const Rgb& whole = airlight[first[x]];
-          size_t rest = first[x] + 1;
-          for (size_t k = 0; k < n; ++k) {
-            PixelLayers& layers = out[(static_cast<size_t>(y) * width + x) * n + k];
-            const double d = distances[k];
-            if (!(d > t0)) continue;  // before the medium
-            const double inside = std::min(d, t1) - t0;
-            layers.transmittance = grey_ ? Rgb(std::exp(-sigma_t_.r * inside)) : glm::exp(-sigma_t_ * inside);
-            layers.inscatter = d < t1 ? glm::max(Rgb(0.0), whole - layers.transmittance * airlight[rest++]) : whole;
-          }
-        }
-      }
-    });
+    const auto body = [&](long long y0, long long y1) {
+      for (auto y = static_cast<int>(y0); y < y1; ++y) slices_row(view.camera, y, distances, out);
+    };
+    parallel_for(view.camera.height_px, options.threads, 1, [&body](long long y0, long long y1) { body(y0, y1); });
     return true;
   }
 
  private:
+  // render_distances' row y: each ray's stretch and geometry toward each light, then its slices.
+  void slices_row(const Camera& camera, int y, std::span<const double> distances, DistanceLayers out) const {
+    const auto width = static_cast<size_t>(camera.width_px), padded = (width + 15) / 16 * 16;
+    const size_t lights = lights_.size(), evaluations = grey_ ? lights : 3 * lights;
+    // Per thread, kept between frames: a frame allocates nothing once they have grown.
+    thread_local std::vector<Ray> rays;
+    thread_local std::vector<float> scratch;
+    thread_local std::vector<TailLight> tails;
+    rays.resize(width);
+    scratch.assign((5 + 2 * lights) * padded, 0.0f);
+    tails.clear();
+    float* const t0 = scratch.data();
+    float* const t1 = t0 + padded;
+    float* const whole[3] = {t1 + padded, t1 + 2 * padded, t1 + 3 * padded};
+    float* const geometry = t1 + 4 * padded;  // per light: t, then h
+    camera.row_rays(y, rays.data());
+    const Aabb bounds = medium_->bounds();
+    for (size_t x = 0; x < width; ++x) {
+      const Ray& ray = rays[x];
+      double a = 0.0, b = kInfinity;
+      if (!bounds.clip(ray, a, b) || !(b > a)) b = a;  // no medium: L_in 0, T 1 everywhere
+      t0[x] = static_cast<float>(a), t1[x] = std::isfinite(b) ? static_cast<float>(b) : INFINITY;
+      for (size_t l = 0; l < lights; ++l) {
+        const Vec3 to_light = lights_[l].position - ray.origin;
+        const double t = glm::dot(to_light, ray.direction);
+        geometry[2 * l * padded + x] = static_cast<float>(t);
+        geometry[(2 * l + 1) * padded + x] = static_cast<float>(glm::length(to_light - t * ray.direction));
+      }
+    }
+    for (size_t l = 0; l < lights; ++l)
+      for (int c = 0; c < (grey_ ? 1 : 3); ++c) {
+        TailLight tail{geometry + 2 * l * padded, geometry + (2 * l + 1) * padded, static_cast<float>(sigma_t_[c]), {}};
+        for (int e = 0; e < 3; ++e)
+          if (grey_ || e == c) tail.weight[e] = static_cast<float>(sigma_s_[e] * lights_[l].intensity[e]);
+        tails.push_back(tail);
+      }
+    TailRow row{tails.data(), evaluations, t0, t1, {whole[0], whole[1], whole[2]}, {}, width};
+    for (int c = 0; c < 3; ++c) row.sigma_t[c] = static_cast<float>(sigma_t_[c]);
+    tail_sums(table_, row, t0, whole);
+    const size_t rays_per_slice = width * static_cast<size_t>(camera.height_px), first = static_cast<size_t>(y) * width;
+    for (size_t k = 0; k < distances.size(); ++k) {
+      const size_t at = k * rays_per_slice + first;
+      airlight_slice(table_, row, static_cast<float>(distances[k]), &out.inscatter[at].x, &out.transmittance[at].x);
+    }
+  }
+
   // A point light's airlight over `batch` into `unit`, then accumulate(scale): unit times scale is
   // the RGB airlight. Grey media take one batch at unit intensity scaled per channel (the airlight
   // is linear in I), others one batch per channel.

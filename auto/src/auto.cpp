@@ -57,7 +57,7 @@ class AutoSolution final : public MethodSolution {
     return chosen_.update(change, o);
   }
   bool renders_layers() const override { return chosen_.method_solution().renders_layers(); }
-  bool render_distances(const View& view, std::span<const double> distances, const RenderOptions& options, std::span<PixelLayers> out) const override {
+  bool render_distances(const View& view, std::span<const double> distances, const RenderOptions& options, DistanceLayers out) const override {
     return chosen_.method_solution().render_distances(view, distances, options, out);
   }
   Rgb transmittance(size_t light, const Vec3& x) const override { return chosen_.transmittance(light, x); }

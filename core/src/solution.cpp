@@ -154,19 +154,14 @@ RenderResult Solution::render(const View& view, const RenderOptions& options) co
   return result;
 }
 
-std::vector<PixelLayers> Solution::render_distances(const View& view, std::span<const double> distances, const RenderOptions& options) const {
-  std::vector<PixelLayers> out(static_cast<size_t>(view.camera.width_px) * static_cast<size_t>(view.camera.height_px) * distances.size());
-  render_distances(view, distances, out, options);
-  return out;
-}
-
-void Solution::render_distances(const View& view, std::span<const double> distances, std::span<PixelLayers> out, const RenderOptions& options) const {
+void Solution::render_distances(const View& view, std::span<const double> distances, DistanceLayers out, const RenderOptions& options) const {
   for (size_t k = 0; k < distances.size(); ++k)
     if (!(distances[k] > 0.0) || (k > 0 && !(distances[k] >= distances[k - 1])))
       throw Error("distances[" + std::to_string(k) + "]", to_text(distances[k]), "ascending distances > 0");
   const size_t rays = static_cast<size_t>(view.camera.width_px) * static_cast<size_t>(view.camera.height_px), n = distances.size();
-  if (out.size() != rays * n)
-    throw Error("out", to_text(out.size()) + " entries", to_text(rays * n) + " (width_px x height_px x " + to_text(n) + " distances)");
+  for (const auto& [name, layer] : {std::pair{"out.inscatter", out.inscatter}, std::pair{"out.transmittance", out.transmittance}})
+    if (layer.size() != rays * n)
+      throw Error(name, to_text(layer.size()) + " entries", to_text(rays * n) + " (width_px x height_px x " + to_text(n) + " distances)");
   const State& s = *state_;
   const View at{view.camera, {}, true};
   if (s.options.single_view && !(view.camera == s.scene.camera))
@@ -182,7 +177,7 @@ void Solution::render_distances(const View& view, std::span<const double> distan
     const RenderResult r = render(View{view.camera, depth, true}, slice);
     for (size_t i = 0; i < rays; ++i) {
       const int x = static_cast<int>(i % static_cast<size_t>(view.camera.width_px)), y = static_cast<int>(i / static_cast<size_t>(view.camera.width_px));
-      out[i * n + k] = {r.inscatter->at(x, y), r.transmittance->at(x, y), r.surface->at(x, y)};
+      out.inscatter[k * rays + i] = Vec3f(r.inscatter->at(x, y)), out.transmittance[k * rays + i] = Vec3f(r.transmittance->at(x, y));
     }
   }
 }

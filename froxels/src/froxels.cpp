@@ -2,6 +2,8 @@
 #include <haze/core/progress.h>
 #include <haze/froxels/froxels.h>
 
+#include <haze/froxels/composite_row.h>
+
 #include <glm/ext/matrix_clip_space.hpp>
 #include <glm/ext/matrix_transform.hpp>
 #include <glm/trigonometric.hpp>
@@ -90,28 +92,18 @@ PixelLayers Froxels::sample(double u, double v, double d) const {
 void build_froxels(const Solution& solution, const Camera& camera, Froxels& out, const FroxelGrid& grid, const RenderOptions& options) {
   check(grid);
   out.grid = grid;
-  const size_t columns = static_cast<size_t>(grid.nx) * static_cast<size_t>(grid.ny), nz = static_cast<size_t>(grid.nz);
-  out.inscatter.resize(columns * nz);
-  out.transmittance.resize(columns * nz);
-  out.layers.resize(columns * nz);
+  const size_t froxels = static_cast<size_t>(grid.nx) * static_cast<size_t>(grid.ny) * static_cast<size_t>(grid.nz);
+  out.inscatter.resize(froxels);
+  out.transmittance.resize(froxels);
   std::array<double, 4096> boundaries;
   for (int k = 0; k < grid.nz; ++k) boundaries[static_cast<size_t>(k)] = grid.boundary(k);
-  solution.render_distances(View{column_camera(camera, grid.nx, grid.ny)}, std::span<const double>(boundaries.data(), nz), out.layers, options);
-  // Column-major layers to slice-major froxels, a slice's row of froxels at a time.
-  const auto transpose = [&](long long k0, long long k1) {
-    for (auto k = static_cast<size_t>(k0); k < static_cast<size_t>(k1); ++k)
-      for (size_t column = 0; column < columns; ++column) {
-        const PixelLayers& p = out.layers[column * nz + k];
-        out.inscatter[k * columns + column] = Vec3f(p.inscatter), out.transmittance[k * columns + column] = Vec3f(p.transmittance);
-      }
-  };
-  parallel_for(grid.nz, options.threads, 1, [&transpose](long long k0, long long k1) { transpose(k0, k1); });
+  solution.render_distances(View{column_camera(camera, grid.nx, grid.ny)}, std::span<const double>(boundaries.data(), static_cast<size_t>(grid.nz)),
+                            DistanceLayers{out.inscatter, out.transmittance}, options);
 }
 
 Froxels build_froxels(const Solution& solution, const Camera& camera, const FroxelGrid& grid, const RenderOptions& options) {
   Froxels out;
   build_froxels(solution, camera, out, grid, options);
-  out.layers = {};
   return out;
 }
 
@@ -127,53 +119,16 @@ void composite_froxels(const Froxels& froxels, ConstImageSpan colour, std::span<
   const size_t nx = static_cast<size_t>(g.nx), plane = nx * static_cast<size_t>(g.ny);
   if (froxels.inscatter.size() != plane * static_cast<size_t>(g.nz) || froxels.transmittance.size() != froxels.inscatter.size())
     throw Error("froxels", to_text(froxels.inscatter.size()) + " froxels", "nx x ny x nz = " + to_text(plane * static_cast<size_t>(g.nz)));
-  // Froxels::sample's lookup in float32: slice(d) = nz log(d / near) / log(far / near) - 1.
-  const float near = static_cast<float>(g.near), log_near = std::log(near), slices_per_log = static_cast<float>(g.nz / std::log(g.far / g.near));
-  const float last_slice = static_cast<float>(g.nz - 1);
-  const Vec3f* const L = froxels.inscatter.data();
-  const Vec3f* const T = froxels.transmittance.data();
-  const auto composite_row = [&](int py) {
-    const float y = std::clamp((static_cast<float>(py) + 0.5f) / static_cast<float>(h) * static_cast<float>(g.ny) - 0.5f, 0.0f, static_cast<float>(g.ny - 1));
-    const int j = std::min(static_cast<int>(y), std::max(g.ny - 2, 0));
-    const float b = g.ny > 1 ? y - static_cast<float>(j) : 0.0f;
-    const float* in = colour.pixel(0, py);
-    float* to = out.pixel(0, py);
-    const float* row_depth = depth.data() + static_cast<size_t>(py) * static_cast<size_t>(w);
-    for (int px = 0; px < w; ++px, in += colour.channels, to += out.channels) {
-      const float x = std::clamp((static_cast<float>(px) + 0.5f) / static_cast<float>(w) * static_cast<float>(g.nx) - 0.5f, 0.0f, static_cast<float>(g.nx - 1));
-      const int i = std::min(static_cast<int>(x), std::max(g.nx - 2, 0));
-      const float a = g.nx > 1 ? x - static_cast<float>(i) : 0.0f;
-      const float d = row_depth[px];
-      const float z = d > near ? std::min(slices_per_log * (std::log(d) - log_near) - 1.0f, last_slice) : -1.0f;
-      const int k = static_cast<int>(std::floor(z));
-      const float c = z - static_cast<float>(k);
-      const size_t at = static_cast<size_t>(j) * nx + static_cast<size_t>(i);
-      const size_t dx = g.nx > 1 ? 1 : 0, dy = g.ny > 1 ? nx : 0;
-      const float w00 = (1.0f - a) * (1.0f - b), w10 = a * (1.0f - b), w01 = (1.0f - a) * b, w11 = a * b;
-      // Slice kk's bilinear L_in and T (kk < 0: near, nothing in-scattered yet).
-      const auto column = [&](int kk, Vec3f& l, Vec3f& t) {
-        if (kk < 0) {
-          l = Vec3f(0.0f), t = Vec3f(1.0f);
-          return;
-        }
-        const size_t o = static_cast<size_t>(kk) * plane + at;
-        l = w00 * L[o] + w10 * L[o + dx] + w01 * L[o + dy] + w11 * L[o + dx + dy];
-        t = w00 * T[o] + w10 * T[o + dx] + w01 * T[o + dy] + w11 * T[o + dx + dy];
-      };
-      Vec3f l, t;
-      column(k, l, t);
-      if (c > 0.0f && k + 1 < g.nz) {
-        Vec3f l1, t1;
-        column(k + 1, l1, t1);
-        l = (1.0f - c) * l + c * l1, t = (1.0f - c) * t + c * t1;
-      }
-      for (int ch = 0; ch < 3; ++ch) to[ch] = l[ch] + t[ch] * in[ch];
-    }
+  const froxels_detail::CompositeVolume volume{&froxels.inscatter.data()->x, &froxels.transmittance.data()->x, g.nx, g.ny, g.nz,
+                                               static_cast<float>(g.near), std::log(static_cast<float>(g.near)),
+                                               static_cast<float>(g.nz / std::log(g.far / g.near))};
+  const auto composite_rows = [&](long long y0, long long y1) {
+    for (auto py = static_cast<int>(y0); py < y1; ++py)
+      froxels_detail::composite_row(volume, {colour.pixel(0, py), colour.channels, depth.data() + static_cast<size_t>(py) * static_cast<size_t>(w),
+                                             out.pixel(0, py), out.channels, w, h, py});
   };
   // A body of one reference: std::function keeps it without allocating.
-  parallel_for(h, threads, 8, [&composite_row](long long y0, long long y1) {
-    for (auto py = static_cast<int>(y0); py < y1; ++py) composite_row(py);
-  });
+  parallel_for(h, threads, 8, [&composite_rows](long long y0, long long y1) { composite_rows(y0, y1); });
 }
 
 Image composite_froxels(const Froxels& froxels, const Image& host_colour, std::span<const float> depth, int threads) {

@@ -227,7 +227,7 @@ void march_row(const Marcher& m, const MarchVolume& v, const View& view, int y, 
 
 // Row y's stretches between consecutive distances, one packet, chained per ray (march_distances).
 void march_row_distances(const Marcher& m, const MarchVolume& v, const View& view, std::span<const double> distances, int y,
-                         std::span<PixelLayers> out) {
+                         DistanceLayers out) {
   const Camera& camera = view.camera;
   const auto width = static_cast<size_t>(camera.width_px), n = distances.size();
   std::vector<Ray> rays(width);
@@ -266,12 +266,14 @@ void march_row_distances(const Marcher& m, const MarchVolume& v, const View& vie
       own[owner[i]].inscatter[c] = static_cast<double>(row(result, channel)[i]);
       own[owner[i]].transmittance[c] = static_cast<double>(row(result, 3 + channel)[i]);
     }
+  const size_t per_slice = width * static_cast<size_t>(camera.height_px);
   for (size_t x = 0; x < width; ++x) {
     Rgb l(0.0), t(1.0);
     for (size_t k = 0; k < n; ++k) {
       const PixelLayers& s = own[x * n + k];
       l += t * s.inscatter, t *= s.transmittance;
-      out[(static_cast<size_t>(y) * width + x) * n + k] = {l, t, Rgb(0.0)};
+      const size_t at = k * per_slice + static_cast<size_t>(y) * width + x;
+      out.inscatter[at] = Vec3f(l), out.transmittance[at] = Vec3f(t);
     }
   }
 }
@@ -279,7 +281,7 @@ void march_row_distances(const Marcher& m, const MarchVolume& v, const View& vie
 }  // namespace
 
 bool march_distances(const Scene& scene, const ExtinctionVolume& volume, const std::vector<DenseGrid>& depths, const MarchSettings& settings,
-                     const RenderOptions& options, const View& view, std::span<const double> distances, std::span<PixelLayers> out,
+                     const RenderOptions& options, const View& view, std::span<const double> distances, DistanceLayers out,
                      const std::vector<DenseGrid>* visibility) {
   const Vec3 h = volume.density.cell_size();
   const Marcher marcher(scene, volume, depths, settings.step_cells * std::min({h.x, h.y, h.z}), options.threads, visibility, false);

@@ -44,7 +44,7 @@ class PropagationSolution final : public GridSolution {
     return result;
   }
   bool renders_layers() const override { return true; }
-  bool render_distances(const View& view, std::span<const double> distances, const RenderOptions& options, std::span<PixelLayers> out) const override {
+  bool render_distances(const View& view, std::span<const double> distances, const RenderOptions& options, DistanceLayers out) const override {
     return march_distances(view_scene(scene_, view.camera), volume_, depths_, march_, options, view, distances, out, &visibility_);
   }
 

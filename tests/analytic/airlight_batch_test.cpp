@@ -85,5 +85,106 @@ TEST(AirlightBatch, FloatPathAgreesWithQuadrature) {
   }
 }
 
+// A row of froxel columns toward three lights: rays from near the origin in random directions,
+// some passing within 1e-4 of a light; unbounded, boxed (t1 finite) and missing the medium.
+struct SliceRow {
+  static constexpr size_t kLights = 3;
+  std::vector<Ray> rays;
+  std::vector<Vec3> lights{Vec3(0.3, -0.4, 2.5), Vec3(-1.0, 0.5, 6.0), Vec3(2.0, 1.0, -1.0)};
+  std::vector<float> t0, t1, geometry, whole;
+  std::vector<TailLight> tails;
+  TailRow row;
+  SliceRow(size_t n, std::uint64_t seed, Rgb sigma_t, Rgb sigma_s, const AirlightTable& table) {
+    Rng rng(seed, 11);
+    const size_t padded = (n + 15) / 16 * 16;
+    t0.assign(padded, 0.0f), t1.assign(padded, 0.0f), geometry.assign(2 * kLights * padded, 1.0f), whole.assign(3 * padded, 0.0f);
+    for (size_t i = 0; i < n; ++i) {
+      const Vec3 o(0.1 * rng.uniform(), 0.1 * rng.uniform(), -0.1 * rng.uniform());
+      Vec3 v = direction_around(Vec3(0, 0, 1), 1.0 - 2.0 * rng.uniform(), 2.0 * kPi * rng.uniform());
+      if (i % 7 == 3) v = glm::normalize(glm::normalize(lights[0] - o) + Vec3(1e-4, 0.0, 0.0));  // the light in view
+      rays.push_back({o, v});
+      t0[i] = i % 3 == 0 ? 0.0f : static_cast<float>(0.5 * rng.uniform());
+      t1[i] = i % 3 == 0 ? INFINITY : i % 3 == 1 ? t0[i] + static_cast<float>(0.1 + 8.0 * rng.uniform()) : t0[i];
+      for (size_t l = 0; l < kLights; ++l) {
+        const Vec3 to = lights[l] - o;
+        const double t = glm::dot(to, v);
+        geometry[2 * l * padded + i] = static_cast<float>(t);
+        geometry[(2 * l + 1) * padded + i] = static_cast<float>(glm::length(to - t * v));
+      }
+    }
+    const bool grey = sigma_t == Rgb(sigma_t.r) && sigma_s == Rgb(sigma_s.r);
+    for (size_t l = 0; l < kLights; ++l)
+      for (int c = 0; c < (grey ? 1 : 3); ++c) {
+        TailLight tail{geometry.data() + 2 * l * padded, geometry.data() + (2 * l + 1) * padded, static_cast<float>(sigma_t[c]), {}};
+        for (int e = 0; e < 3; ++e)
+          if (grey || e == c) tail.weight[e] = static_cast<float>(sigma_s[e] * (1.0 + static_cast<double>(l)));
+        tails.push_back(tail);
+      }
+    float* const sums[3] = {whole.data(), whole.data() + padded, whole.data() + 2 * padded};
+    row = TailRow{tails.data(), tails.size(), t0.data(), t1.data(), {sums[0], sums[1], sums[2]}, {}, n};
+    for (int c = 0; c < 3; ++c) row.sigma_t[c] = static_cast<float>(sigma_t[c]);
+    tail_sums_reference(table, row, t0.data(), sums);
+  }
+};
+
+TEST_P(AirlightBatchTargets, SlicesMatchScalarReference) {
+  for (size_t n : {size_t(1), size_t(37), size_t(160)})
+    for (const Rgb& sigma_t : {Rgb(0.26), Rgb(0.05, 0.3, 2.0)}) {
+      const SliceRow r(n, 5 + n, sigma_t, 0.9 * sigma_t, table());
+      const size_t padded = (n + 15) / 16 * 16;
+      std::vector<float> sums(3 * padded), reference(3 * padded);
+      float* const s[3] = {sums.data(), sums.data() + padded, sums.data() + 2 * padded};
+      float* const ref[3] = {reference.data(), reference.data() + padded, reference.data() + 2 * padded};
+      tail_sums(table(), r.row, r.t0.data(), s);
+      tail_sums_reference(table(), r.row, r.t0.data(), ref);
+      for (size_t c = 0; c < 3; ++c)
+        for (size_t i = 0; i < n; ++i) ASSERT_NEAR(s[c][i], ref[c][i], 2e-5f * ref[c][i]) << "ray " << i << " channel " << c;
+      for (float distance : {0.05f, 0.4f, 2.0f, 30.0f}) {
+        std::vector<float> l(3 * n), t(3 * n), l_ref(3 * n), t_ref(3 * n);
+        airlight_slice(table(), r.row, distance, l.data(), t.data());
+        airlight_slice_reference(table(), r.row, distance, l_ref.data(), t_ref.data());
+        for (size_t i = 0; i < 3 * n; ++i) {
+          // L_in = whole - T g: the kernel's rounding is relative to the whole ray's in-scatter.
+          ASSERT_NEAR(l[i], l_ref[i], 2e-5f * r.whole[(i % 3) * padded + i / 3] + 1e-30f) << "ray " << i / 3 << " at " << distance;
+          ASSERT_NEAR(t[i], t_ref[i], 1e-6f * t_ref[i]) << "ray " << i / 3 << " at " << distance;
+        }
+      }
+    }
+}
+
+// Slices against adaptive quadrature of the stretch [t0, min(d, t1)]: within 1e-3 of the whole
+// ray's in-scatter (the table's error relative to g(t0)), rays within 1e-4 of a light included.
+TEST(AirlightBatch, SlicesAgreeWithQuadrature) {
+  for (double g : {0.0, 0.6, 0.9}) {
+    const PhaseFunction phase = PhaseFunction::henyey_greenstein(g);
+    const AirlightTable table(phase);
+    const Rgb sigma_t(0.26, 0.5, 2.0), sigma_s = 0.9 * sigma_t;
+    const SliceRow r(64, 17, sigma_t, sigma_s, table);
+    const size_t padded = 64;
+    double worst = 0.0;
+    for (float distance : {0.3f, 1.0f, 2.5f, 7.0f, 40.0f}) {
+      std::vector<float> l(3 * 64), t(3 * 64);
+      airlight_slice(table, r.row, distance, l.data(), t.data());
+      for (size_t i = 0; i < 64; ++i) {
+        const double a = r.t0[i], b = std::min(static_cast<double>(distance), static_cast<double>(r.t1[i]));
+        for (int c = 0; c < 3; ++c) {
+          double exact = 0.0;
+          if (b > a)
+            for (size_t k = 0; k < SliceRow::kLights; ++k)
+              exact += airlight_quadrature(phase, {sigma_t[c], sigma_s[c], 1.0 + static_cast<double>(k)},
+                                           AirlightSegment::from_points(r.rays[i].at(a), r.rays[i].direction, r.lights[k], b - a), 1e-9);
+          const double whole = r.whole[static_cast<size_t>(c) * padded + i];
+          const double error = std::abs(static_cast<double>(l[3 * i + static_cast<size_t>(c)]) - exact) / std::max(whole, 1e-30);
+          if (b > a) worst = std::max(worst, error);
+          ASSERT_LT(error, 1e-3) << "g " << g << " ray " << i << " channel " << c << " at " << distance << ": " << l[3 * i + static_cast<size_t>(c)]
+                                 << " against " << exact;
+          ASSERT_NEAR(t[3 * i + static_cast<size_t>(c)], std::exp(-sigma_t[c] * std::max(0.0, b - a)), 1e-6);
+        }
+      }
+    }
+    std::printf("g %.1f: froxel slices against quadrature, worst error %.2e of the whole ray's in-scatter\n", g, worst);
+  }
+}
+
 }  // namespace
 }  // namespace haze::analytic

@@ -22,6 +22,36 @@ void add_airlight(const AirlightTable& table, const AirlightChannel& light, cons
 // The scalar reference: the same float32 formulas, one segment at a time.
 void add_airlight_reference(const AirlightTable& table, const AirlightChannel& light, const SegmentBatch& batch, float* out);
 
+// Froxel slices: the airlight along a row of rays (lanes) to a distance d, from each ray's unit
+// tails g(d) = G(d) / (sigma_s I), G(d) the airlight from distance d to infinity (airlight.h's
+// near tail; the formulas of add_airlight's kernel). With [t0, t1] a ray's stretch in the medium,
+// L_in(d) = sum over lights of sigma_s I (g(t0) - T(d) g(d)) at d clamped to [t0, t1] (the far
+// end's tails cancel), T(d) = e^(-sigma_t (d - t0)). The ray's geometry toward each light comes in
+// float32 from float64: no lane needs the float64 path.
+struct TailLight {
+  const float* t = nullptr;  // per ray: the light's projection along the ray, (p - o) . v
+  const float* h = nullptr;  // per ray: the light's distance from the ray's line
+  float sigma_t = 0.0f;
+  float weight[3] = {};      // sigma_s I per channel (zero outside its channel in a coloured medium)
+};
+struct TailRow {
+  const TailLight* lights = nullptr;
+  size_t light_count = 0;
+  const float* t0 = nullptr;         // per ray: where it enters the medium (0 inside)
+  const float* t1 = nullptr;         // per ray: where it leaves it (+inf unbounded; t1 = t0: no medium)
+  const float* whole[3] = {};        // per ray: L_in past t1, the sum of sigma_s I g(t0) (tail_sums)
+  float sigma_t[3] = {};
+  size_t count = 0;                  // rays; every array holds count rounded up to 16
+};
+// sums[c][i] = sum over lights of weight[c] g(d[i]) for rays i (d[i] >= 0).
+void tail_sums(const AirlightTable& table, const TailRow& row, const float* d, float* const sums[3]);
+// Slice `distance` of the row: L_in and T per ray as RGB triples into inscatter[3 i + c] and
+// transmittance[3 i + c] (count rays each): before t0 L_in 0 and T 1, past t1 their values at t1.
+void airlight_slice(const AirlightTable& table, const TailRow& row, float distance, float* inscatter, float* transmittance);
+// The scalar references: the same float32 formulas, one ray at a time.
+void tail_sums_reference(const AirlightTable& table, const TailRow& row, const float* d, float* const sums[3]);
+void airlight_slice_reference(const AirlightTable& table, const TailRow& row, float distance, float* inscatter, float* transmittance);
+
 }  // namespace haze::analytic
 
 #pragma GCC visibility pop

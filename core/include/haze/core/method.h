@@ -168,13 +168,11 @@ class Solution {
   RenderResult render(const View& view, const RenderOptions& options = {}) const;
   RenderResult render(const RenderOptions& options = {}) const { return render(View{scene().camera}, options); }
   // L_in and T along each of the view's rays (its depth ignored; Haze's own surfaces still end
-  // them) to each of `distances` (ascending, > 0): out[ray * distances.size() + k]. The method's
-  // one-pass path where it has one (analytic with point lights and no surfaces; propagation), else
-  // one layered render per distance. What build_froxels (froxels.h) calls.
-  std::vector<PixelLayers> render_distances(const View& view, std::span<const double> distances, const RenderOptions& options = {}) const;
-  // The same into the caller's `out` (width_px x height_px x distances.size() entries), which a
-  // frame loop reuses.
-  void render_distances(const View& view, std::span<const double> distances, std::span<PixelLayers> out, const RenderOptions& options = {}) const;
+  // them) to each of `distances` (ascending, > 0), into the caller's `out` (width_px x height_px x
+  // distances.size() entries each, slice-major), which a frame loop reuses. The method's one-pass
+  // path where it has one (analytic with point lights and no surfaces; propagation), else one
+  // layered render per distance. What build_froxels (froxels.h) calls.
+  void render_distances(const View& view, std::span<const double> distances, DistanceLayers out, const RenderOptions& options = {}) const;
   // Redoes only what the change reaches (the method says what in the report); a change nothing
   // can be reused for prepares again (report.rebuilt). The scene's camera may change freely: it
   // is not part of a solution. A change that throws haze::Error (checked before anything is

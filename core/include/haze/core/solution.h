@@ -86,6 +86,12 @@ struct PixelLayers {
   Rgb radiance() const { return inscatter + transmittance * surface; }
 };
 
+// L_in and T at distances along a view's rays in float32, slice-major as froxels hold them:
+// [k * rays + ray] for distance k and ray = y * width_px + x (Solution::render_distances).
+struct DistanceLayers {
+  std::span<Vec3f> inscatter, transmittance;
+};
+
 struct RenderResult {
   Image radiance;
   std::optional<Image> std_error;                   // per-pixel standard error, for Monte Carlo methods
@@ -133,11 +139,10 @@ class MethodSolution {
   // Whether render honours View::depth and View::layers; a method that does not is refused such
   // views with a haze::Error (every method Haze registers does).
   virtual bool renders_layers() const { return false; }
-  // L_in and T along each of the view's rays to each of `distances` (ascending, > 0), into
-  // out[ray * distances.size() + k] (every entry written; out's size checked by the caller), in one
-  // pass; false where the method has no such path for this scene (Solution::render_distances then
-  // renders once per distance).
-  virtual bool render_distances(const View&, std::span<const double>, const RenderOptions&, std::span<PixelLayers> /*out*/) const { return false; }
+  // L_in and T along each of the view's rays to each of `distances` (ascending, > 0), into `out`
+  // (every entry written; its size checked by the caller), in one pass; false where the method has
+  // no such path for this scene (Solution::render_distances then renders once per distance).
+  virtual bool render_distances(const View&, std::span<const double>, const RenderOptions&, DistanceLayers /*out*/) const { return false; }
   // Applies `change` in place, given `scene` with the change applied, and reports what it redid;
   // std::nullopt when nothing can be reused (the Solution then prepares again). The default.
   virtual std::optional<UpdateReport> update(const Scene& scene, const SceneChange& change, const RenderOptions& options);

@@ -35,9 +35,6 @@ struct Froxels {
   // Column (i, j) is the camera's ray through film position ((i + 0.5) W / nx, (j + 0.5) H / ny)
   // of its W x H image, rows top to bottom.
   std::vector<Vec3f> inscatter, transmittance;
-  // What the build renders the columns into (Solution::render_distances), kept so that a frame
-  // loop building into the same Froxels allocates nothing.
-  std::vector<PixelLayers> layers;
 
   // The layers at film position (u, v) in [0, 1]^2 of the image (u across, v down) and distance d
   // along the ray: bilinear between column centres (clamped at the edges), linear in slice(d)

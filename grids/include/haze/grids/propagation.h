@@ -93,9 +93,9 @@ RenderResult march_view(const Scene& scene, const ExtinctionVolume& volume, cons
 // L_in and T along each of view's rays to each of `distances` (ascending; MethodSolution::
 // render_distances) in one march: each ray's stretch between consecutive distances is marched as
 // its own segment (the SIMD kernel's, all of a row's in one packet) and the segments are chained,
-// L(d_k) = L(d_k-1) + T(d_k-1) L_k, T(d_k) = T(d_k-1) T_k. Into out[ray * n + k]; false without the SIMD kernel.
+// L(d_k) = L(d_k-1) + T(d_k-1) L_k, T(d_k) = T(d_k-1) T_k. Into out (slice-major, float32); false without the SIMD kernel.
 bool march_distances(const Scene& scene, const ExtinctionVolume& volume, const std::vector<DenseGrid>& depths, const MarchSettings& settings,
-                     const RenderOptions& options, const View& view, std::span<const double> distances, std::span<PixelLayers> out,
+                     const RenderOptions& options, const View& view, std::span<const double> distances, DistanceLayers out,
                      const std::vector<DenseGrid>* visibility = nullptr);
 
 // Everything method "propagation" computes before it marches, from the scene and the method's
