@@ -9,6 +9,7 @@
 #include <haze/grids/march_rays.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 namespace haze::grids {
@@ -35,10 +36,11 @@ struct Marcher {
   const std::vector<DenseGrid>& depths;
   Rgb sigma_t;
   double step;
-  // The lights' depths interleaved (all lights of a cell together): one stencil reads 8 short runs.
-  std::vector<float> packed;
-  // The same for the surfaces' shadows (surface_visibility); empty without surfaces.
-  std::vector<float> packed_visibility;
+  // The lights' depths interleaved (all lights of a cell together): one stencil reads 8 short runs;
+  // the same for the surfaces' shadows (surface_visibility; empty without surfaces). The caller's
+  // (PackedLights, made once per solution) or made here.
+  PackedLights own;
+  const PackedLights& packed;
 
   // MarchSettings::surface_gather: the directions, and the tangent of the cone each stands for.
   bool gather = false;
@@ -46,22 +48,11 @@ struct Marcher {
   double cone = 0.0;
 
   Marcher(const Scene& s, const ExtinctionVolume& v, const std::vector<DenseGrid>& d, double step_length, int threads,
-          const std::vector<DenseGrid>* visibility, bool surface_gather = false)
-      : scene(s), volume(v), depths(d), sigma_t(v.sigma_t_scale), step(step_length), packed(interleave(d)) {
+          const PackedLights* lights, bool surface_gather = false)
+      : scene(s), volume(v), depths(d), sigma_t(v.sigma_t_scale), step(step_length),
+        own(lights ? PackedLights{} : pack_lights(s, v, d, threads)), packed(lights ? *lights : own) {
     gather = surface_gather && !scene.surfaces.empty() && volume.albedo != Rgb(0.0);
     cone = cone_tangent(kSurfaceDirections);
-    if (volume.albedo == Rgb(0.0) || scene.surfaces.empty()) return;  // no light in the medium to shadow
-    packed_visibility = interleave(visibility ? *visibility : surface_visibility(volume.density, scene.lights, scene.surfaces, threads));
-  }
-
-  // Per-light volumes interleaved, [cell * lights + l].
-  static std::vector<float> interleave(const std::vector<DenseGrid>& grids) {
-    if (grids.empty()) return {};
-    const size_t lights = grids.size(), cells = grids.front().cell_count();
-    std::vector<float> out(cells * lights);
-    for (size_t c = 0; c < cells; ++c)
-      for (size_t l = 0; l < lights; ++l) out[c * lights + l] = grids[l].values()[c];
-    return out;
   }
 
   // The nearest surface before t_max (a host's depth); h.t is t_max where there is none.
@@ -100,13 +91,13 @@ struct Marcher {
       }
       std::fill(depth.begin(), depth.end(), 0.0);
       for (int m = 0; m < 8; ++m) {
-        const float* run = packed.data() + stencil.offset[m] * lights;
+        const float* run = packed.depths.data() + stencil.offset[m] * lights;
         for (size_t l = 0; l < lights; ++l) depth[l] += stencil.weight[m] * static_cast<double>(run[l]);
       }
-      if (!packed_visibility.empty()) {
+      if (!packed.visibility.empty()) {
         std::fill(visible.begin(), visible.end(), 0.0);
         for (int m = 0; m < 8; ++m) {
-          const float* run = packed_visibility.data() + stencil.offset[m] * lights;
+          const float* run = packed.visibility.data() + stencil.offset[m] * lights;
           for (size_t l = 0; l < lights; ++l) visible[l] += stencil.weight[m] * static_cast<double>(run[l]);
         }
       }
@@ -187,8 +178,8 @@ bool simd_volume(const Marcher& m, std::vector<MarchLight>& lights, MarchVolume&
     lights.push_back(l);
   }
   v.density = density.values().data();
-  v.depths = m.packed.data();
-  v.visibility = m.packed_visibility.empty() ? nullptr : m.packed_visibility.data();
+  v.depths = m.packed.depths.data();
+  v.visibility = m.packed.visibility.empty() ? nullptr : m.packed.visibility.data();
   v.lights = lights.data();
   v.light_count = static_cast<int>(lights.size());
   v.channels = all_grey ? 1 : 3;
@@ -226,65 +217,90 @@ void march_row(const Marcher& m, const MarchVolume& v, const View& view, int y, 
 }
 
 // Row y's stretches between consecutive distances, one packet, chained per ray (march_distances).
+// The segments go slice by slice, so that a vector's lanes march the same slice of neighbouring
+// rays (similar step counts). Buffers are per thread and kept: a frame allocates nothing once
+// they have grown.
 void march_row_distances(const Marcher& m, const MarchVolume& v, const View& view, std::span<const double> distances, int y,
                          DistanceLayers out) {
   const Camera& camera = view.camera;
   const auto width = static_cast<size_t>(camera.width_px), n = distances.size();
-  std::vector<Ray> rays(width);
+  thread_local std::vector<Ray> rays;
+  thread_local std::vector<std::pair<double, double>> inside;  // each ray's stretch in the medium
+  thread_local std::vector<float> packed, result;
+  thread_local std::vector<Vec3f> l, t;  // each ray's layers so far
+  rays.resize(width), inside.resize(width);
   camera.row_rays(y, rays.data());
-  std::vector<float> in;
-  std::vector<size_t> owner;  // the (x, k) of each segment, as x * n + k
-  std::vector<std::array<float, 9>> segments;
   for (size_t x = 0; x < width; ++x) {
-    const Hit hit = m.hit(rays[x]);
-    double a = 0.0, b = hit.t;
-    if (!m.volume.density.bounds().clip(rays[x], a, b) || !(b > a)) continue;
-    for (size_t k = 0; k < n; ++k) {
-      const double from = std::max(a, k == 0 ? 0.0 : distances[k - 1]), to = std::min(b, distances[k]);
-      if (!(to > from)) continue;
-      const int count = static_cast<int>(std::ceil((to - from) / m.step));
-      const Ray& r = rays[x];
-      segments.push_back({static_cast<float>(r.origin.x), static_cast<float>(r.origin.y), static_cast<float>(r.origin.z),
-                          static_cast<float>(r.direction.x), static_cast<float>(r.direction.y), static_cast<float>(r.direction.z),
-                          static_cast<float>(from), static_cast<float>((to - from) / count), static_cast<float>(count)});
-      owner.push_back(x * n + k);
-    }
+    double a = 0.0, b = m.hit(rays[x]).t;
+    if (!m.volume.density.bounds().clip(rays[x], a, b) || !(b > a)) b = a;
+    inside[x] = {a, b};
   }
-  const size_t count = segments.size();
-  std::vector<float> packed(9 * count), result(6 * count, 0.0f);
-  for (size_t i = 0; i < count; ++i)
-    for (size_t a = 0; a < 9; ++a) packed[a * count + i] = segments[i][a];
+  // The stretch of ray x before distance k inside the medium: [from, to) when to > from.
+  const auto stretch = [&](size_t x, size_t k) {
+    return std::pair{std::max(inside[x].first, k == 0 ? 0.0 : distances[k - 1]), std::min(inside[x].second, distances[k])};
+  };
+  size_t count = 0;
+  for (size_t k = 0; k < n; ++k)
+    for (size_t x = 0; x < width; ++x)
+      if (const auto [from, to] = stretch(x, k); to > from) ++count;
+  packed.resize(9 * count), result.assign(6 * count, 0.0f);
+  size_t i = 0;
+  for (size_t k = 0; k < n; ++k)
+    for (size_t x = 0; x < width; ++x)
+      if (const auto [from, to] = stretch(x, k); to > from) {
+        const int steps = static_cast<int>(std::ceil((to - from) / m.step));
+        const Ray& r = rays[x];
+        const double segment[9] = {r.origin.x, r.origin.y, r.origin.z, r.direction.x, r.direction.y, r.direction.z, from, (to - from) / steps,
+                                   static_cast<double>(steps)};
+        for (size_t e = 0; e < 9; ++e) packed[e * count + i] = static_cast<float>(segment[e]);
+        ++i;
+      }
   auto row = [&](std::vector<float>& buffer, size_t a) { return buffer.data() + a * count; };
   RayPacket packet{row(packed, 0), row(packed, 1), row(packed, 2), row(packed, 3), row(packed, 4), row(packed, 5), row(packed, 6), row(packed, 7),
                          row(packed, 8), count, {row(result, 0), row(result, 1), row(result, 2)}, {row(result, 3), row(result, 4), row(result, 5)}};
   if (count > 0) march_rays(v, m.volume.phase, packet);
-  // Each segment's own L and T, then chained along the ray.
-  std::vector<PixelLayers> own(width * n);
-  for (size_t i = 0; i < count; ++i)
-    for (int c = 0; c < 3; ++c) {
-      const size_t channel = v.channels == 1 ? 0 : static_cast<size_t>(c);
-      own[owner[i]].inscatter[c] = static_cast<double>(row(result, channel)[i]);
-      own[owner[i]].transmittance[c] = static_cast<double>(row(result, 3 + channel)[i]);
+  // Chained front to back: L(d_k) = L(d_k-1) + T(d_k-1) L_k, T(d_k) = T(d_k-1) T_k.
+  l.assign(width, Vec3f(0.0f)), t.assign(width, Vec3f(1.0f));
+  const size_t per_slice = width * static_cast<size_t>(camera.height_px), first = static_cast<size_t>(y) * width;
+  i = 0;
+  for (size_t k = 0; k < n; ++k)
+    for (size_t x = 0; x < width; ++x) {
+      if (const auto [from, to] = stretch(x, k); to > from) {
+        for (int c = 0; c < 3; ++c) {
+          const size_t channel = v.channels == 1 ? 0 : static_cast<size_t>(c);
+          l[x][c] += t[x][c] * row(result, channel)[i], t[x][c] *= row(result, 3 + channel)[i];
+        }
+        ++i;
+      }
+      out.inscatter[k * per_slice + first + x] = l[x], out.transmittance[k * per_slice + first + x] = t[x];
     }
-  const size_t per_slice = width * static_cast<size_t>(camera.height_px);
-  for (size_t x = 0; x < width; ++x) {
-    Rgb l(0.0), t(1.0);
-    for (size_t k = 0; k < n; ++k) {
-      const PixelLayers& s = own[x * n + k];
-      l += t * s.inscatter, t *= s.transmittance;
-      const size_t at = k * per_slice + static_cast<size_t>(y) * width + x;
-      out.inscatter[at] = Vec3f(l), out.transmittance[at] = Vec3f(t);
-    }
-  }
 }
 
 }  // namespace
 
+PackedLights pack_lights(const Scene& scene, const ExtinctionVolume& volume, const std::vector<DenseGrid>& depths, int threads,
+                         const std::vector<DenseGrid>* visibility) {
+  const auto interleave = [](const std::vector<DenseGrid>& grids) {
+    if (grids.empty()) return std::vector<float>{};
+    const size_t lights = grids.size(), cells = grids.front().cell_count();
+    std::vector<float> out(cells * lights);
+    for (size_t c = 0; c < cells; ++c)
+      for (size_t l = 0; l < lights; ++l) out[c * lights + l] = grids[l].values()[c];
+    return out;
+  };
+  PackedLights packed{interleave(depths), {}};
+  if (volume.albedo == Rgb(0.0) || scene.surfaces.empty()) return packed;  // no light in the medium to shadow
+  if (visibility && visibility->size() != depths.size())
+    throw Error("visibility", to_text(visibility->size()) + " volumes", "one per light (" + to_text(depths.size()) + ")");
+  packed.visibility = interleave(visibility ? *visibility : surface_visibility(volume.density, scene.lights, scene.surfaces, threads));
+  return packed;
+}
+
 bool march_distances(const Scene& scene, const ExtinctionVolume& volume, const std::vector<DenseGrid>& depths, const MarchSettings& settings,
                      const RenderOptions& options, const View& view, std::span<const double> distances, DistanceLayers out,
-                     const std::vector<DenseGrid>* visibility) {
+                     const PackedLights* packed) {
   const Vec3 h = volume.density.cell_size();
-  const Marcher marcher(scene, volume, depths, settings.step_cells * std::min({h.x, h.y, h.z}), options.threads, visibility, false);
+  const Marcher marcher(scene, volume, depths, settings.step_cells * std::min({h.x, h.y, h.z}), options.threads, packed, false);
   std::vector<MarchLight> lights;
   MarchVolume simd_view;
   if (settings.scalar || !simd_volume(marcher, lights, simd_view)) return false;
@@ -296,19 +312,17 @@ bool march_distances(const Scene& scene, const ExtinctionVolume& volume, const s
 }
 
 Image march_image(const Scene& scene, const ExtinctionVolume& volume, const std::vector<DenseGrid>& depths,
-                  const MarchSettings& settings, const RenderOptions& options, const std::vector<DenseGrid>* visibility) {
-  return march_view(scene, volume, depths, settings, options, View{scene.camera}, visibility).radiance;
+                  const MarchSettings& settings, const RenderOptions& options, const PackedLights* packed) {
+  return march_view(scene, volume, depths, settings, options, View{scene.camera}, packed).radiance;
 }
 
 RenderResult march_view(const Scene& scene, const ExtinctionVolume& volume, const std::vector<DenseGrid>& depths, const MarchSettings& settings,
-                        const RenderOptions& options, const View& view, const std::vector<DenseGrid>* visibility) {
+                        const RenderOptions& options, const View& view, const PackedLights* packed) {
   if (depths.size() != scene.lights.size())
     throw Error("depths", to_text(depths.size()) + " volumes", "one per light (" + to_text(scene.lights.size()) + ")");
   if (!(settings.step_cells > 0.0)) throw Error("step", to_text(settings.step_cells), "a step > 0 cells");
   const Vec3 h = volume.density.cell_size();
-  if (visibility && !scene.surfaces.empty() && visibility->size() != depths.size())
-    throw Error("visibility", to_text(visibility->size()) + " volumes", "one per light (" + to_text(depths.size()) + ")");
-  const Marcher marcher(scene, volume, depths, settings.step_cells * std::min({h.x, h.y, h.z}), options.threads, visibility,
+  const Marcher marcher(scene, volume, depths, settings.step_cells * std::min({h.x, h.y, h.z}), options.threads, packed,
                         settings.surface_gather);
   std::vector<MarchLight> lights;
   MarchVolume simd_view;

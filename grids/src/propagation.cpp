@@ -34,18 +34,18 @@ class PropagationSolution final : public GridSolution {
         resolution_(fields.resolution),
         cutoff_(fields.cutoff) {
     stats = std::move(fields.stats);
-    visibility_ = surface_visibility(volume_.density, scene_.lights, scene_.surfaces, depth_.threads);
+    packed_ = pack_lights(scene_, volume_, depths_, depth_.threads);
   }
 
   RenderResult render(const View& view, const RenderOptions& options) const override {
     const Stopwatch watch;
-    RenderResult result = march_view(view_scene(scene_, view.camera), volume_, depths_, march_, options, view, &visibility_);
+    RenderResult result = march_view(view_scene(scene_, view.camera), volume_, depths_, march_, options, view, &packed_);
     result.stats["march_seconds"] = watch.seconds();
     return result;
   }
   bool renders_layers() const override { return true; }
   bool render_distances(const View& view, std::span<const double> distances, const RenderOptions& options, DistanceLayers out) const override {
-    return march_distances(view_scene(scene_, view.camera), volume_, depths_, march_, options, view, distances, out, &visibility_);
+    return march_distances(view_scene(scene_, view.camera), volume_, depths_, march_, options, view, distances, out, &packed_);
   }
 
   // A new density (re-injected by region where it can: replace_volume) redoes every light's depth,
@@ -61,7 +61,7 @@ class PropagationSolution final : public GridSolution {
     }
     update_depths(scene, change.medium.has_value(), depth_, report);
     report.stats["propagate_seconds"] = watch.lap();
-    if (change.medium || change.lights || change.surfaces) visibility_ = surface_visibility(volume_.density, scene.lights, scene.surfaces, options.threads);
+    packed_ = pack_lights(scene, volume_, depths_, options.threads);
     scene_ = scene;
     return report;
   }
@@ -71,7 +71,7 @@ class PropagationSolution final : public GridSolution {
   DepthOptions depth_;
   int resolution_;
   double cutoff_;
-  std::vector<DenseGrid> visibility_;  // surface_visibility: the surfaces' shadows, made once per prepare or update
+  PackedLights packed_;  // the depths and the surfaces' shadows as the marcher reads them, made once per prepare or update
 };
 
 class PropagationMethod final : public Method {

@@ -76,27 +76,38 @@ struct MarchSettings {
   bool surface_gather = false;
 };
 
+// The per-light volumes as the marcher reads them, all lights of a cell together ([cell * lights +
+// l]): the optical depths, and the surfaces' shadows (surface_visibility; empty without surfaces
+// or where nothing scatters). 4 bytes a cell and light each: made once per solution, not per frame.
+struct PackedLights {
+  std::vector<float> depths, visibility;
+};
+// `visibility` when given (one grid per light), else computed here.
+PackedLights pack_lights(const Scene& scene, const ExtinctionVolume& volume, const std::vector<DenseGrid>& depths, int threads,
+                         const std::vector<DenseGrid>* visibility = nullptr);
+
 // Seed 003 eq. 8-10 in Haze's conventions: along each camera ray inside the volume, in steps,
 //   L += T_cam albedo (1 - e^(-sigma_t rho step)) sum_lights p(wi . wo) E_light e^(-sigma_t depth_light),
 // with density and depths trilinear at the step's midpoint and T_cam the transmittance so far
 // (the (1 - e^-tau) form keeps thick steps energy-conserving, where eq. 8's K_t step does not).
 // Surfaces (Lambert/Phong) are lit through the depth volume (or, outside it, a DDA walk through
 // the density) where no other surface is in the way, and seen through T_cam; E_light is times its
-// visibility past the surfaces (surface_visibility: `visibility` when given, which a caller
-// rendering many frames keeps, else computed here). depths[i] belongs to scene.lights[i].
+// visibility past the surfaces (surface_visibility). depths[i] belongs to scene.lights[i]. The
+// marcher reads them packed (PackedLights): `packed` when given, which a caller rendering many
+// frames keeps, else made here.
 Image march_image(const Scene& scene, const ExtinctionVolume& volume, const std::vector<DenseGrid>& depths,
-                  const MarchSettings& settings, const RenderOptions& options, const std::vector<DenseGrid>* visibility = nullptr);
+                  const MarchSettings& settings, const RenderOptions& options, const PackedLights* packed = nullptr);
 // The same for `view` (its camera in place of the scene's): rays end at its depth where no surface
 // is nearer, and with view.layers the result holds L_in, T and C per pixel (PixelLayers).
 RenderResult march_view(const Scene& scene, const ExtinctionVolume& volume, const std::vector<DenseGrid>& depths, const MarchSettings& settings,
-                        const RenderOptions& options, const View& view, const std::vector<DenseGrid>* visibility = nullptr);
+                        const RenderOptions& options, const View& view, const PackedLights* packed = nullptr);
 // L_in and T along each of view's rays to each of `distances` (ascending; MethodSolution::
 // render_distances) in one march: each ray's stretch between consecutive distances is marched as
 // its own segment (the SIMD kernel's, all of a row's in one packet) and the segments are chained,
 // L(d_k) = L(d_k-1) + T(d_k-1) L_k, T(d_k) = T(d_k-1) T_k. Into out (slice-major, float32); false without the SIMD kernel.
 bool march_distances(const Scene& scene, const ExtinctionVolume& volume, const std::vector<DenseGrid>& depths, const MarchSettings& settings,
                      const RenderOptions& options, const View& view, std::span<const double> distances, DistanceLayers out,
-                     const std::vector<DenseGrid>* visibility = nullptr);
+                     const PackedLights* packed = nullptr);
 
 // Everything method "propagation" computes before it marches, from the scene and the method's
 // settings in options.settings (resolution, optical_depth, sweep_layers, step, cutoff; unknown
