@@ -40,9 +40,11 @@ HWY_NOINLINE void CompositeRowKernel(const CompositeVolume& v, const CompositeRo
   const int j = std::min(static_cast<int>(y), std::max(ny - 2, 0));
   const float b = ny > 1 ? y - static_cast<float>(j) : 0.0f;
   const size_t dx = nx > 1 ? 1 : 0, dy = ny > 1 ? static_cast<size_t>(nx) : 0, row_at = static_cast<size_t>(j) * static_cast<size_t>(nx);
-  HWY_ALIGN float a_of[kChunk + 16], c_of[kChunk + 16];
+  // Per pixel of a chunk: its column i, slice k and the weights of its four lerped taps.
+  HWY_ALIGN float w_of[4][kChunk + 16];
   HWY_ALIGN int32_t i_of[kChunk + 16], k_of[kChunk + 16];
-  HWY_ALIGN float l_out[4], t_out[4];
+  // The chunk's L_in and T, RGB packed (a pixel's four-float store overlaps the next's first float).
+  HWY_ALIGN float l_of[3 * kChunk + 16], t_of[3 * kChunk + 16];
   const auto x_scale = hn::Set(d, static_cast<float>(nx) / static_cast<float>(w));
   const auto x_max = hn::Set(d, static_cast<float>(nx - 1)), i_max = hn::Set(d, static_cast<float>(std::max(nx - 2, 0)));
   const auto near = hn::Set(d, v.near), log_near = hn::Set(d, v.log_near), per_log = hn::Set(d, v.slices_per_log);
@@ -80,7 +82,7 @@ HWY_NOINLINE void CompositeRowKernel(const CompositeVolume& v, const CompositeRo
       const auto px = hn::Add(lane_index, hn::Set(d, static_cast<float>(x0 + p)));
       const auto x = hn::Min(hn::Max(hn::MulSub(hn::Add(px, half), x_scale, half), zero), x_max);
       const auto i = hn::Min(hn::Floor(x), i_max);
-      hn::Store(nx > 1 ? hn::Sub(x, i) : zero, d, a_of + p);
+      const auto a = nx > 1 ? hn::Sub(x, i) : zero;
       hn::Store(hn::ConvertTo(di, i), di, i_of + p);
       // The row's last, partial vector through a copy: its lanes past the end are computed, never used.
       HWY_ALIGN float tail[HWY_MAX_BYTES / sizeof(float)];
@@ -92,22 +94,28 @@ HWY_NOINLINE void CompositeRowKernel(const CompositeVolume& v, const CompositeRo
       const auto dist = hn::LoadU(d, depth);
       const auto z = hn::IfThenElse(hn::Gt(dist, near), hn::Min(hn::MulSub(per_log, hn::Sub(hn::Log(d, dist), log_near), one), last_slice),
                                     hn::Set(d, -1.0f));
-      const auto k = hn::Floor(z);
-      hn::Store(hn::Sub(z, k), d, c_of + p);
+      const auto k = hn::Floor(z), c = hn::Sub(z, k);
       hn::Store(hn::ConvertTo(di, k), di, k_of + p);
+      const auto not_a = hn::Sub(one, a), not_c = hn::Sub(one, c);
+      hn::Store(hn::Mul(not_a, not_c), d, w_of[0] + p), hn::Store(hn::Mul(a, not_c), d, w_of[1] + p);
+      hn::Store(hn::Mul(not_a, c), d, w_of[2] + p), hn::Store(hn::Mul(a, c), d, w_of[3] + p);
     }
     for (int p = 0; p < n; ++p) {
-      const int px = x0 + p, k = k_of[p], i = i_of[p];
+      const int k = k_of[p], i = i_of[p];
       if (k != cached_k || i != cached_i) fill(i, k), cached_i = i, cached_k = k;
-      const float a = a_of[p], c = c_of[p];
-      const V4 w00 = hn::Set(d4, (1.0f - a) * (1.0f - c)), w10 = hn::Set(d4, a * (1.0f - c));
-      const V4 w01 = hn::Set(d4, (1.0f - a) * c), w11 = hn::Set(d4, a * c);
-      const V4 l = hn::MulAdd(w11, yl[3], hn::MulAdd(w01, yl[2], hn::MulAdd(w10, yl[1], hn::Mul(w00, yl[0]))));
-      const V4 t = hn::MulAdd(w11, yt[3], hn::MulAdd(w01, yt[2], hn::MulAdd(w10, yt[1], hn::Mul(w00, yt[0]))));
-      hn::Store(l, d4, l_out), hn::Store(t, d4, t_out);
-      const float* in = row.colour + static_cast<size_t>(px) * static_cast<size_t>(row.colour_channels);
-      float* to = row.out + static_cast<size_t>(px) * static_cast<size_t>(row.out_channels);
-      for (int ch = 0; ch < 3; ++ch) to[ch] = l_out[ch] + t_out[ch] * in[ch];
+      const V4 w00 = hn::Set(d4, w_of[0][p]), w10 = hn::Set(d4, w_of[1][p]), w01 = hn::Set(d4, w_of[2][p]), w11 = hn::Set(d4, w_of[3][p]);
+      hn::StoreU(hn::Add(hn::MulAdd(w10, yl[1], hn::Mul(w00, yl[0])), hn::MulAdd(w11, yl[3], hn::Mul(w01, yl[2]))), d4, l_of + 3 * p);
+      hn::StoreU(hn::Add(hn::MulAdd(w10, yt[1], hn::Mul(w00, yt[0])), hn::MulAdd(w11, yt[3], hn::Mul(w01, yt[2]))), d4, t_of + 3 * p);
+    }
+    // colour = L_in + T colour, over the chunk's floats in full vectors where rows are RGB.
+    const float* in = row.colour + static_cast<size_t>(x0) * static_cast<size_t>(row.colour_channels);
+    float* to = row.out + static_cast<size_t>(x0) * static_cast<size_t>(row.out_channels);
+    int f = 0;
+    if (row.colour_channels == 3 && row.out_channels == 3)
+      for (; f + lanes <= 3 * n; f += lanes) hn::StoreU(hn::MulAdd(hn::Load(d, t_of + f), hn::LoadU(d, in + f), hn::Load(d, l_of + f)), d, to + f);
+    for (; f < 3 * n; ++f) {
+      const int px = f / 3, ch = f - 3 * px;
+      to[px * row.out_channels + ch] = l_of[f] + t_of[f] * in[px * row.colour_channels + ch];
     }
   }
 }

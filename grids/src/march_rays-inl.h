@@ -71,12 +71,13 @@ HWY_INLINE void MarchVector(D d, const MarchVolume& v, const simd::PhaseParams& 
     if (hn::AllFalse(d, active)) continue;
     V in[C];
     for (int c = 0; c < C; ++c) in[c] = zero;
-    const VI lights = hn::Set(di, v.light_count);
+    // The corners' offsets into the per-light volumes ([cell * lights + l]).
+    VI light_offset[8];
+    for (int m = 0; m < 8; ++m) light_offset[m] = hn::Mul(offset[m], hn::Set(di, v.light_count));
     for (int l = 0; l < v.light_count; ++l) {
       const MarchLight& light = v.lights[l];
       V depth = zero;
-      for (int m = 0; m < 8; ++m)
-        depth = hn::MulAdd(weight[m], hn::GatherIndex(d, v.depths + l, hn::Mul(offset[m], lights)), depth);
+      for (int m = 0; m < 8; ++m) depth = hn::MulAdd(weight[m], hn::GatherIndex(d, v.depths + l, light_offset[m]), depth);
       V to[3], falloff;
       if (light.type == MarchLight::directional) {
         for (int e = 0; e < 3; ++e) to[e] = hn::Set(d, light.to_light[e]);
@@ -85,7 +86,7 @@ HWY_INLINE void MarchVector(D d, const MarchVolume& v, const simd::PhaseParams& 
         V w[3];
         for (int e = 0; e < 3; ++e) w[e] = hn::Sub(hn::Set(d, light.position[e]), x[e]);
         const V r2 = hn::MulAdd(w[0], w[0], hn::MulAdd(w[1], w[1], hn::Mul(w[2], w[2])));
-        const V inv_r = hn::Div(one, hn::Sqrt(r2));
+        const V inv_r = simd::HWY_NAMESPACE::ReciprocalSqrt(r2);
         for (int e = 0; e < 3; ++e) to[e] = hn::Mul(w[e], inv_r);
         falloff = hn::Mul(inv_r, inv_r);
         if (light.type == MarchLight::spot) {
@@ -99,7 +100,7 @@ HWY_INLINE void MarchVector(D d, const MarchVolume& v, const simd::PhaseParams& 
       if (v.visibility) {
         V visible = zero;
         for (int m = 0; m < 8; ++m)
-          visible = hn::MulAdd(weight[m], hn::GatherIndex(d, v.visibility + l, hn::Mul(offset[m], lights)), visible);
+          visible = hn::MulAdd(weight[m], hn::GatherIndex(d, v.visibility + l, light_offset[m]), visible);
         falloff = hn::Mul(falloff, visible);
       }
       const V mu = hn::MulAdd(to[0], dir[0], hn::MulAdd(to[1], dir[1], hn::Mul(to[2], dir[2])));
