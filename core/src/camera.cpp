@@ -4,6 +4,7 @@
 #include <glm/matrix.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 namespace haze {
@@ -102,9 +103,12 @@ void Camera::row_rays_at(double py, const double* px, int count, Ray* out) const
 }
 
 void Camera::row_rays(int y, Ray* out) const {
-  std::vector<double> px(static_cast<size_t>(width_px));
-  for (int x = 0; x < width_px; ++x) px[static_cast<size_t>(x)] = x + 0.5;
-  row_rays_at(y + 0.5, px.data(), width_px, out);
+  std::array<double, 256> px;  // pixel centres a run at a time: a frame's rows allocate nothing
+  for (int x0 = 0; x0 < width_px; x0 += static_cast<int>(px.size())) {
+    const int count = std::min(static_cast<int>(px.size()), width_px - x0);
+    for (int i = 0; i < count; ++i) px[static_cast<size_t>(i)] = x0 + i + 0.5;
+    row_rays_at(y + 0.5, px.data(), count, out + x0);
+  }
 }
 
 }  // namespace haze

@@ -42,6 +42,13 @@ struct Solution::State {
     return changed;
   }
 
+  // What a render hands the method: the caller's threads and progress with what the solution was
+  // prepared under, but not prepare's settings and cache (a render reads neither): a copy that
+  // allocates nothing, so that a frame need not.
+  RenderOptions for_render(const RenderOptions& call) const {
+    return RenderOptions{call.threads, nullptr, call.progress, {}, options.single_view, options.max_memory, options.ranks};
+  }
+
   // An error about "lights[k]..." from the method names the caller's light, not the k-th kept.
   template <class F>
   auto naming_lights(F f) const {
@@ -144,9 +151,7 @@ RenderResult Solution::render(const View& view, const RenderOptions& options) co
     throw Error("settings", json_text(options.settings), "none when rendering a solution (settings are given to haze::prepare)");
   if (s.options.single_view && !(view.camera == s.scene.camera))
     throw Error("view.camera", "another camera than the scene's", "the scene's camera for a solution prepared with single_view");
-  RenderOptions o = s.options;
-  o.threads = options.threads;
-  o.progress = options.progress;
+  const RenderOptions o = s.for_render(options);
   RenderResult result = s.naming_lights([&] { return s.solution->render(view, o); });
   nlohmann::json stats = s.solution->stats;
   for (auto& [key, value] : result.stats.items()) stats[key] = std::move(value);
@@ -166,8 +171,7 @@ void Solution::render_distances(const View& view, std::span<const double> distan
   const View at{view.camera, {}, true};
   if (s.options.single_view && !(view.camera == s.scene.camera))
     throw Error("view.camera", "another camera than the scene's", "the scene's camera for a solution prepared with single_view");
-  RenderOptions o = s.options;
-  o.threads = options.threads;
+  const RenderOptions o = s.for_render(options);
   if (s.naming_lights([&] { return s.solution->render_distances(at, distances, o, out); })) return;
   std::vector<float> depth(rays);
   RenderOptions slice = options;

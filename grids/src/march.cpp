@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <optional>
 
 namespace haze::grids {
 
@@ -44,7 +45,7 @@ struct Marcher {
 
   // MarchSettings::surface_gather: the directions, and the tangent of the cone each stands for.
   bool gather = false;
-  DirectionSet around = DirectionSet::fibonacci(kSurfaceDirections);
+  std::optional<DirectionSet> around;  // made only when gathering: a frame's marcher allocates nothing else
   double cone = 0.0;
 
   Marcher(const Scene& s, const ExtinctionVolume& v, const std::vector<DenseGrid>& d, double step_length, int threads,
@@ -52,6 +53,7 @@ struct Marcher {
       : scene(s), volume(v), depths(d), sigma_t(v.sigma_t_scale), step(step_length),
         own(lights ? PackedLights{} : pack_lights(s, v, d, threads)), packed(lights ? *lights : own) {
     gather = surface_gather && !scene.surfaces.empty() && volume.albedo != Rgb(0.0);
+    if (gather) around = DirectionSet::fibonacci(kSurfaceDirections);
     cone = cone_tangent(kSurfaceDirections);
   }
 
@@ -124,13 +126,13 @@ struct Marcher {
     if (!h.surface) return {radiance, transmittance, std::isinf(h.t) ? scene.background : Rgb(0.0)};
     const Vec3 p = ray.at(h.t);
     Rgb surface = surface_direct(scene.lights, scene.surfaces, volume.density, depths, sigma_t, *h.surface, p, h.normal, -ray.direction);
-    for (int j = 0; gather && j < around.size(); ++j) {
-      const double cos_i = glm::dot(h.normal, around[j]);
+    for (int j = 0; gather && j < around->size(); ++j) {
+      const double cos_i = glm::dot(h.normal, (*around)[j]);
       if (cos_i <= 0.0) continue;
-      const Ray up{p, around[j]};
+      const Ray up{p, (*around)[j]};
       Rgb arriving, unused;
       march(up, steps(up, hit(up).t), arriving, unused, cone);
-      surface += around.weight(j) * cos_i * h.surface->brdf(around[j], -ray.direction, h.normal) * arriving;
+      surface += around->weight(j) * cos_i * h.surface->brdf((*around)[j], -ray.direction, h.normal) * arriving;
     }
     return {radiance, transmittance, surface};
   }
@@ -301,13 +303,16 @@ bool march_distances(const Scene& scene, const ExtinctionVolume& volume, const s
                      const PackedLights* packed) {
   const Vec3 h = volume.density.cell_size();
   const Marcher marcher(scene, volume, depths, settings.step_cells * std::min({h.x, h.y, h.z}), options.threads, packed, false);
-  std::vector<MarchLight> lights;
+  thread_local std::vector<MarchLight> lights;  // kept: a frame allocates nothing
+  lights.clear();
   MarchVolume simd_view;
   if (settings.scalar || !simd_volume(marcher, lights, simd_view)) return false;
   const Camera& camera = view.camera;
-  parallel_for(camera.height_px, options.threads, 1, [&](long long y0, long long y1) {
+  const auto rows = [&](long long y0, long long y1) {
     for (auto y = static_cast<int>(y0); y < y1; ++y) march_row_distances(marcher, simd_view, view, distances, y, out);
-  });
+  };
+  // A body of one reference: std::function keeps it without allocating.
+  parallel_for(camera.height_px, options.threads, 1, [&rows](long long y0, long long y1) { rows(y0, y1); });
   return true;
 }
 

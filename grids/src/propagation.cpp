@@ -45,7 +45,7 @@ class PropagationSolution final : public GridSolution {
   }
   bool renders_layers() const override { return true; }
   bool render_distances(const View& view, std::span<const double> distances, const RenderOptions& options, DistanceLayers out) const override {
-    return march_distances(view_scene(scene_, view.camera), volume_, depths_, march_, options, view, distances, out, &packed_);
+    return march_distances(scene_, volume_, depths_, march_, options, view, distances, out, &packed_);  // the view's camera, not the scene's
   }
 
   // A new density (re-injected by region where it can: replace_volume) redoes every light's depth,
