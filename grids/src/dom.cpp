@@ -272,6 +272,46 @@ class DomMethodSolution final : public GridSolution {
   }
   bool renders_layers() const override { return true; }
 
+  // Without surfaces or emission, each ray marched once: its stretch between consecutive distances
+  // gathered in steps of its own (Gather::along_stretch) and the stretches chained front to back,
+  // L(d_k) = L(d_k-1) + T(d_k-1) L_k, T(d_k) = T(d_k-1) T_k (what the layered render at d_k gives,
+  // but for where the steps fall).
+  bool render_distances(const View& view, std::span<const double> distances, const RenderOptions& options, DistanceLayers out) const override {
+    if (!scene_.surfaces.empty() || volume_.emission.emits()) return false;
+    Rgb sky;
+    const Scene delta = without_sky(scene_, sky);
+    const dom::Gather gather(delta, volume_, depths_, solution_, step_cells_, options.threads, nullptr);
+    const Camera& camera = view.camera;
+    const auto width = static_cast<size_t>(camera.width_px);
+    const size_t per_slice = width * static_cast<size_t>(camera.height_px);
+    const Aabb bounds = volume_.density.bounds();
+    const auto rows = [&](long long y0, long long y1) {
+      std::vector<Ray> rays(width);
+      for (auto y = static_cast<int>(y0); y < y1; ++y) {
+        camera.row_rays(y, rays.data());
+        for (size_t x = 0; x < width; ++x) {
+          const Ray& ray = rays[x];
+          double t0 = 0.0, t1 = kInfinity;
+          const bool inside = bounds.clip(ray, t0, t1) && t1 > t0;
+          const Eigen::VectorXd c = inside ? inscatter_weights(solution_, -ray.direction) : Eigen::VectorXd();
+          Rgb l(0.0), t(1.0);
+          for (size_t k = 0; k < distances.size(); ++k) {
+            const double from = std::max(t0, k == 0 ? 0.0 : distances[k - 1]), to = std::min(t1, distances[k]);
+            if (inside && to > from) {
+              Rgb t_k;
+              const Rgb l_k = gather.along_stretch(ray, from, to, c, t_k);
+              l += t * l_k, t *= t_k;
+            }
+            const size_t at = k * per_slice + static_cast<size_t>(y) * width + x;
+            out.inscatter[at] = Vec3f(l), out.transmittance[at] = Vec3f(t);
+          }
+        }
+      }
+    };
+    parallel_for(camera.height_px, options.threads, 1, [&rows](long long y0, long long y1) { rows(y0, y1); });
+    return true;
+  }
+
   // A new density (re-injected by region where it can: replace_volume) redoes every light's depth,
   // new lights only those that differ; the moments then iterate from the previous ones
   // (warm_iterations sweeps, or to the tolerance).

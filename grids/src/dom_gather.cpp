@@ -80,15 +80,19 @@ void Gather::only_planes(int first, int last) {
 }
 
 Rgb Gather::along(const Ray& ray, double t_end, const Eigen::VectorXd& c, Rgb& transmittance, double cone) const {
-  return along(ray, t_end, &c, nullptr, kAll, transmittance, cone);
+  return along(ray, 0.0, t_end, &c, nullptr, kAll, transmittance, cone);
 }
 
-Rgb Gather::along(const Ray& ray, double t_end, const Eigen::VectorXd* c, const double* share, size_t only, Rgb& transmittance,
-                  double cone) const {
+Rgb Gather::along_stretch(const Ray& ray, double t_start, double t_end, const Eigen::VectorXd& c, Rgb& transmittance) const {
+  return along(ray, t_start, t_end, &c, nullptr, kAll, transmittance, 0.0);
+}
+
+Rgb Gather::along(const Ray& ray, double t_start, double t_end, const Eigen::VectorXd* c, const double* share, size_t only,
+                  Rgb& transmittance, double cone) const {
   const DenseGrid& density = volume_.density;
   Rgb radiance(0.0);
   transmittance = Rgb(1.0);
-  double t0 = 0.0, t1 = t_end;
+  double t0 = t_start, t1 = t_end;
   if (!density.bounds().clip(ray, t0, t1) || !(t1 > t0)) return radiance;
   const auto n = static_cast<size_t>(solution_.terms());
   std::array<double, 64> small;  // the moments at a step: no allocation for up to 64 terms
@@ -200,7 +204,7 @@ Rgb Gather::arriving(const Vec3& point, const Vec3& w, const Eigen::VectorXd& c,
   Vec3 n;
   const Surface* hit = nearest_surface(delta_.surfaces, up, kInfinity, t_next, n);
   Rgb t_up;
-  const Rgb radiance = along(up, t_next, &c, share, kAll, t_up, cone);
+  const Rgb radiance = along(up, 0.0, t_next, &c, share, kAll, t_up, cone);
   if (!hit) return radiance + t_up * sky;
   return surfaces_ ? radiance + t_up * surfaces_->reflected(*hit, up.at(t_next), n, -w, false) : radiance;
 }
@@ -230,7 +234,7 @@ Rgb Gather::single(const Vec3& point, const Vec3& w, size_t l) const {
   Vec3 n;
   nearest_surface(delta_.surfaces, up, kInfinity, t_next, n);
   Rgb unused;
-  return along(up, t_next, nullptr, nullptr, l, unused, 0.0);
+  return along(up, 0.0, t_next, nullptr, nullptr, l, unused, 0.0);
 }
 
 }  // namespace haze::grids::dom

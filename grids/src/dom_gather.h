@@ -33,6 +33,9 @@ class Gather {
   // (equiangular_nodes) and a sphere it passes replaces the medium's light from its direction
   // (sphere_correction).
   Rgb along(const Ray& ray, double t_end, const Eigen::VectorXd& c, Rgb& transmittance, double cone = 0.0) const;
+  // The same over the ray's stretch [t_start, t_end] alone, in steps of its own (a camera ray's
+  // slice between two froxel boundaries: render_distances chains them).
+  Rgb along_stretch(const Ray& ray, double t_start, double t_end, const Eigen::VectorXd& c, Rgb& transmittance) const;
 
   // From now on along() takes only the steps whose midpoints lie in z planes [first, last), the
   // steps themselves unchanged, and reads moments from a solution holding planes from
@@ -108,7 +111,7 @@ class Gather {
   // along() with the moments' in-scattering only given c, and each light's single scattering
   // times share[l] (all of it without `share`), or only light `only`'s (in longer steps).
   static constexpr size_t kAll = static_cast<size_t>(-1);
-  Rgb along(const Ray& ray, double t_end, const Eigen::VectorXd* c, const double* share, size_t only, Rgb& transmittance,
+  Rgb along(const Ray& ray, double t_start, double t_end, const Eigen::VectorXd* c, const double* share, size_t only, Rgb& transmittance,
             double cone) const;
 
   const Scene& delta_;
