@@ -4,7 +4,8 @@
 // stage is timed frame by frame: the froxel build (build_froxels, 160 x 90 x 64 by default), the
 // CPU composite of the froxels over the host's colour and depth into the renderer's own image,
 // reused from frame to frame, and the per-pixel layers (Solution::render with the depth). Medians
-// over the frames.
+// over the frames; with the per-pixel layers, the froxel composite's relative RMS difference from
+// theirs over the host's floor and sky at frame 0.
 #include "commands.h"
 
 #include <haze/core/error.h>
@@ -53,6 +54,15 @@ std::vector<float> floor_depth(const Camera& camera) {
   return depth;
 }
 
+// The host's colour: its floor where the depth is finite, its sky beyond.
+Image host_colour(const std::vector<float>& depth, int width, int height) {
+  Image colour(width, height);
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x)
+      colour.set(x, y, std::isinf(depth[static_cast<size_t>(y) * static_cast<size_t>(width) + static_cast<size_t>(x)]) ? Rgb(0.05, 0.1, 0.2) : Rgb(0.3, 0.25, 0.2));
+  return colour;
+}
+
 double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
   const size_t n = v.size();
@@ -63,6 +73,9 @@ struct StageRow {
   std::string scene, method, stage;
   std::vector<double> ms;  // per frame
   double items = 0.0;      // froxels or pixels a frame
+  // per_pixel: the froxel composite's relative RMS difference from the layers' composite over the
+  // host's colour, frame 0 (NaN where not measured).
+  double froxel_error = std::numeric_limits<double>::quiet_NaN();
 };
 
 // Times `stage` frame by frame; `frame(f)` runs frame f's work and returns its milliseconds.
@@ -84,7 +97,7 @@ std::vector<StageRow> run_scene(const std::filesystem::path& file, const FrameAr
   options.threads = a.threads;
   const Solution solution = prepare(scene, "", options);
   const FroxelGrid grid{a.froxels[0], a.froxels[1], a.froxels[2]};
-  const Image host(a.width, a.height);
+  const Image host = host_colour(floor_depth(scene.camera), a.width, a.height);
   Image composed(a.width, a.height);  // the renderer's own target and froxels, reused frame after frame
   Froxels froxels;
   const auto wanted = [&](const std::string& stage) { return a.stages.empty() || std::count(a.stages.begin(), a.stages.end(), stage) > 0; };
@@ -108,14 +121,27 @@ std::vector<StageRow> run_scene(const std::filesystem::path& file, const FrameAr
                                         ImageSpan{composed.data().data(), a.width, a.height}, a.threads);
                       return 1e3 * watch.seconds();
                     }), pixels});
-  if (wanted(kStages[2]))
+  if (wanted(kStages[2])) {
+    double error = std::numeric_limits<double>::quiet_NaN();
     rows.push_back({name, method, kStages[2], time_frames(a, [&](int f) {
                       const Camera camera = pose(scene.camera, f);
                       const std::vector<float> depth = floor_depth(camera);
                       const Stopwatch watch;
                       const RenderResult r = solution.render(View{camera, depth, true}, options);
-                      return 1e3 * watch.seconds();
+                      const double ms = 1e3 * watch.seconds();
+                      if (f == 0) {  // the froxels' composite against the layers', over the host's floor and sky
+                        const Image colour = host_colour(depth, a.width, a.height);
+                        build_froxels(solution, camera, froxels, grid, options);
+                        const Image froxel = composite_froxels(froxels, colour, depth, a.threads);
+                        Image exact(a.width, a.height);
+                        for (int y = 0; y < a.height; ++y)
+                          for (int x = 0; x < a.width; ++x) exact.set(x, y, r.inscatter->at(x, y) + r.transmittance->at(x, y) * colour.at(x, y));
+                        error = relative_rmse(froxel, exact);
+                      }
+                      return ms;
                     }), pixels});
+    rows.back().froxel_error = error;
+  }
   return rows;
 }
 
@@ -140,8 +166,12 @@ int run(const FrameArgs& a) {
       const double m = median(r.ms), ns = 1e6 * m / r.items;
       out.push_back({{"scene", r.scene}, {"method", r.method}, {"stage", r.stage}, {"median_ms", m},
                      {"frames", r.ms.size()}, {"items", r.items}, {"ns_per_item", ns}});
-      if (!a.json)
-        std::printf("%-18s %-12s %-13s %10.1f %7zu %12.2f\n", r.scene.c_str(), r.method.c_str(), r.stage.c_str(), m, r.ms.size(), ns);
+      if (!std::isnan(r.froxel_error)) out.back()["froxel_error"] = r.froxel_error;
+      if (!a.json) {
+        std::printf("%-18s %-12s %-13s %10.1f %7zu %12.2f", r.scene.c_str(), r.method.c_str(), r.stage.c_str(), m, r.ms.size(), ns);
+        if (!std::isnan(r.froxel_error)) std::printf("  (froxel composite %.2f%% off)", 100.0 * r.froxel_error);
+        std::printf("\n");
+      }
       std::fflush(stdout);
     }
   if (a.json) std::cout << out.dump(2) << "\n";
@@ -162,7 +192,7 @@ Command add_bench_frame(CLI::App& bench) {
   sub->add_option("--width", a->width, "Image width")->capture_default_str()->check(CLI::Range(1, 16384));
   sub->add_option("--height", a->height, "Image height")->capture_default_str()->check(CLI::Range(1, 16384));
   sub->add_option("--froxels", a->froxels, "Froxel columns across, down and slices")->expected(3)->capture_default_str()->check(CLI::Range(1, 4096));
-  sub->add_flag("--json", a->json, "Print a JSON list of {scene, method, stage, median_ms, frames, items, ns_per_item}");
+  sub->add_flag("--json", a->json, "Print a JSON list of {scene, method, stage, median_ms, frames, items, ns_per_item[, froxel_error]}");
   return {sub, [a] { return run(*a); }};
 }
 
