@@ -2,7 +2,8 @@
 // scene of bench/frame names its method: one solution is prepared, then the camera moves every
 // frame on an orbit around it while the host's floor (y = -1.5) is its depth buffer, and each
 // stage is timed frame by frame: the froxel build (build_froxels, 160 x 90 x 64 by default), the
-// CPU composite of the froxels over the host's colour and depth into the renderer's own image,
+// CPU composite of the froxels over the host's colour and depth into the renderer's own image with
+// the glow of lights in view added per pixel (add_glow, 4 columns by default),
 // reused from frame to frame, and the per-pixel layers (Solution::render with the depth). Medians
 // over the frames; with the per-pixel layers, the froxel composite's relative RMS difference from
 // theirs over the host's floor and sky at frame 0.
@@ -28,6 +29,7 @@ struct FrameArgs {
   std::vector<std::string> stages;  // --stage: these stages only
   int frames = 30, threads = 2, width = 1920, height = 1080;
   std::vector<int> froxels{160, 90, 64};
+  double glow_columns = 4.0;  // FroxelGrid::glow_columns: the glow of lights in view added per pixel
   double stage_seconds = 60.0;  // a stage stops before this many seconds have passed, after 3 frames at least
   bool json = false;
 };
@@ -96,7 +98,8 @@ std::vector<StageRow> run_scene(const std::filesystem::path& file, const FrameAr
   RenderOptions options;
   options.threads = a.threads;
   const Solution solution = prepare(scene, "", options);
-  const FroxelGrid grid{a.froxels[0], a.froxels[1], a.froxels[2]};
+  FroxelGrid grid{a.froxels[0], a.froxels[1], a.froxels[2]};
+  grid.glow_columns = a.glow_columns;
   const Image host = host_colour(floor_depth(scene.camera), a.width, a.height);
   Image composed(a.width, a.height);  // the renderer's own target and froxels, reused frame after frame
   Froxels froxels;
@@ -117,8 +120,9 @@ std::vector<StageRow> run_scene(const std::filesystem::path& file, const FrameAr
                       const std::vector<float> depth = floor_depth(camera);
                       build_froxels(solution, camera, froxels, grid, options);
                       const Stopwatch watch;
-                      composite_froxels(froxels, ConstImageSpan{host.data().data(), a.width, a.height}, depth,
-                                        ImageSpan{composed.data().data(), a.width, a.height}, a.threads);
+                      const ImageSpan target{composed.data().data(), a.width, a.height};
+                      composite_froxels(froxels, ConstImageSpan{host.data().data(), a.width, a.height}, depth, target, a.threads);
+                      add_glow(solution, camera, froxels, depth, target, a.threads);
                       return 1e3 * watch.seconds();
                     }), pixels});
   if (wanted(kStages[2])) {
@@ -132,7 +136,8 @@ std::vector<StageRow> run_scene(const std::filesystem::path& file, const FrameAr
                       if (f == 0) {  // the froxels' composite against the layers', over the host's floor and sky
                         const Image colour = host_colour(depth, a.width, a.height);
                         build_froxels(solution, camera, froxels, grid, options);
-                        const Image froxel = composite_froxels(froxels, colour, depth, a.threads);
+                        Image froxel = composite_froxels(froxels, colour, depth, a.threads);
+                        add_glow(solution, camera, froxels, depth, ImageSpan{froxel.data().data(), a.width, a.height}, a.threads);
                         Image exact(a.width, a.height);
                         for (int y = 0; y < a.height; ++y)
                           for (int x = 0; x < a.width; ++x) exact.set(x, y, r.inscatter->at(x, y) + r.transmittance->at(x, y) * colour.at(x, y));
@@ -192,6 +197,8 @@ Command add_bench_frame(CLI::App& bench) {
   sub->add_option("--width", a->width, "Image width")->capture_default_str()->check(CLI::Range(1, 16384));
   sub->add_option("--height", a->height, "Image height")->capture_default_str()->check(CLI::Range(1, 16384));
   sub->add_option("--froxels", a->froxels, "Froxel columns across, down and slices")->expected(3)->capture_default_str()->check(CLI::Range(1, 4096));
+  sub->add_option("--glow-columns", a->glow_columns, "FroxelGrid::glow_columns: lights' glow within this many columns added per pixel (0: none)")
+      ->capture_default_str()->check(CLI::Range(0.0, 16.0));
   sub->add_flag("--json", a->json, "Print a JSON list of {scene, method, stage, median_ms, frames, items, ns_per_item[, froxel_error]}");
   return {sub, [a] { return run(*a); }};
 }

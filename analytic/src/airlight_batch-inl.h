@@ -131,7 +131,8 @@ HWY_INLINE void SumTails(D d, const float* HWY_RESTRICT table, int na, int ne, f
   s0 = s1 = s2 = hn::Zero(d);
   for (size_t l = 0; l < row.light_count; ++l) {
     const TailLight& light = row.lights[l];
-    const V g = UnitTail(d, table, na, ne, eta_max, hn::LoadU(d, light.t + i), hn::LoadU(d, light.h + i), hn::Set(d, light.sigma_t), at);
+    V g = UnitTail(d, table, na, ne, eta_max, hn::LoadU(d, light.t + i), hn::LoadU(d, light.h + i), hn::Set(d, light.sigma_t), at);
+    if (light.share) g = hn::Mul(g, hn::LoadU(d, light.share + i));
     s0 = hn::MulAdd(hn::Set(d, light.weight[0]), g, s0);
     s1 = hn::MulAdd(hn::Set(d, light.weight[1]), g, s1);
     s2 = hn::MulAdd(hn::Set(d, light.weight[2]), g, s2);

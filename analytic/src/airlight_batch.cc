@@ -80,7 +80,7 @@ void sum_tails_scalar(const AirlightTable& table, const TailRow& row, size_t i, 
   s[0] = s[1] = s[2] = 0.0f;
   for (size_t l = 0; l < row.light_count; ++l) {
     const TailLight& light = row.lights[l];
-    const float g = unit_tail_scalar(table, light.t[i], light.h[i], light.sigma_t, at);
+    const float g = unit_tail_scalar(table, light.t[i], light.h[i], light.sigma_t, at) * (light.share ? light.share[i] : 1.0f);
     for (int c = 0; c < 3; ++c) s[c] += light.weight[c] * g;
   }
 }

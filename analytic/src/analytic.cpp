@@ -244,60 +244,153 @@ class AnalyticSolution final : public MethodSolution {
   // of it (froxels composite it over the host's colour, where that is what matters). The float64
   // kernel setting renders once per distance instead.
   bool render_distances(const View& view, std::span<const double> distances, const RenderOptions& options, DistanceLayers out) const override {
-    if (!scene_.surfaces.empty() || !airlight_ || kernel_ != &add_airlight) return false;
-    for (const auto& light : lights_)
-      if (light.spot()) return false;
+    if (!one_pass()) return false;
+    const double glow = glows(view.camera) ? out.glow_angle : 0.0;
     const auto body = [&](long long y0, long long y1) {
-      for (auto y = static_cast<int>(y0); y < y1; ++y) slices_row(view.camera, y, distances, out);
+      for (auto y = static_cast<int>(y0); y < y1; ++y) slices_row(view.camera, y, distances, glow, out);
     };
     parallel_for(view.camera.height_px, options.threads, 1, [&body](long long y0, long long y1) { body(y0, y1); });
     return true;
   }
 
+  // Per pixel near each point light in view, the share render_distances left out: the light's
+  // in-scatter along the ray to its end times glow_share, by the same kernel (tail_sums at the
+  // ray's entry and end), over the pixels within the glow angle of the light.
+  void add_glow(const View& view, double glow_angle, ImageSpan out, const RenderOptions& options) const override {
+    const Camera& camera = view.camera;
+    if (!one_pass() || !glows(camera)) return;
+    for (size_t l = 0; l < lights_.size(); ++l) {
+      double px, py;
+      if (!camera.film_position(lights_[l].position, px, py)) continue;
+      // The window of pixels within the angle: its radius from the pixels' angle at the light.
+      const Ray a = camera.generate_ray(px, py), b = camera.generate_ray(px + 1.0, py);
+      const double pixel = std::acos(std::clamp(glm::dot(a.direction, b.direction), -1.0, 1.0));
+      if (!(pixel > 0.0)) continue;
+      const double radius = 1.25 * glow_angle / pixel + 2.0;
+      const int x0 = std::clamp(static_cast<int>(std::floor(px - radius)), 0, camera.width_px), x1 = std::clamp(static_cast<int>(std::ceil(px + radius)), 0, camera.width_px);
+      const int y0 = std::clamp(static_cast<int>(std::floor(py - radius)), 0, camera.height_px), y1 = std::clamp(static_cast<int>(std::ceil(py + radius)), 0, camera.height_px);
+      if (x0 >= x1 || y0 >= y1) continue;
+      const auto body = [&](long long r0, long long r1) {
+        for (auto y = static_cast<int>(r0); y < r1; ++y) glow_row(view, l, glow_angle, y, x0, x1, out);
+      };
+      parallel_for(y1 - y0, options.threads, 4, [&body, y0](long long r0, long long r1) { body(y0 + r0, y0 + r1); });
+    }
+  }
+
  private:
-  // render_distances' row y: each ray's stretch and geometry toward each light, then its slices.
-  void slices_row(const Camera& camera, int y, std::span<const double> distances, DistanceLayers out) const {
-    const auto width = static_cast<size_t>(camera.width_px), padded = (width + 15) / 16 * 16;
-    const size_t lights = lights_.size(), evaluations = grey_ ? lights : 3 * lights;
+  // Point lights without surfaces, the SIMD kernel: render_distances' one pass (and add_glow's).
+  bool one_pass() const {
+    if (!scene_.surfaces.empty() || !airlight_ || kernel_ != &add_airlight) return false;
+    return std::none_of(lights_.begin(), lights_.end(), [](const AnalyticLight& light) { return light.spot(); });
+  }
+  // Cameras whose rays leave one eye: a light's glow is about its direction from there.
+  static bool glows(const Camera& camera) {
+    return camera.type == Camera::Type::pinhole || (camera.type == Camera::Type::matrices && camera.projection[2][3] != 0.0);
+  }
+  // The share of a light's in-scatter along a ray that passes psi from its direction (radians)
+  // left to add_glow: 1 within half the glow angle, smoothly 0 at the angle.
+  static double glow_share(double psi, double glow_angle) {
+    if (!(glow_angle > 0.0) || psi >= glow_angle) return 0.0;
+    const double u = std::min(1.0, 2.0 * (glow_angle - psi) / glow_angle);
+    return u * u * (3.0 - 2.0 * u);
+  }
+
+  // One row of rays toward every light (or only light `only`): each ray's stretch [t0, t1] in the
+  // medium, its geometry toward each light in float64 (t and h), and with a glow angle each
+  // light's share per ray (taken, or left: `left`), into the thread's kept scratch; the TailRow
+  // over them.
+  struct RowRays {
+    TailRow row;
+    float *t0, *t1;
+  };
+  RowRays ray_tails(const Ray* rays, size_t count, double glow_angle, size_t only, bool left) const {
+    const size_t padded = (count + 15) / 16 * 16;
+    const size_t lights = lights_.size();
     // Per thread, kept between frames: a frame allocates nothing once they have grown.
-    thread_local std::vector<Ray> rays;
     thread_local std::vector<float> scratch;
     thread_local std::vector<TailLight> tails;
-    rays.resize(width);
-    scratch.assign((5 + 2 * lights) * padded, 0.0f);
+    scratch.assign((5 + 3 * lights) * padded, 0.0f);
     tails.clear();
     float* const t0 = scratch.data();
     float* const t1 = t0 + padded;
-    float* const whole[3] = {t1 + padded, t1 + 2 * padded, t1 + 3 * padded};
-    float* const geometry = t1 + 4 * padded;  // per light: t, then h
-    camera.row_rays(y, rays.data());
+    float* const whole = t1 + padded;  // three channels
+    float* const geometry = whole + 3 * padded;  // per light: t, h, share
     const Aabb bounds = medium_->bounds();
-    for (size_t x = 0; x < width; ++x) {
+    for (size_t x = 0; x < count; ++x) {
       const Ray& ray = rays[x];
       double a = 0.0, b = kInfinity;
       if (!bounds.clip(ray, a, b) || !(b > a)) b = a;  // no medium: L_in 0, T 1 everywhere
       t0[x] = static_cast<float>(a), t1[x] = std::isfinite(b) ? static_cast<float>(b) : INFINITY;
       for (size_t l = 0; l < lights; ++l) {
+        if (only < lights && l != only) continue;
         const Vec3 to_light = lights_[l].position - ray.origin;
-        const double t = glm::dot(to_light, ray.direction);
-        geometry[2 * l * padded + x] = static_cast<float>(t);
-        geometry[(2 * l + 1) * padded + x] = static_cast<float>(glm::length(to_light - t * ray.direction));
+        const double t = glm::dot(to_light, ray.direction), h = glm::length(to_light - t * ray.direction);
+        float* g = geometry + 3 * l * padded;
+        g[x] = static_cast<float>(t), g[padded + x] = static_cast<float>(h);
+        const double share = glow_share(std::atan2(h, t), glow_angle);
+        g[2 * padded + x] = static_cast<float>(left ? share : 1.0 - share);
       }
     }
-    for (size_t l = 0; l < lights; ++l)
+    for (size_t l = 0; l < lights; ++l) {
+      if (only < lights && l != only) continue;
+      const float* g = geometry + 3 * l * padded;
+      const bool whole_light = !left && std::all_of(g + 2 * padded, g + 2 * padded + count, [](float s) { return s == 1.0f; });
       for (int c = 0; c < (grey_ ? 1 : 3); ++c) {
-        TailLight tail{geometry + 2 * l * padded, geometry + (2 * l + 1) * padded, static_cast<float>(sigma_t_[c]), {}};
+        TailLight tail{g, g + padded, static_cast<float>(sigma_t_[c]), {}, whole_light || glow_angle == 0.0 ? nullptr : g + 2 * padded};
         for (int e = 0; e < 3; ++e)
           if (grey_ || e == c) tail.weight[e] = static_cast<float>(sigma_s_[e] * lights_[l].intensity[e]);
         tails.push_back(tail);
       }
-    TailRow row{tails.data(), evaluations, t0, t1, {whole[0], whole[1], whole[2]}, {}, width};
+    }
+    TailRow row{tails.data(), tails.size(), t0, t1, {whole, whole + padded, whole + 2 * padded}, {}, count};
     for (int c = 0; c < 3; ++c) row.sigma_t[c] = static_cast<float>(sigma_t_[c]);
-    tail_sums(table_, row, t0, whole);
+    return {row, t0, t1};
+  }
+
+  // render_distances' row y: the row's rays, then its slices.
+  void slices_row(const Camera& camera, int y, std::span<const double> distances, double glow_angle, DistanceLayers out) const {
+    const auto width = static_cast<size_t>(camera.width_px);
+    thread_local std::vector<Ray> rays;
+    rays.resize(width);
+    camera.row_rays(y, rays.data());
+    const RowRays r = ray_tails(rays.data(), width, glow_angle, lights_.size(), false);
+    float* const whole[3] = {const_cast<float*>(r.row.whole[0]), const_cast<float*>(r.row.whole[1]), const_cast<float*>(r.row.whole[2])};
+    tail_sums(table_, r.row, r.t0, whole);
     const size_t rays_per_slice = width * static_cast<size_t>(camera.height_px), first = static_cast<size_t>(y) * width;
     for (size_t k = 0; k < distances.size(); ++k) {
       const size_t at = k * rays_per_slice + first;
-      airlight_slice(table_, row, static_cast<float>(distances[k]), &out.inscatter[at].x, &out.transmittance[at].x);
+      airlight_slice(table_, r.row, static_cast<float>(distances[k]), &out.inscatter[at].x, &out.transmittance[at].x);
+    }
+  }
+
+  // add_glow's pixels [x0, x1) of row y for light l: L_in = share (S(t0) - T(end) S(end)) per
+  // channel, S the light's tails, `end` the ray's end in the medium (the view's depth or t1).
+  void glow_row(const View& view, size_t l, double glow_angle, int y, int x0, int x1, ImageSpan out) const {
+    const auto count = static_cast<size_t>(x1 - x0), padded = (count + 15) / 16 * 16;
+    thread_local std::vector<Ray> rays;
+    thread_local std::vector<float> ends, at_end;
+    rays.resize(count), ends.assign(padded, 0.0f), at_end.assign(3 * padded, 0.0f);  // ends: the rays' ends in the medium
+    view.camera.row_rays(y, x0, x1, rays.data());
+    const RowRays r = ray_tails(rays.data(), count, glow_angle, l, true);
+    for (size_t i = 0; i < count; ++i) {
+      const double depth = view.max_distance(x0 + static_cast<int>(i), y);
+      ends[i] = std::min(r.t1[i], std::isfinite(depth) ? static_cast<float>(depth) : INFINITY);
+    }
+    float* const whole[3] = {const_cast<float*>(r.row.whole[0]), const_cast<float*>(r.row.whole[1]), const_cast<float*>(r.row.whole[2])};
+    float* const sums[3] = {at_end.data(), at_end.data() + padded, at_end.data() + 2 * padded};
+    tail_sums(table_, r.row, r.t0, whole);
+    // A ray without end in unbounded fog takes all of S(t0): its tails at the entry stand in.
+    thread_local std::vector<float> at;
+    at.assign(padded, 0.0f);
+    for (size_t i = 0; i < count; ++i) at[i] = std::isfinite(ends[i]) ? std::max(ends[i], r.t0[i]) : r.t0[i];
+    tail_sums(table_, r.row, at.data(), sums);
+    for (size_t i = 0; i < count; ++i) {
+      if (!(ends[i] > r.t0[i])) continue;
+      float* pixel = out.pixel(x0 + static_cast<int>(i), y);
+      for (int c = 0; c < 3; ++c) {
+        const double T = std::isfinite(ends[i]) ? std::exp(-sigma_t_[c] * static_cast<double>(ends[i] - r.t0[i])) : 0.0;
+        pixel[c] += static_cast<float>(std::max(0.0, static_cast<double>(whole[c][i]) - T * static_cast<double>(sums[c][i])));
+      }
     }
   }
 

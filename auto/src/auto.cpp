@@ -60,6 +60,9 @@ class AutoSolution final : public MethodSolution {
   bool render_distances(const View& view, std::span<const double> distances, const RenderOptions& options, DistanceLayers out) const override {
     return chosen_.method_solution().render_distances(view, distances, options, out);
   }
+  void add_glow(const View& view, double glow_angle, ImageSpan out, const RenderOptions& options) const override {
+    chosen_.method_solution().add_glow(view, glow_angle, out, options);
+  }
   Rgb transmittance(size_t light, const Vec3& x) const override { return chosen_.transmittance(light, x); }
   Rgb fluence(const Vec3& x) const override { return chosen_.fluence(x); }
   Rgb inscattered(const Vec3& x, const Vec3& w) const override { return chosen_.inscattered(x, w); }

@@ -79,6 +79,29 @@ Ray Camera::generate_ray(double px, double py) const {
   return ray;
 }
 
+bool Camera::film_position(const Vec3& point, double& px, double& py) const {
+  if (type == Type::matrices) {
+    if (projection[2][3] == 0.0) return false;  // orthographic
+    const glm::dvec4 clip = projection * (view * glm::dvec4(point, 1.0));
+    if (!(clip.w > 0.0)) return false;
+    px = 0.5 * (clip.x / clip.w + 1.0) * width_px, py = 0.5 * (1.0 - clip.y / clip.w) * height_px;
+    return true;
+  }
+  if (type != Type::pinhole) return false;
+  // row_rays_at's frame, inverted.
+  Vec3 forward = look_at - position, right;
+  make_unit(forward);
+  right = glm::cross(forward, up);
+  make_unit(right);
+  const Vec3 true_up = glm::cross(right, forward), d = point - position;
+  const double z = glm::dot(d, forward);
+  if (!(z > 0.0)) return false;
+  const double tan_half = std::tan(0.5 * fov_y_deg * kPi / 180.0), aspect = static_cast<double>(width_px) / height_px;
+  px = 0.5 * (glm::dot(d, right) / (z * aspect * tan_half) + 1.0) * width_px;
+  py = 0.5 * (1.0 - glm::dot(d, true_up) / (z * tan_half)) * height_px;
+  return true;
+}
+
 void Camera::row_rays_at(double py, const double* px, int count, Ray* out) const {
   if (type == Type::rays || type == Type::matrices) {
     for (int i = 0; i < count; ++i) out[i] = generate_ray(px[i], py);
@@ -102,12 +125,12 @@ void Camera::row_rays_at(double py, const double* px, int count, Ray* out) const
   for (int i = 0; i < count; ++i) out[i] = {position, glm::normalize(centre + right * ((2.0 * px[i] / width_px - 1.0) * aspect * tan_half))};
 }
 
-void Camera::row_rays(int y, Ray* out) const {
+void Camera::row_rays(int y, int x0, int x1, Ray* out) const {
   std::array<double, 256> px;  // pixel centres a run at a time: a frame's rows allocate nothing
-  for (int x0 = 0; x0 < width_px; x0 += static_cast<int>(px.size())) {
-    const int count = std::min(static_cast<int>(px.size()), width_px - x0);
-    for (int i = 0; i < count; ++i) px[static_cast<size_t>(i)] = x0 + i + 0.5;
-    row_rays_at(y + 0.5, px.data(), count, out + x0);
+  for (int from = x0; from < x1; from += static_cast<int>(px.size())) {
+    const int count = std::min(static_cast<int>(px.size()), x1 - from);
+    for (int i = 0; i < count; ++i) px[static_cast<size_t>(i)] = from + i + 0.5;
+    row_rays_at(y + 0.5, px.data(), count, out + (from - x0));
   }
 }
 

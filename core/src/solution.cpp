@@ -186,6 +186,22 @@ void Solution::render_distances(const View& view, std::span<const double> distan
   }
 }
 
+void Solution::add_glow(const View& view, double glow_angle, ImageSpan out, const RenderOptions& options) const {
+  check_span(out, "out");
+  // The depth's size only: its values are read near the lights alone, where a NaN or negative
+  // distance ends the ray before the medium (a full check would cost a frame a millisecond).
+  const size_t pixels = static_cast<size_t>(view.camera.width_px) * static_cast<size_t>(view.camera.height_px);
+  if (!view.depth.empty() && view.depth.size() != pixels)
+    throw Error("view.depth", to_text(view.depth.size()) + " values", to_text(pixels) + " (width_px x height_px), one distance per pixel");
+  if (out.width != view.camera.width_px || out.height != view.camera.height_px)
+    throw Error("out", to_text(out.width) + " x " + to_text(out.height), "the view's size, " + to_text(view.camera.width_px) + " x " + to_text(view.camera.height_px));
+  if (!(glow_angle >= 0.0 && glow_angle < 1.0)) throw Error("glow_angle", to_text(glow_angle), "an angle in [0, 1) radians");
+  if (glow_angle == 0.0) return;
+  const State& s = *state_;
+  const RenderOptions o = s.for_render(options);
+  s.naming_lights([&] { s.solution->add_glow(view, glow_angle, out, o); });
+}
+
 UpdateReport Solution::update(const SceneChange& change, const RenderOptions& options) {
   State& s = *state_;
   const Stopwatch watch;

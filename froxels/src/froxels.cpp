@@ -45,6 +45,7 @@ void check(const FroxelGrid& g) {
     if (n < 1 || n > 4096) throw Error(std::string("froxels.") + name, std::to_string(n), "an integer in [1, 4096]");
   if (!(g.far > 0.0 && std::isfinite(g.far))) throw Error("froxels.far", to_text(g.far), "a finite distance > 0");
   if (!(g.near > 0.0 && g.near < g.far)) throw Error("froxels.near", to_text(g.near), "a distance in (0, far = " + to_text(g.far) + ")");
+  if (!(g.glow_columns >= 0.0 && g.glow_columns <= 16.0)) throw Error("froxels.glow_columns", to_text(g.glow_columns), "a number of columns in [0, 16]");
 }
 
 }  // namespace
@@ -97,8 +98,16 @@ void build_froxels(const Solution& solution, const Camera& camera, Froxels& out,
   out.transmittance.resize(froxels);
   std::array<double, 4096> boundaries;
   for (int k = 0; k < grid.nz; ++k) boundaries[static_cast<size_t>(k)] = grid.boundary(k);
-  solution.render_distances(View{column_camera(camera, grid.nx, grid.ny)}, std::span<const double>(boundaries.data(), static_cast<size_t>(grid.nz)),
-                            DistanceLayers{out.inscatter, out.transmittance}, options);
+  const Camera columns = column_camera(camera, grid.nx, grid.ny);
+  // The glow angle: glow_columns times the angle between the middle column and its neighbour.
+  out.glow_angle = 0.0;
+  if (grid.glow_columns > 0.0) {
+    const double i = 0.5 * grid.nx, j = 0.5 * grid.ny;
+    const double cos_pitch = glm::dot(columns.generate_ray(i, j).direction, columns.generate_ray(i + 1.0, j).direction);
+    out.glow_angle = std::min(grid.glow_columns * std::acos(std::clamp(cos_pitch, -1.0, 1.0)), 0.5);
+  }
+  solution.render_distances(View{columns}, std::span<const double>(boundaries.data(), static_cast<size_t>(grid.nz)),
+                            DistanceLayers{out.inscatter, out.transmittance, out.glow_angle}, options);
 }
 
 Froxels build_froxels(const Solution& solution, const Camera& camera, const FroxelGrid& grid, const RenderOptions& options) {
@@ -129,6 +138,12 @@ void composite_froxels(const Froxels& froxels, ConstImageSpan colour, std::span<
   };
   // A body of one reference: std::function keeps it without allocating.
   parallel_for(h, threads, 8, [&composite_rows](long long y0, long long y1) { composite_rows(y0, y1); });
+}
+
+void add_glow(const Solution& solution, const Camera& camera, const Froxels& froxels, std::span<const float> depth, ImageSpan out, int threads) {
+  if (froxels.glow_angle == 0.0) return;
+  RenderOptions options{threads, nullptr, {}, {}, false, 0, nullptr};  // settings null: nothing allocated
+  solution.add_glow(View{camera, depth}, froxels.glow_angle, out, options);
 }
 
 Image composite_froxels(const Froxels& froxels, const Image& host_colour, std::span<const float> depth, int threads) {

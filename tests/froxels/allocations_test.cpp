@@ -1,7 +1,8 @@
 // Heap allocations in a frame (issue 51: after the first frame, a frame allocates nothing). This
 // program replaces the global operator new to count every allocation made through it, on any
-// thread. The CPU composite into the caller's memory allocates nothing, and neither does the
-// froxel build of analytic or propagation once each thread's kept row buffers have grown.
+// thread. The CPU composite into the caller's memory allocates nothing, and neither do the
+// froxel build of analytic or propagation and the glow of lights in view once each thread's kept
+// row buffers have grown.
 #include <haze/froxels/froxels.h>
 
 #include <gtest/gtest.h>
@@ -46,11 +47,14 @@ TEST(FrameAllocations, TheCompositeIntoCallerMemoryAllocatesNothing) {
   }
 }
 
-// The froxel build into the same Froxels, the camera moving every frame: after a few frames (each
-// thread's kept row buffers grown), the analytic and propagation paths allocate nothing.
+// The froxel build into the same Froxels, the camera moving every frame, a light in view and its
+// glow added per pixel: after a few frames (each thread's kept row buffers grown), the analytic
+// and propagation paths allocate nothing.
 TEST(FrameAllocations, TheFroxelBuildAllocatesNothingAfterTheFirstFrames) {
-  const Scene scene = testing::fog_box(64, 36);
-  const FroxelGrid grid{16, 9, 12, 0.1, 20.0};
+  const Scene scene = testing::fog_box(64, 36, Vec3(0.1, -0.1, 0.4));
+  const FroxelGrid grid{16, 9, 12, 0.1, 20.0, 4.0};
+  std::vector<float> out(3 * 64 * 36, 0.0f);
+  const std::vector<float> depth(64 * 36, 3.0f);
   for (const char* method : {"analytic", "propagation"}) {
     RenderOptions prepared;
     if (std::string(method) == "propagation") prepared.settings = {{"resolution", 16}};
@@ -63,6 +67,7 @@ TEST(FrameAllocations, TheFroxelBuildAllocatesNothingAfterTheFirstFrames) {
       const auto frame = [&](int f) {
         camera.position.x = 0.2 + 0.05 * f;
         build_froxels(solution, camera, froxels, grid, options);
+        add_glow(solution, camera, froxels, depth, ImageSpan{out.data(), 64, 36}, threads);
       };
       for (int f = 0; f < 4; ++f) frame(f);
       const long long before = allocations.load();

@@ -98,6 +98,38 @@ TEST(Froxels, CompositeConvergesToThePerPixelLayers) {
   EXPECT_LT(previous, 0.02);
 }
 
+// A point light in view: its glow is narrower than a column, and the froxels alone are far off
+// near it; with glow_columns the froxels leave each light's glow out and add_glow adds it per
+// pixel in closed form.
+TEST(Froxels, AddGlowMendsALightInView) {
+  for (const bool unbounded : {false, true}) {
+  Scene scene = fog_box(96, 64, Vec3(0.1, -0.1, 0.4));
+  if (unbounded) scene.medium->bounds = Aabb{};  // the sky's rays never end
+  const std::vector<float> depth = floor_depth(scene.camera);
+  const Solution solution = prepare(scene, "analytic");
+  const RenderResult exact = solution.render(View{scene.camera, depth, true});
+  Image host(96, 64);
+  for (int y = 0; y < 64; ++y)
+    for (int x = 0; x < 96; ++x) host.set(x, y, std::isinf(depth[static_cast<size_t>(y * 96 + x)]) ? Rgb(0.05, 0.1, 0.2) : Rgb(0.3, 0.25, 0.2));
+  Image truth(96, 64);
+  for (int y = 0; y < 64; ++y)
+    for (int x = 0; x < 96; ++x) truth.set(x, y, exact.inscatter->at(x, y) + exact.transmittance->at(x, y) * host.at(x, y));
+  double errors[2];
+  for (int glow : {0, 1}) {
+    FroxelGrid grid{24, 16, 32, 0.5, 20.0};
+    grid.glow_columns = glow ? 4.0 : 0.0;
+    const Froxels froxels = build_froxels(solution, scene.camera, grid);
+    Image composite = composite_froxels(froxels, host, depth);
+    add_glow(solution, scene.camera, froxels, depth, ImageSpan{composite.data().data(), 96, 64});
+    errors[glow] = relative_rmse(composite, truth);
+  }
+  std::printf("a light in view (%s), froxels 24 x 16 x 32 for 96 x 64 pixels: composite %.2e off, with the glow added %.2e\n",
+              unbounded ? "unbounded fog" : "fog box", errors[0], errors[1]);
+  EXPECT_GT(errors[0], 0.2);
+  EXPECT_LT(errors[1], 0.05);
+  }
+}
+
 // The composite into the caller's memory (float32, rows over threads, RGBA rows with padding, in
 // place over the colour) against Froxels::sample's float64 lookup, pixel by pixel, over depths
 // before near, inside every slice, past far and the background; and for a single column and slice.
@@ -175,6 +207,16 @@ TEST(Froxels, BadGridsAreClearErrors) {
   EXPECT_EQ(field({8, 8, 5000, 0.1, 10.0}), "froxels.nz");
   EXPECT_EQ(field({8, 8, 8, 10.0, 10.0}), "froxels.near");
   EXPECT_EQ(field({8, 8, 8, 0.1, kInfinity}), "froxels.far");
+  EXPECT_EQ(field({8, 8, 8, 0.1, 10.0, -1.0}), "froxels.glow_columns");
+  // add_glow's output must be the view's size.
+  const Froxels froxels = build_froxels(solution, scene.camera, FroxelGrid{8, 8, 8, 0.1, 10.0, 4.0});
+  std::vector<float> small(3 * 4 * 4);
+  try {
+    add_glow(solution, scene.camera, froxels, {}, ImageSpan{small.data(), 4, 4});
+    ADD_FAILURE() << "no error for a 4 x 4 output";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.field(), "out");
+  }
 }
 
 }  // namespace

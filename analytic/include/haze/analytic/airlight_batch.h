@@ -33,6 +33,7 @@ struct TailLight {
   const float* h = nullptr;  // per ray: the light's distance from the ray's line
   float sigma_t = 0.0f;
   float weight[3] = {};      // sigma_s I per channel (zero outside its channel in a coloured medium)
+  const float* share = nullptr;  // per ray: the share of the light taken (null: all of it)
 };
 struct TailRow {
   const TailLight* lights = nullptr;

@@ -47,7 +47,13 @@ struct Camera {
   Ray generate_ray(double px, double py) const;
   Ray pixel_ray(int x, int y) const { return generate_ray(x + 0.5, y + 0.5); }
   // The rays of row y's pixels, out[x] = pixel_ray(x, y) (the camera's frame made once per row).
-  void row_rays(int y, Ray* out) const;
+  void row_rays(int y, Ray* out) const { row_rays(y, 0, width_px, out); }
+  // Those of pixels [x0, x1) of row y, out[x - x0].
+  void row_rays(int y, int x0, int x1, Ray* out) const;
+  // The film position (px, py) whose ray passes through `point` (generate_ray's inverse), for a
+  // pinhole camera or a host's perspective matrices; false for a point behind the eye and for
+  // other cameras.
+  bool film_position(const Vec3& point, double& px, double& py) const;
   bool operator==(const Camera&) const = default;
 
  private:

@@ -173,6 +173,10 @@ class Solution {
   // path where it has one (analytic with point lights and no surfaces; propagation), else one
   // layered render per distance. What build_froxels (froxels.h) calls.
   void render_distances(const View& view, std::span<const double> distances, DistanceLayers out, const RenderOptions& options = {}) const;
+  // Adds to `out` (float32 RGB or RGBA rows of the view's size) what render_distances left out
+  // when asked to for `glow_angle` (DistanceLayers::glow_angle): the glow of the point lights in
+  // view, per pixel, along each ray up to view.depth (froxels.h's add_glow calls it).
+  void add_glow(const View& view, double glow_angle, ImageSpan out, const RenderOptions& options = {}) const;
   // Redoes only what the change reaches (the method says what in the report); a change nothing
   // can be reused for prepares again (report.rebuilt). The scene's camera may change freely: it
   // is not part of a solution. A change that throws haze::Error (checked before anything is

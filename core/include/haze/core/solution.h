@@ -90,6 +90,10 @@ struct PixelLayers {
 // [k * rays + ray] for distance k and ray = y * width_px + x (Solution::render_distances).
 struct DistanceLayers {
   std::span<Vec3f> inscatter, transmittance;
+  // Where > 0, a method may leave out of these layers each point light's in-scatter near its
+  // direction, within this angle (radians) of it, for MethodSolution::add_glow to add per pixel
+  // (the glow of a light in view is narrower than a froxel column).
+  double glow_angle = 0.0;
 };
 
 struct RenderResult {
@@ -143,6 +147,10 @@ class MethodSolution {
   // (every entry written; its size checked by the caller), in one pass; false where the method has
   // no such path for this scene (Solution::render_distances then renders once per distance).
   virtual bool render_distances(const View&, std::span<const double>, const RenderOptions&, DistanceLayers /*out*/) const { return false; }
+  // Adds to `out` (the view's pixels) what render_distances left out for `glow_angle`: per pixel,
+  // the near share of each point light's in-scatter along the ray up to its end (view.depth or
+  // the medium's). A method that leaves nothing out adds nothing, the default.
+  virtual void add_glow(const View&, double /*glow_angle*/, ImageSpan /*out*/, const RenderOptions&) const {}
   // Applies `change` in place, given `scene` with the change applied, and reports what it redid;
   // std::nullopt when nothing can be reused (the Solution then prepares again). The default.
   virtual std::optional<UpdateReport> update(const Scene& scene, const SceneChange& change, const RenderOptions& options);

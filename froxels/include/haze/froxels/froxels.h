@@ -23,6 +23,11 @@ namespace haze {
 struct FroxelGrid {
   int nx = 160, ny = 90, nz = 64;
   double near = 0.1, far = 100.0;
+  // 0: the froxels hold every light whole. Else each point light's glow, its in-scatter along the
+  // rays within this many columns' angle of its direction, is left to add_glow per pixel, where
+  // the method can (analytic with point lights; others hold it whole): a light in view glows
+  // narrower than a column. In [0, 16]; 4 suits 1080p.
+  double glow_columns = 0.0;
   // Slice k's far boundary (k = -1: near).
   double boundary(int k) const;
   // The continuous slice coordinate of distance d: k at boundary(k), -1 at near and before.
@@ -31,6 +36,7 @@ struct FroxelGrid {
 
 struct Froxels {
   FroxelGrid grid;
+  double glow_angle = 0.0;  // grid.glow_columns as an angle from the eye (radians), what add_glow adds
   // [(k * ny + j) * nx + i]: L_in and T along column (i, j)'s ray from the camera to boundary(k).
   // Column (i, j) is the camera's ray through film position ((i + 0.5) W / nx, (j + 0.5) H / ny)
   // of its W x H image, rows top to bottom.
@@ -61,6 +67,12 @@ void build_froxels(const Solution& solution, const Camera& camera, Froxels& out,
 void composite_froxels(const Froxels& froxels, ConstImageSpan colour, std::span<const float> depth, ImageSpan out, int threads = 0);
 // The same into a new image.
 Image composite_froxels(const Froxels& froxels, const Image& host_colour, std::span<const float> depth, int threads = 0);
+
+// Adds to the composite `out` what the froxels left out for grid.glow_columns: per pixel near
+// each point light in view, its glow along the pixel's ray up to its depth, in closed form
+// (Solution::add_glow; docs/HOST.md). `camera` and `solution` are the froxels'; nothing where
+// glow_columns is 0 or the method holds every light whole. The GL pass does not add it yet.
+void add_glow(const Solution& solution, const Camera& camera, const Froxels& froxels, std::span<const float> depth, ImageSpan out, int threads = 0);
 
 }  // namespace haze
 
