@@ -2,8 +2,9 @@
 // scene of bench/frame names its method: one solution is prepared, then the camera moves every
 // frame on an orbit around it while the host's floor (y = -1.5) is its depth buffer, and each
 // stage is timed frame by frame: the froxel build (build_froxels, 160 x 90 x 64 by default), the
-// CPU composite of the froxels over the host's colour and depth into the renderer's own image with
-// the glow of lights in view added per pixel (add_glow, 4 columns by default),
+// CPU composite of the froxels over the host's depth into the renderer's colour of the frame, in
+// place (written just before, as a renderer's is), with the glow of lights in view added per
+// pixel (add_glow, 4 columns by default),
 // reused from frame to frame, and the per-pixel layers (Solution::render with the depth). Medians
 // over the frames; with the per-pixel layers, the froxel composite's relative RMS difference from
 // theirs over the host's floor and sky at frame 0.
@@ -101,7 +102,7 @@ std::vector<StageRow> run_scene(const std::filesystem::path& file, const FrameAr
   FroxelGrid grid{a.froxels[0], a.froxels[1], a.froxels[2]};
   grid.glow_columns = a.glow_columns;
   const Image host = host_colour(floor_depth(scene.camera), a.width, a.height);
-  Image composed(a.width, a.height);  // the renderer's own target and froxels, reused frame after frame
+  Image composed(a.width, a.height);  // the renderer's colour buffer and froxels, reused frame after frame
   Froxels froxels;
   const auto wanted = [&](const std::string& stage) { return a.stages.empty() || std::count(a.stages.begin(), a.stages.end(), stage) > 0; };
   std::vector<StageRow> rows;
@@ -119,9 +120,10 @@ std::vector<StageRow> run_scene(const std::filesystem::path& file, const FrameAr
                       const Camera camera = pose(scene.camera, f);
                       const std::vector<float> depth = floor_depth(camera);
                       build_froxels(solution, camera, froxels, grid, options);
+                      composed.data() = host.data();  // the renderer's colour of this frame, composited in place
                       const Stopwatch watch;
                       const ImageSpan target{composed.data().data(), a.width, a.height};
-                      composite_froxels(froxels, ConstImageSpan{host.data().data(), a.width, a.height}, depth, target, a.threads);
+                      composite_froxels(froxels, ConstImageSpan{composed.data().data(), a.width, a.height}, depth, target, a.threads);
                       add_glow(solution, camera, froxels, depth, target, a.threads);
                       return 1e3 * watch.seconds();
                     }), pixels});

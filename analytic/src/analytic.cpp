@@ -267,11 +267,15 @@ class AnalyticSolution final : public MethodSolution {
       const double pixel = std::acos(std::clamp(glm::dot(a.direction, b.direction), -1.0, 1.0));
       if (!(pixel > 0.0)) continue;
       const double radius = 1.25 * glow_angle / pixel + 2.0;
-      const int x0 = std::clamp(static_cast<int>(std::floor(px - radius)), 0, camera.width_px), x1 = std::clamp(static_cast<int>(std::ceil(px + radius)), 0, camera.width_px);
       const int y0 = std::clamp(static_cast<int>(std::floor(py - radius)), 0, camera.height_px), y1 = std::clamp(static_cast<int>(std::ceil(py + radius)), 0, camera.height_px);
-      if (x0 >= x1 || y0 >= y1) continue;
+      if (y0 >= y1) continue;
       const auto body = [&](long long r0, long long r1) {
-        for (auto y = static_cast<int>(r0); y < r1; ++y) glow_row(view, l, glow_angle, y, x0, x1, out);
+        for (auto y = static_cast<int>(r0); y < r1; ++y) {  // the row's chord of the window's circle
+          const double dy = y + 0.5 - py, half = std::sqrt(std::max(0.0, radius * radius - dy * dy));
+          const int x0 = std::clamp(static_cast<int>(std::floor(px - half)), 0, camera.width_px);
+          const int x1 = std::clamp(static_cast<int>(std::ceil(px + half)), 0, camera.width_px);
+          if (x0 < x1) glow_row(view, l, glow_angle, y, x0, x1, out);
+        }
       };
       parallel_for(y1 - y0, options.threads, 4, [&body, y0](long long r0, long long r1) { body(y0 + r0, y0 + r1); });
     }
