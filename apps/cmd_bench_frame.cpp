@@ -5,7 +5,8 @@
 // CPU composite of the froxels over the host's depth into the renderer's colour of the frame, in
 // place (written just before, as a renderer's is), with the glow of lights in view added per
 // pixel (add_glow, 4 columns by default),
-// reused from frame to frame, and the per-pixel layers (Solution::render with the depth). Medians
+// reused from frame to frame, and the per-pixel layers (Solution::render_layers with the depth, into
+// the renderer's buffers, reused). Medians
 // over the frames; with the per-pixel layers, the froxel composite's relative RMS difference from
 // theirs over the host's floor and sky at frame 0.
 #include "commands.h"
@@ -129,11 +130,14 @@ std::vector<StageRow> run_scene(const std::filesystem::path& file, const FrameAr
                     }), pixels});
   if (wanted(kStages[2])) {
     double error = std::numeric_limits<double>::quiet_NaN();
+    Image inscatter(a.width, a.height), transmittance(a.width, a.height);  // the renderer's layer buffers, reused
     rows.push_back({name, method, kStages[2], time_frames(a, [&](int f) {
                       const Camera camera = pose(scene.camera, f);
                       const std::vector<float> depth = floor_depth(camera);
                       const Stopwatch watch;
-                      const RenderResult r = solution.render(View{camera, depth, true}, options);
+                      solution.render_layers(View{camera, depth}, {ImageSpan{inscatter.data().data(), a.width, a.height},
+                                                                   ImageSpan{transmittance.data().data(), a.width, a.height}, ImageSpan{}},
+                                             options);
                       const double ms = 1e3 * watch.seconds();
                       if (f == 0) {  // the froxels' composite against the layers', over the host's floor and sky
                         const Image colour = host_colour(depth, a.width, a.height);
@@ -142,7 +146,7 @@ std::vector<StageRow> run_scene(const std::filesystem::path& file, const FrameAr
                         add_glow(solution, camera, froxels, depth, ImageSpan{froxel.data().data(), a.width, a.height}, a.threads);
                         Image exact(a.width, a.height);
                         for (int y = 0; y < a.height; ++y)
-                          for (int x = 0; x < a.width; ++x) exact.set(x, y, r.inscatter->at(x, y) + r.transmittance->at(x, y) * colour.at(x, y));
+                          for (int x = 0; x < a.width; ++x) exact.set(x, y, inscatter.at(x, y) + transmittance.at(x, y) * colour.at(x, y));
                         error = relative_rmse(froxel, exact);
                       }
                       return ms;

@@ -253,6 +253,19 @@ class AnalyticSolution final : public MethodSolution {
     return true;
   }
 
+  // Per pixel, a row of rays in SIMD lanes: L_in = sum of sigma_s I (g(t0) - T g(end)) to each ray's
+  // end, the tails' form of render_distances. Where T g(end) is above 3/4 of g(t0) the difference
+  // would lose more than the table's 1e-3 to cancellation (short stretches): those pixels take the
+  // float64 segment path render() takes for them.
+  bool render_layers(const View& view, LayerSpans out, const RenderOptions& options) const override {
+    if (!one_pass()) return false;
+    const auto body = [&](long long y0, long long y1) {
+      for (auto y = static_cast<int>(y0); y < y1; ++y) layers_row(view, y, out);
+    };
+    parallel_for(view.camera.height_px, options.threads, 1, [&body](long long y0, long long y1) { body(y0, y1); });
+    return true;
+  }
+
   // Per pixel near each point light in view, the share render_distances left out: the light's
   // in-scatter along the ray to its end times glow_share, by the same kernel (tail_sums at the
   // ray's entry and end), over the pixels within the glow angle of the light.
@@ -331,7 +344,7 @@ class AnalyticSolution final : public MethodSolution {
         const double t = glm::dot(to_light, ray.direction), h = glm::length(to_light - t * ray.direction);
         float* g = geometry + 3 * l * padded;
         g[x] = static_cast<float>(t), g[padded + x] = static_cast<float>(h);
-        const double share = glow_share(std::atan2(h, t), glow_angle);
+        const double share = glow_angle > 0.0 ? glow_share(std::atan2(h, t), glow_angle) : 0.0;
         g[2 * padded + x] = static_cast<float>(left ? share : 1.0 - share);
       }
     }
@@ -365,6 +378,71 @@ class AnalyticSolution final : public MethodSolution {
       const size_t at = k * rays_per_slice + first;
       airlight_slice(table_, r.row, static_cast<float>(distances[k]), &out.inscatter[at].x, &out.transmittance[at].x);
     }
+  }
+
+  // render_layers' row y.
+  void layers_row(const View& view, int y, LayerSpans out) const {
+    const Camera& camera = view.camera;
+    const auto width = static_cast<size_t>(camera.width_px), padded = (width + 15) / 16 * 16;
+    thread_local std::vector<Ray> rays;
+    thread_local std::vector<float> ends, at, at_end;
+    rays.resize(width), ends.assign(padded, 0.0f), at.assign(padded, 0.0f), at_end.assign(3 * padded, 0.0f);
+    camera.row_rays(y, rays.data());
+    const RowRays r = ray_tails(rays.data(), width, 0.0, lights_.size(), false);
+    float* const whole[3] = {const_cast<float*>(r.row.whole[0]), const_cast<float*>(r.row.whole[1]), const_cast<float*>(r.row.whole[2])};
+    float* const sums[3] = {at_end.data(), at_end.data() + padded, at_end.data() + 2 * padded};
+    tail_sums(table_, r.row, r.t0, whole);
+    for (size_t x = 0; x < width; ++x) {
+      const double depth = view.max_distance(static_cast<int>(x), y);
+      ends[x] = std::min(r.t1[x], std::isfinite(depth) ? static_cast<float>(depth) : INFINITY);
+      at[x] = std::isfinite(ends[x]) ? std::max(ends[x], r.t0[x]) : r.t0[x];  // an endless ray's tails at its entry stand in
+    }
+    tail_sums(table_, r.row, at.data(), sums);
+    for (size_t x = 0; x < width; ++x) {
+      const auto px = static_cast<int>(x);
+      Rgb l(0.0), t(1.0);
+      const double t0 = r.t0[x], end = ends[x];
+      if (end > t0) {
+        bool cancels = false;
+        for (int c = 0; c < 3; ++c) {
+          t[c] = c > 0 && grey_ ? t[0] : std::isfinite(end) ? std::exp(-sigma_t_[c] * (end - t0)) : 0.0;
+          const double far = t[c] * static_cast<double>(sums[c][x]);
+          cancels = cancels || far > 0.75 * static_cast<double>(whole[c][x]);
+          l[c] = std::max(0.0, static_cast<double>(whole[c][x]) - far);
+        }
+        if (cancels) l = exact_airlight(rays[x], t0, end);
+      }
+      float* li = out.inscatter.pixel(px, y);
+      float* ti = out.transmittance.pixel(px, y);
+      for (int c = 0; c < 3; ++c) li[c] = static_cast<float>(l[c]), ti[c] = static_cast<float>(t[c]);
+      if (out.surface.data) {  // the background where nothing ends the ray, else the host's (0)
+        const Rgb surface = std::isinf(view.max_distance(px, y)) ? scene_.background : Rgb(0.0);
+        float* si = out.surface.pixel(px, y);
+        for (int c = 0; c < 3; ++c) si[c] = static_cast<float>(surface[c]);
+      }
+    }
+  }
+
+  // The point lights' airlight along [t0, end] of a ray by the float64 segment path.
+  Rgb exact_airlight(const Ray& ray, double t0, double end) const {
+    const Vec3 o = ray.at(t0);
+    const float ox = static_cast<float>(o.x), oy = static_cast<float>(o.y), oz = static_cast<float>(o.z);
+    const float dx = static_cast<float>(ray.direction.x), dy = static_cast<float>(ray.direction.y), dz = static_cast<float>(ray.direction.z);
+    const float length = std::isfinite(end) ? static_cast<float>(end - t0) : INFINITY;
+    const SegmentBatch segment{&ox, &oy, &oz, &dx, &dy, &dz, &length, 1};
+    Rgb sum(0.0);
+    for (const auto& light : lights_) {
+      const Vec3& p = light.position;
+      for (int c = 0; c < (grey_ ? 1 : 3); ++c) {
+        float v = 0.0f;
+        add_airlight_float64(table_, {static_cast<float>(p.x), static_cast<float>(p.y), static_cast<float>(p.z), static_cast<float>(sigma_t_[c]),
+                                      static_cast<float>(sigma_s_[c]), grey_ ? 1.0f : static_cast<float>(light.intensity[c])},
+                             segment, &v);
+        if (grey_) sum += static_cast<double>(v) * light.intensity;
+        else sum[c] += static_cast<double>(v);
+      }
+    }
+    return sum;
   }
 
   // add_glow's pixels [x0, x1) of row y for light l: L_in = share (S(t0) - T(end) S(end)) per

@@ -60,6 +60,9 @@ class AutoSolution final : public MethodSolution {
   bool render_distances(const View& view, std::span<const double> distances, const RenderOptions& options, DistanceLayers out) const override {
     return chosen_.method_solution().render_distances(view, distances, options, out);
   }
+  bool render_layers(const View& view, LayerSpans out, const RenderOptions& options) const override {
+    return chosen_.method_solution().render_layers(view, out, options);
+  }
   void add_glow(const View& view, double glow_angle, ImageSpan out, const RenderOptions& options) const override {
     chosen_.method_solution().add_glow(view, glow_angle, out, options);
   }

@@ -1,5 +1,7 @@
 #include <haze/core/error.h>
 #include <haze/core/image.h>
+
+#include <string_view>
 #include <haze/core/progress.h>
 
 #include "exr_layout.h"
@@ -26,15 +28,16 @@ Image::Image(int width, int height) {
 }
 
 template <class Float>
-void check_span(const BasicImageSpan<Float>& span, const std::string& field) {
+void check_span(const BasicImageSpan<Float>& span, std::string_view field) {
+  const auto name = [&](const char* part) { return std::string(field) + part; };  // only on an error: a frame's checks allocate nothing
   if (!span.data || span.width < 1 || span.height < 1)
-    throw Error(field, to_text(span.width) + " x " + to_text(span.height) + (span.data ? "" : " without data"), "an image of at least 1 x 1 pixels");
-  if (span.channels != 3 && span.channels != 4) throw Error(field + ".channels", to_text(span.channels), "3 (RGB) or 4 (RGBA)");
+    throw Error(name(""), to_text(span.width) + " x " + to_text(span.height) + (span.data ? "" : " without data"), "an image of at least 1 x 1 pixels");
+  if (span.channels != 3 && span.channels != 4) throw Error(name(".channels"), to_text(span.channels), "3 (RGB) or 4 (RGBA)");
   if (span.stride && span.stride < static_cast<std::size_t>(span.width) * static_cast<std::size_t>(span.channels))
-    throw Error(field + ".stride", to_text(span.stride) + " floats", "at least width x channels = " + to_text(span.width * span.channels));
+    throw Error(name(".stride"), to_text(span.stride) + " floats", "at least width x channels = " + to_text(span.width * span.channels));
 }
-template void check_span(const BasicImageSpan<float>&, const std::string&);
-template void check_span(const BasicImageSpan<const float>&, const std::string&);
+template void check_span(const BasicImageSpan<float>&, std::string_view);
+template void check_span(const BasicImageSpan<const float>&, std::string_view);
 
 Rgb Image::mean() const {
   Rgb sum(0.0);

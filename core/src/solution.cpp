@@ -9,6 +9,7 @@
 #include <haze/core/stopwatch.h>
 
 #include <algorithm>
+#include <string_view>
 
 namespace haze {
 
@@ -157,6 +158,34 @@ RenderResult Solution::render(const View& view, const RenderOptions& options) co
   for (auto& [key, value] : result.stats.items()) stats[key] = std::move(value);
   result.stats = std::move(stats);
   return result;
+}
+
+void Solution::render_layers(const View& view, LayerSpans out, const RenderOptions& options) const {
+  const Camera& camera = view.camera;
+  for (const auto& [name, span] : {std::pair{"out.inscatter", out.inscatter}, std::pair{"out.transmittance", out.transmittance}, std::pair{"out.surface", out.surface}}) {
+    if (span.data == nullptr && std::string_view(name) == "out.surface") continue;
+    check_span(span, name);
+    if (span.width != camera.width_px || span.height != camera.height_px)
+      throw Error(name, to_text(span.width) + " x " + to_text(span.height), "the view's size, " + to_text(camera.width_px) + " x " + to_text(camera.height_px));
+  }
+  const State& s = *state_;
+  check_depth(view);
+  if (!s.solution->renders_layers())
+    throw Error("view", "layers", "a method that renders layers (every built-in method does; " + s.info.name + " does not)");
+  if (s.options.single_view && !(camera == s.scene.camera))
+    throw Error("view.camera", "another camera than the scene's", "the scene's camera for a solution prepared with single_view");
+  const RenderOptions o = s.for_render(options);
+  const View layered{camera, view.depth, true};
+  if (s.naming_lights([&] { return s.solution->render_layers(layered, out, o); })) return;
+  const RenderResult r = render(layered, options);
+  for (int y = 0; y < camera.height_px; ++y)
+    for (int x = 0; x < camera.width_px; ++x)
+      for (const auto& [span, image] : {std::pair{out.inscatter, &*r.inscatter}, std::pair{out.transmittance, &*r.transmittance}, std::pair{out.surface, &*r.surface}}) {
+        if (!span.data) continue;
+        const Rgb v = image->at(x, y);
+        float* p = span.pixel(x, y);
+        p[0] = static_cast<float>(v.r), p[1] = static_cast<float>(v.g), p[2] = static_cast<float>(v.b);
+      }
 }
 
 void Solution::render_distances(const View& view, std::span<const double> distances, DistanceLayers out, const RenderOptions& options) const {

@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <map>
 #include <string>
+#include <string_view>
 #include <optional>
 #include <utility>
 #include <vector>
@@ -58,7 +59,7 @@ using ConstImageSpan = BasicImageSpan<const float>;
 // Throws haze::Error naming `field` unless the span has data, a size >= 1, 3 or 4 channels, and
 // rows at least width * channels floats apart.
 template <class Float>
-void check_span(const BasicImageSpan<Float>& span, const std::string& field);
+void check_span(const BasicImageSpan<Float>& span, std::string_view field);
 
 // Writes linear float RGB ("R", "G", "B"); with std_error, also its layer "stderr.R/G/B".
 void write_exr(const std::filesystem::path& path, const Image& image, const Image* std_error = nullptr);

@@ -96,6 +96,13 @@ struct DistanceLayers {
   double glow_angle = 0.0;
 };
 
+// Per-pixel layers into the caller's memory (Solution::render_layers): float32 RGB or RGBA rows of
+// the view's size, any stride (a GL pixel-buffer upload takes them as they are); `surface` may be
+// left empty (no data) when the caller has no use for it.
+struct LayerSpans {
+  ImageSpan inscatter, transmittance, surface;
+};
+
 struct RenderResult {
   Image radiance;
   std::optional<Image> std_error;                   // per-pixel standard error, for Monte Carlo methods
@@ -147,6 +154,10 @@ class MethodSolution {
   // (every entry written; its size checked by the caller), in one pass; false where the method has
   // no such path for this scene (Solution::render_distances then renders once per distance).
   virtual bool render_distances(const View&, std::span<const double>, const RenderOptions&, DistanceLayers /*out*/) const { return false; }
+  // The view's layers per pixel into `out` (spans checked by the caller), in one pass that
+  // allocates nothing once warm; false where the method has no such path for this scene
+  // (Solution::render_layers then renders and copies).
+  virtual bool render_layers(const View&, LayerSpans /*out*/, const RenderOptions&) const { return false; }
   // Adds to `out` (the view's pixels) what render_distances left out for `glow_angle`: per pixel,
   // the near share of each point light's in-scatter along the ray up to its end (view.depth or
   // the medium's). A method that leaves nothing out adds nothing, the default.
