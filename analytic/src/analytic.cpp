@@ -397,7 +397,9 @@ class AnalyticSolution final : public MethodSolution {
       ends[x] = std::min(r.t1[x], std::isfinite(depth) ? static_cast<float>(depth) : INFINITY);
       at[x] = std::isfinite(ends[x]) ? std::max(ends[x], r.t0[x]) : r.t0[x];  // an endless ray's tails at its entry stand in
     }
-    tail_sums(table_, r.row, at.data(), sums);
+    // A row of endless rays (the sky in unbounded fog) needs no tails at the ends.
+    if (std::any_of(ends.begin(), ends.begin() + static_cast<std::ptrdiff_t>(width), [](float e) { return std::isfinite(e); }))
+      tail_sums(table_, r.row, at.data(), sums);
     for (size_t x = 0; x < width; ++x) {
       const auto px = static_cast<int>(x);
       Rgb l(0.0), t(1.0);
