@@ -1,14 +1,14 @@
 // haze bench frame: a host renderer's frame (docs/HOST.md, "Frame time"; tracker issue 51). Each
 // scene of bench/frame names its method: one solution is prepared, then the camera moves every
 // frame on an orbit around it while the host's floor (y = -1.5) is its depth buffer, and each
-// stage is timed frame by frame: the froxel build (build_froxels, 160 x 90 x 64 by default), the
+// stage is timed frame by frame: the froxel build (build_froxels, 160 x 90 x 64 by default); the
 // CPU composite of the froxels over the host's depth into the renderer's colour of the frame, in
 // place (written just before, as a renderer's is), with the glow of lights in view added per
-// pixel (add_glow, 4 columns by default),
-// reused from frame to frame, and the per-pixel layers (Solution::render_layers with the depth, into
-// the renderer's buffers, reused). Medians
-// over the frames; with the per-pixel layers, the froxel composite's relative RMS difference from
-// theirs over the host's floor and sky at frame 0.
+// pixel (add_glow, 4 columns by default); and the per-pixel layers (Solution::render_layers with
+// the depth, into the renderer's buffers, reused). Medians over the frames, each stage's least
+// memory traffic as a share of the copy bandwidth measured on the same threads first; with the
+// per-pixel layers, the froxel composite's relative RMS difference from theirs over the host's
+// floor and sky at frame 0.
 #include "commands.h"
 
 #include <haze/core/error.h>
@@ -77,6 +77,7 @@ struct StageRow {
   std::string scene, method, stage;
   std::vector<double> ms;  // per frame
   double items = 0.0;      // froxels or pixels a frame
+  double bytes = 0.0;      // the least memory traffic a frame of the stage makes (what it must write and read)
   // per_pixel: the froxel composite's relative RMS difference from the layers' composite over the
   // host's colour, frame 0 (NaN where not measured).
   double froxel_error = std::numeric_limits<double>::quiet_NaN();
@@ -115,7 +116,7 @@ std::vector<StageRow> run_scene(const std::filesystem::path& file, const FrameAr
                       const Stopwatch watch;
                       build_froxels(solution, camera, froxels, grid, options);
                       return 1e3 * watch.seconds();
-                    }), static_cast<double>(grid.nx) * grid.ny * grid.nz});
+                    }), static_cast<double>(grid.nx) * grid.ny * grid.nz, 24.0 * grid.nx * grid.ny * grid.nz});  // L_in and T written
   if (wanted(kStages[1]))
     rows.push_back({name, method, kStages[1], time_frames(a, [&](int f) {
                       const Camera camera = pose(scene.camera, f);
@@ -127,7 +128,7 @@ std::vector<StageRow> run_scene(const std::filesystem::path& file, const FrameAr
                       composite_froxels(froxels, ConstImageSpan{composed.data().data(), a.width, a.height}, depth, target, a.threads);
                       add_glow(solution, camera, froxels, depth, target, a.threads);
                       return 1e3 * watch.seconds();
-                    }), pixels});
+                    }), pixels, 28.0 * pixels});  // colour read and written, depth read
   if (wanted(kStages[2])) {
     double error = std::numeric_limits<double>::quiet_NaN();
     Image inscatter(a.width, a.height), transmittance(a.width, a.height);  // the renderer's layer buffers, reused
@@ -150,10 +151,26 @@ std::vector<StageRow> run_scene(const std::filesystem::path& file, const FrameAr
                         error = relative_rmse(froxel, exact);
                       }
                       return ms;
-                    }), pixels});
+                    }), pixels, 28.0 * pixels});  // L_in and T written, depth read
     rows.back().froxel_error = error;
   }
   return rows;
+}
+
+// The machine's copy bandwidth on the threads (STREAM's copy: bytes read plus written per second),
+// 2 x 128 MB, the best of 5.
+double copy_bandwidth(int threads) {
+  const size_t n = size_t(32) << 20, chunk = size_t(1) << 20;
+  std::vector<float> from(n, 1.0f), to(n, 0.0f);
+  double best = 0.0;
+  for (int r = 0; r < 5; ++r) {
+    const Stopwatch watch;
+    parallel_for(static_cast<long long>(n / chunk), threads, 1, [&](long long c0, long long c1) {
+      for (auto c = static_cast<size_t>(c0); c < static_cast<size_t>(c1); ++c) std::copy_n(from.data() + c * chunk, chunk, to.data() + c * chunk);
+    });
+    best = std::max(best, 2.0 * sizeof(float) * static_cast<double>(n) / watch.seconds());
+  }
+  return best;
 }
 
 int run(const FrameArgs& a) {
@@ -169,17 +186,19 @@ int run(const FrameArgs& a) {
   if (files.empty()) throw Error("--scenes", a.scenes, "a directory holding the scenes asked for (bench/frame)");
   std::sort(files.begin(), files.end());
   nlohmann::json out = nlohmann::json::array();
+  const double bandwidth = copy_bandwidth(a.threads);
   if (!a.json)
-    std::printf("%dx%d, %d x %d x %d froxels, %d threads; medians over the frames\n%-18s %-12s %-13s %10s %7s %12s\n", a.width, a.height,
-                a.froxels[0], a.froxels[1], a.froxels[2], a.threads, "scene", "method", "stage", "median ms", "frames", "ns per item");
+    std::printf("%dx%d, %d x %d x %d froxels, %d threads; medians over the frames; copy bandwidth %.1f GB/s\n%-18s %-12s %-13s %10s %7s %12s %10s\n",
+                a.width, a.height, a.froxels[0], a.froxels[1], a.froxels[2], a.threads, 1e-9 * bandwidth, "scene", "method", "stage", "median ms",
+                "frames", "ns per item", "of copy bw");
   for (const auto& file : files)
     for (const StageRow& r : run_scene(file, a)) {
-      const double m = median(r.ms), ns = 1e6 * m / r.items;
-      out.push_back({{"scene", r.scene}, {"method", r.method}, {"stage", r.stage}, {"median_ms", m},
-                     {"frames", r.ms.size()}, {"items", r.items}, {"ns_per_item", ns}});
+      const double m = median(r.ms), ns = 1e6 * m / r.items, share = r.bytes / (1e-3 * m) / bandwidth;
+      out.push_back({{"scene", r.scene}, {"method", r.method}, {"stage", r.stage}, {"median_ms", m}, {"frames", r.ms.size()}, {"items", r.items},
+                     {"ns_per_item", ns}, {"bytes", r.bytes}, {"bandwidth_share", share}});
       if (!std::isnan(r.froxel_error)) out.back()["froxel_error"] = r.froxel_error;
       if (!a.json) {
-        std::printf("%-18s %-12s %-13s %10.1f %7zu %12.2f", r.scene.c_str(), r.method.c_str(), r.stage.c_str(), m, r.ms.size(), ns);
+        std::printf("%-18s %-12s %-13s %10.1f %7zu %12.2f %9.1f%%", r.scene.c_str(), r.method.c_str(), r.stage.c_str(), m, r.ms.size(), ns, 100.0 * share);
         if (!std::isnan(r.froxel_error)) std::printf("  (froxel composite %.2f%% off)", 100.0 * r.froxel_error);
         std::printf("\n");
       }
@@ -205,7 +224,7 @@ Command add_bench_frame(CLI::App& bench) {
   sub->add_option("--froxels", a->froxels, "Froxel columns across, down and slices")->expected(3)->capture_default_str()->check(CLI::Range(1, 4096));
   sub->add_option("--glow-columns", a->glow_columns, "FroxelGrid::glow_columns: lights' glow within this many columns added per pixel (0: none)")
       ->capture_default_str()->check(CLI::Range(0.0, 16.0));
-  sub->add_flag("--json", a->json, "Print a JSON list of {scene, method, stage, median_ms, frames, items, ns_per_item[, froxel_error]}");
+  sub->add_flag("--json", a->json, "Print a JSON list of {scene, method, stage, median_ms, frames, items, ns_per_item, bytes, bandwidth_share[, froxel_error]}");
   return {sub, [a] { return run(*a); }};
 }
 

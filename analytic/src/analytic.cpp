@@ -275,18 +275,23 @@ class AnalyticSolution final : public MethodSolution {
     for (size_t l = 0; l < lights_.size(); ++l) {
       double px, py;
       if (!camera.film_position(lights_[l].position, px, py)) continue;
-      // The window of pixels within the angle: its radius from the pixels' angle at the light.
-      const Ray a = camera.generate_ray(px, py), b = camera.generate_ray(px + 1.0, py);
-      const double pixel = std::acos(std::clamp(glm::dot(a.direction, b.direction), -1.0, 1.0));
+      // The window of pixels within the angle: its radius from the pixels' smaller angle at the
+      // light, across or down (a light off the axis of a wide view sees them foreshortened).
+      const Vec3 at = camera.generate_ray(px, py).direction;
+      const double across = std::acos(std::clamp(glm::dot(at, camera.generate_ray(px + 1.0, py).direction), -1.0, 1.0));
+      const double down = std::acos(std::clamp(glm::dot(at, camera.generate_ray(px, py + 1.0).direction), -1.0, 1.0));
+      const double pixel = std::min(across, down);
       if (!(pixel > 0.0)) continue;
       const double radius = 1.25 * glow_angle / pixel + 2.0;
-      const int y0 = std::clamp(static_cast<int>(std::floor(py - radius)), 0, camera.height_px), y1 = std::clamp(static_cast<int>(std::ceil(py + radius)), 0, camera.height_px);
+      // Clamped as doubles first: a light far off the film projects far outside int's range.
+      const auto row = [&](double v) { return static_cast<int>(std::clamp(v, 0.0, static_cast<double>(camera.height_px))); };
+      const int y0 = row(std::floor(py - radius)), y1 = row(std::ceil(py + radius));
       if (y0 >= y1) continue;
       const auto body = [&](long long r0, long long r1) {
         for (auto y = static_cast<int>(r0); y < r1; ++y) {  // the row's chord of the window's circle
           const double dy = y + 0.5 - py, half = std::sqrt(std::max(0.0, radius * radius - dy * dy));
-          const int x0 = std::clamp(static_cast<int>(std::floor(px - half)), 0, camera.width_px);
-          const int x1 = std::clamp(static_cast<int>(std::ceil(px + half)), 0, camera.width_px);
+          const auto column = [&](double v) { return static_cast<int>(std::clamp(v, 0.0, static_cast<double>(camera.width_px))); };
+          const int x0 = column(std::floor(px - half)), x1 = column(std::ceil(px + half));
           if (x0 < x1) glow_row(view, l, glow_angle, y, x0, x1, out);
         }
       };
@@ -318,7 +323,7 @@ class AnalyticSolution final : public MethodSolution {
   // over them.
   struct RowRays {
     TailRow row;
-    float *t0, *t1;
+    float *t0, *t1, *whole[3];  // whole: where tail_sums puts the row's sums at t0 (row.whole)
   };
   RowRays ray_tails(const Ray* rays, size_t count, double glow_angle, size_t only, bool left) const {
     const size_t padded = (count + 15) / 16 * 16;
@@ -336,7 +341,7 @@ class AnalyticSolution final : public MethodSolution {
     for (size_t x = 0; x < count; ++x) {
       const Ray& ray = rays[x];
       double a = 0.0, b = kInfinity;
-      if (!bounds.clip(ray, a, b) || !(b > a)) b = a;  // no medium: L_in 0, T 1 everywhere
+      if (!bounds.clip(ray, a, b) || !(b > a)) a = b = 0.0;  // no medium: L_in 0, T 1 everywhere (a miss may leave a at +inf)
       t0[x] = static_cast<float>(a), t1[x] = std::isfinite(b) ? static_cast<float>(b) : INFINITY;
       for (size_t l = 0; l < lights; ++l) {
         if (only < lights && l != only) continue;
@@ -361,7 +366,7 @@ class AnalyticSolution final : public MethodSolution {
     }
     TailRow row{tails.data(), tails.size(), t0, t1, {whole, whole + padded, whole + 2 * padded}, {}, count};
     for (int c = 0; c < 3; ++c) row.sigma_t[c] = static_cast<float>(sigma_t_[c]);
-    return {row, t0, t1};
+    return {row, t0, t1, {whole, whole + padded, whole + 2 * padded}};
   }
 
   // render_distances' row y: the row's rays, then its slices.
@@ -371,7 +376,7 @@ class AnalyticSolution final : public MethodSolution {
     rays.resize(width);
     camera.row_rays(y, rays.data());
     const RowRays r = ray_tails(rays.data(), width, glow_angle, lights_.size(), false);
-    float* const whole[3] = {const_cast<float*>(r.row.whole[0]), const_cast<float*>(r.row.whole[1]), const_cast<float*>(r.row.whole[2])};
+    float* const* whole = r.whole;
     tail_sums(table_, r.row, r.t0, whole);
     const size_t rays_per_slice = width * static_cast<size_t>(camera.height_px), first = static_cast<size_t>(y) * width;
     for (size_t k = 0; k < distances.size(); ++k) {
@@ -389,7 +394,7 @@ class AnalyticSolution final : public MethodSolution {
     rays.resize(width), ends.assign(padded, 0.0f), at.assign(padded, 0.0f), at_end.assign(3 * padded, 0.0f);
     camera.row_rays(y, rays.data());
     const RowRays r = ray_tails(rays.data(), width, 0.0, lights_.size(), false);
-    float* const whole[3] = {const_cast<float*>(r.row.whole[0]), const_cast<float*>(r.row.whole[1]), const_cast<float*>(r.row.whole[2])};
+    float* const* whole = r.whole;
     float* const sums[3] = {at_end.data(), at_end.data() + padded, at_end.data() + 2 * padded};
     tail_sums(table_, r.row, r.t0, whole);
     for (size_t x = 0; x < width; ++x) {
@@ -456,11 +461,11 @@ class AnalyticSolution final : public MethodSolution {
     rays.resize(count), ends.assign(padded, 0.0f), at_end.assign(3 * padded, 0.0f);  // ends: the rays' ends in the medium
     view.camera.row_rays(y, x0, x1, rays.data());
     const RowRays r = ray_tails(rays.data(), count, glow_angle, l, true);
-    for (size_t i = 0; i < count; ++i) {
+    for (size_t i = 0; i < count; ++i) {  // a NaN or negative depth ends the ray before the medium, as the composite takes it
       const double depth = view.max_distance(x0 + static_cast<int>(i), y);
-      ends[i] = std::min(r.t1[i], std::isfinite(depth) ? static_cast<float>(depth) : INFINITY);
+      ends[i] = !(depth >= 0.0) ? r.t0[i] : std::min(r.t1[i], std::isfinite(depth) ? static_cast<float>(depth) : INFINITY);
     }
-    float* const whole[3] = {const_cast<float*>(r.row.whole[0]), const_cast<float*>(r.row.whole[1]), const_cast<float*>(r.row.whole[2])};
+    float* const* whole = r.whole;
     float* const sums[3] = {at_end.data(), at_end.data() + padded, at_end.data() + 2 * padded};
     tail_sums(table_, r.row, r.t0, whole);
     // A ray without end in unbounded fog takes all of S(t0): its tails at the entry stand in.

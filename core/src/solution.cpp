@@ -218,7 +218,8 @@ void Solution::render_distances(const View& view, std::span<const double> distan
 void Solution::add_glow(const View& view, double glow_angle, ImageSpan out, const RenderOptions& options) const {
   check_span(out, "out");
   // The depth's size only: its values are read near the lights alone, where a NaN or negative
-  // distance ends the ray before the medium (a full check would cost a frame a millisecond).
+  // distance ends the ray before the medium, as the composite takes it (a full check would cost
+  // a frame a millisecond).
   const size_t pixels = static_cast<size_t>(view.camera.width_px) * static_cast<size_t>(view.camera.height_px);
   if (!view.depth.empty() && view.depth.size() != pixels)
     throw Error("view.depth", to_text(view.depth.size()) + " values", to_text(pixels) + " (width_px x height_px), one distance per pixel");

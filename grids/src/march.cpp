@@ -52,6 +52,10 @@ struct Marcher {
           const PackedLights* lights, bool surface_gather = false)
       : scene(s), volume(v), depths(d), sigma_t(v.sigma_t_scale), step(step_length),
         own(lights ? PackedLights{} : pack_lights(s, v, d, threads)), packed(lights ? *lights : own) {
+    const size_t values = v.density.cell_count() * d.size();
+    if (packed.depths.size() != values || (!packed.visibility.empty() && packed.visibility.size() != values))
+      throw Error("packed", to_text(packed.depths.size()) + " depths and " + to_text(packed.visibility.size()) + " visibilities",
+                  to_text(values) + " each (cells x lights; pack_lights for this volume and these depths)");
     gather = surface_gather && !scene.surfaces.empty() && volume.albedo != Rgb(0.0);
     if (gather) around = DirectionSet::fibonacci(kSurfaceDirections);
     cone = cone_tangent(kSurfaceDirections);
@@ -303,7 +307,9 @@ bool march_distances(const Scene& scene, const ExtinctionVolume& volume, const s
                      const PackedLights* packed) {
   const Vec3 h = volume.density.cell_size();
   const Marcher marcher(scene, volume, depths, settings.step_cells * std::min({h.x, h.y, h.z}), options.threads, packed, false);
-  thread_local std::vector<MarchLight> lights;  // kept: a frame allocates nothing
+  // Kept: a frame allocates nothing. The rows read it while this thread waits in parallel_for,
+  // which runs only row tasks of Haze's arena meanwhile (none of them marches again).
+  thread_local std::vector<MarchLight> lights;
   lights.clear();
   MarchVolume simd_view;
   if (settings.scalar || !simd_volume(marcher, lights, simd_view)) return false;

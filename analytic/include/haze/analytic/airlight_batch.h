@@ -40,11 +40,12 @@ struct TailRow {
   size_t light_count = 0;
   const float* t0 = nullptr;         // per ray: where it enters the medium (0 inside)
   const float* t1 = nullptr;         // per ray: where it leaves it (+inf unbounded; t1 = t0: no medium)
-  const float* whole[3] = {};        // per ray: L_in past t1, the sum of sigma_s I g(t0) (tail_sums)
+  const float* whole[3] = {};        // per ray: the sum of sigma_s I g(t0) (tail_sums): L_in to the medium's end where t1 is infinite
   float sigma_t[3] = {};
   size_t count = 0;                  // rays; every array holds count rounded up to 16
 };
-// sums[c][i] = sum over lights of weight[c] g(d[i]) for rays i (d[i] >= 0).
+// sums[c][i] = sum over lights of weight[c] g(d[i]) for rays i (d[i] >= 0); d and sums, like the
+// row's arrays, hold count rounded up to 16 (whole vectors are read and stored).
 void tail_sums(const AirlightTable& table, const TailRow& row, const float* d, float* const sums[3]);
 // Slice `distance` of the row: L_in and T per ray as RGB triples into inscatter[3 i + c] and
 // transmittance[3 i + c] (count rays each): before t0 L_in 0 and T 1, past t1 their values at t1.

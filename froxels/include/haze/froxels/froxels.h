@@ -26,7 +26,7 @@ struct FroxelGrid {
   // 0: the froxels hold every light whole. Else each point light's glow, its in-scatter along the
   // rays within this many columns' angle of its direction, is left to add_glow per pixel, where
   // the method can (analytic with point lights; others hold it whole): a light in view glows
-  // narrower than a column. In [0, 16]; 4 suits 1080p.
+  // narrower than a column. In [0, 16] (the angle at most 0.5 radians); 4 suits 1080p.
   double glow_columns = 0.0;
   // Slice k's far boundary (k = -1: near).
   double boundary(int k) const;
