@@ -84,44 +84,20 @@ HWY_NOINLINE size_t AirlightBatch(const float* HWY_RESTRICT table, int na, int n
   return i;
 }
 
-// 1 / x from the hardware estimate and one Newton step (within 2 ulp; the divider is the kernel's
-// bottleneck otherwise).
-template <class V>
-HWY_INLINE V Reciprocal(V x) {
-  const V r = hn::ApproximateReciprocal(x);
-  return hn::Mul(r, hn::NegMulAdd(x, r, hn::Set(hn::DFromV<V>(), 2.0f)));
-}
-
 // The unit tail g(d) = G(d) / (sigma_s I) of rays whose light projects to t_c along them at
-// distance h_c from their lines, at distances `at` (airlight_batch.h, TailRow): LogTail's
-// formulas with one square root and reciprocals for its divisions.
+// distance h_c from their lines, at distances `at` (airlight_batch.h, TailRow).
 template <class D, class V>
 HWY_INLINE V UnitTail(D d, const float* HWY_RESTRICT table, int na, int ne, float eta_max, V t_c, V h_c, V sigma, V at) {
-  const hn::RebindToSigned<D> di;
-  const V zero = hn::Zero(d), one = hn::Set(d, 1.0f);
+  const V zero = hn::Zero(d);
   const V t = hn::Sub(t_c, at);
   const V d_sv = hn::Sqrt(hn::MulAdd(t, t, hn::Mul(h_c, h_c)));
   const V h = hn::Max(hn::Max(h_c, hn::Mul(hn::Set(d, 1e-6f), d_sv)), hn::Set(d, 1e-20f));
   // w = (xi + r) / h without cancellation (xi = -t), floored where the point sits on the light.
   const auto behind = hn::Le(t, zero);
-  const V w = hn::Max(hn::Mul(hn::IfThenElse(behind, hn::Sub(d_sv, t), h), Reciprocal(hn::IfThenElse(behind, h, hn::Add(d_sv, t)))),
-                      hn::Set(d, 1e-30f));
-  const V a = hn::Min(hn::Mul(hn::Mul(sigma, h), hn::Add(one, w)), hn::Set(d, 1e30f));
-  const V m = hn::Sqrt(hn::Mul(a, Reciprocal(hn::Add(one, a))));
-  const V fa = hn::Mul(m, hn::Set(d, static_cast<float>(na - 1)));
-  const V e = hn::Min(hn::Max(hn::Log(d, w), hn::Set(d, -eta_max)), hn::Set(d, eta_max));
-  const V fe = hn::Mul(hn::Add(e, hn::Set(d, eta_max)), hn::Set(d, static_cast<float>(ne - 1) / (2.0f * eta_max)));
-  const V fi = hn::Min(hn::Floor(fa), hn::Set(d, static_cast<float>(na - 2)));
-  const V fj = hn::Min(hn::Floor(fe), hn::Set(d, static_cast<float>(ne - 2)));
-  const V x = hn::Sub(fa, fi), y = hn::Sub(fe, fj);
-  const auto index = hn::ConvertTo(di, hn::MulAdd(fj, hn::Set(d, static_cast<float>(na)), fi));
-  const V t00 = hn::GatherIndex(d, table, index), t10 = hn::GatherIndex(d, table + 1, index);
-  const V t01 = hn::GatherIndex(d, table + na, index), t11 = hn::GatherIndex(d, table + na + 1, index);
-  const V t0 = hn::MulAdd(x, hn::Sub(t10, t00), t00), t1 = hn::MulAdd(x, hn::Sub(t11, t01), t01);
-  const V log_tail = hn::MulAdd(y, hn::Sub(t1, t0), t0);
-  // g = K e^(-sigma_t d_sv) / h with K = e^(log T) 2 / ((1 + w)(1 + a)).
-  const V scale = Reciprocal(hn::Mul(hn::Mul(hn::Add(one, w), hn::Add(one, a)), hn::Mul(h, hn::Set(d, 0.5f))));
-  return hn::Mul(hn::Exp(d, hn::NegMulAdd(sigma, d_sv, log_tail)), scale);
+  const V w0 = hn::Max(hn::Div(hn::IfThenElse(behind, hn::Sub(d_sv, t), h), hn::IfThenElse(behind, h, hn::Add(d_sv, t))), hn::Set(d, 1e-30f));
+  V scale;
+  const V log_tail = LogTail(d, table, na, ne, eta_max, hn::Mul(sigma, h), hn::Log(d, w0), w0, scale);
+  return hn::Div(hn::Mul(hn::Exp(d, hn::NegMulAdd(sigma, d_sv, log_tail)), scale), h);
 }
 
 // s_c = sum over the row's lights of weight[c] g(at), for the vector of rays at i.

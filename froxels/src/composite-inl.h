@@ -25,7 +25,6 @@ namespace hn = hwy::HWY_NAMESPACE;
 HWY_NOINLINE void CompositeRowKernel(const CompositeVolume& v, const CompositeRow& row) {
 #if HWY_TARGET == HWY_SCALAR  // one lane: no four-float vectors
   composite_row_reference(v, row);
-}
 #else
   constexpr int kChunk = 64;
   const hn::ScalableTag<float> d;
@@ -118,8 +117,8 @@ HWY_NOINLINE void CompositeRowKernel(const CompositeVolume& v, const CompositeRo
       to[px * row.out_channels + ch] = l_of[f] + t_of[f] * in[px * row.colour_channels + ch];
     }
   }
-}
 #endif
+}
 
 }  // namespace haze::froxels_detail::HWY_NAMESPACE
 HWY_AFTER_NAMESPACE();

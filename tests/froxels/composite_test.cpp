@@ -11,8 +11,12 @@
 #include <limits>
 #include <vector>
 
-namespace haze::froxels_detail {
+// Outside namespace haze: Highway's macro names `testing::`, which haze::testing (the shared test
+// scenes, beside this file in one unity build) would shadow.
 namespace {
+
+using haze::Rng;
+using namespace haze::froxels_detail;
 
 class CompositeTargets : public hwy::TestWithParamTarget {};
 HWY_TARGET_INSTANTIATE_TEST_SUITE_P(CompositeTargets);
@@ -51,4 +55,3 @@ TEST_P(CompositeTargets, RowKernelMatchesTheScalarReference) {
 }
 
 }  // namespace
-}  // namespace haze::froxels_detail
