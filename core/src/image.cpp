@@ -1,7 +1,5 @@
 #include <haze/core/error.h>
 #include <haze/core/image.h>
-
-#include <string_view>
 #include <haze/core/progress.h>
 
 #include "exr_layout.h"
@@ -15,8 +13,10 @@
 #include <png.h>
 
 #include <algorithm>
+#include <cstdint>
 #include <cstdio>
 #include <memory>
+#include <string_view>
 
 namespace haze {
 
@@ -78,14 +78,20 @@ void window_size(const Imf::InputFile& file, const std::string& field, std::size
 
 // One float channel of an open EXR, x fastest from its data window's corner; its size through
 // width and height.
+// The slice base OpenEXR addresses pixel (x, y) of the data window from: `data` less the window
+// origin's offset, in integers (a window not at 0 puts it outside the buffer, which pointer
+// arithmetic may not reach: the fuzzer's undefined-behaviour check found one).
+char* window_base(void* data, const Imath::Box2i& window, int width, size_t pixel_bytes) {
+  const auto offset = (static_cast<ptrdiff_t>(window.min.y) * width + window.min.x) * static_cast<ptrdiff_t>(pixel_bytes);
+  return reinterpret_cast<char*>(reinterpret_cast<uintptr_t>(data) - static_cast<uintptr_t>(offset));
+}
+
 std::vector<float> read_channel(Imf::InputFile& file, const std::string& field, const char* channel, int& width, int& height) {
   window_size(file, field, sizeof(float), width, height);
   const auto window = file.header().dataWindow();
   std::vector<float> values(static_cast<size_t>(width) * static_cast<size_t>(height));
   Imf::FrameBuffer fb;
-  char* base = reinterpret_cast<char*>(values.data()) -
-               (static_cast<ptrdiff_t>(window.min.y) * width + window.min.x) * static_cast<ptrdiff_t>(sizeof(float));
-  fb.insert(channel, Imf::Slice(Imf::FLOAT, base, sizeof(float), sizeof(float) * static_cast<size_t>(width)));
+  fb.insert(channel, Imf::Slice(Imf::FLOAT, window_base(values.data(), window, width, sizeof(float)), sizeof(float), sizeof(float) * static_cast<size_t>(width)));
   file.setFrameBuffer(fb);
   file.readPixels(window.min.y, window.max.y);
   return values;
@@ -141,7 +147,7 @@ Image read_exr(const std::filesystem::path& path, std::optional<Image>* std_erro
     // The slices are addressed from the data window's origin.
     for (auto it = fb.begin(); it != fb.end(); ++it) {
       auto& slice = it.slice();
-      slice.base -= (static_cast<ptrdiff_t>(window.min.y) * image.width() + window.min.x) * 3 * sizeof(float);
+      slice.base = window_base(slice.base, window, image.width(), 3 * sizeof(float));
     }
     file.setFrameBuffer(fb);
     file.readPixels(window.min.y, window.max.y);
