@@ -325,8 +325,11 @@ class AnalyticSolution final : public MethodSolution {
     TailRow row;
     float *t0, *t1, *whole[3];  // whole: where tail_sums puts the row's sums at t0 (row.whole)
   };
+  // The kernels' arrays hold whole vectors: count rounded up to 16 (airlight_batch.h).
+  static size_t padded_count(size_t count) { return (count + 15) / 16 * 16; }
+
   RowRays ray_tails(const Ray* rays, size_t count, double glow_angle, size_t only, bool left) const {
-    const size_t padded = (count + 15) / 16 * 16;
+    const size_t padded = padded_count(count);
     const size_t lights = lights_.size();
     // Per thread, kept between frames: a frame allocates nothing once they have grown.
     thread_local std::vector<float> scratch;
@@ -376,8 +379,7 @@ class AnalyticSolution final : public MethodSolution {
     rays.resize(width);
     camera.row_rays(y, rays.data());
     const RowRays r = ray_tails(rays.data(), width, glow_angle, lights_.size(), false);
-    float* const* whole = r.whole;
-    tail_sums(table_, r.row, r.t0, whole);
+    tail_sums(table_, r.row, r.t0, r.whole);
     const size_t rays_per_slice = width * static_cast<size_t>(camera.height_px), first = static_cast<size_t>(y) * width;
     for (size_t k = 0; k < distances.size(); ++k) {
       const size_t at = k * rays_per_slice + first;
@@ -385,26 +387,44 @@ class AnalyticSolution final : public MethodSolution {
     }
   }
 
+  // The ends in the medium of rays [x0, x0 + count) of row y (the view's depth or t1; t0 where the
+  // depth is NaN or negative, as the composite takes it), and the tails of ray_tails' row r at
+  // their entries (into r.whole) and at their ends. An endless ray's tails at its entry stand in
+  // at its end (it takes all of them: T = 0); a row of endless rays (the sky in unbounded fog)
+  // skips the second sums.
+  struct EndTails {
+    const float* ends;
+    const float* sums[3];
+  };
+  EndTails end_tails(const View& view, int y, int x0, const RowRays& r, size_t count) const {
+    const size_t padded = padded_count(count);
+    thread_local std::vector<float> ends, at, at_end;
+    ends.assign(padded, 0.0f), at.assign(padded, 0.0f), at_end.assign(3 * padded, 0.0f);
+    bool any_end = false;
+    for (size_t i = 0; i < count; ++i) {
+      const double depth = view.max_distance(x0 + static_cast<int>(i), y);
+      ends[i] = !(depth >= 0.0) ? r.t0[i] : std::min(r.t1[i], std::isfinite(depth) ? static_cast<float>(depth) : INFINITY);
+      at[i] = std::isfinite(ends[i]) ? std::max(ends[i], r.t0[i]) : r.t0[i];
+      any_end = any_end || std::isfinite(ends[i]);
+    }
+    float* const sums[3] = {at_end.data(), at_end.data() + padded, at_end.data() + 2 * padded};
+    tail_sums(table_, r.row, r.t0, r.whole);
+    if (any_end) tail_sums(table_, r.row, at.data(), sums);
+    return {ends.data(), {sums[0], sums[1], sums[2]}};
+  }
+
   // render_layers' row y.
   void layers_row(const View& view, int y, LayerSpans out) const {
     const Camera& camera = view.camera;
-    const auto width = static_cast<size_t>(camera.width_px), padded = (width + 15) / 16 * 16;
+    const auto width = static_cast<size_t>(camera.width_px);
     thread_local std::vector<Ray> rays;
-    thread_local std::vector<float> ends, at, at_end;
-    rays.resize(width), ends.assign(padded, 0.0f), at.assign(padded, 0.0f), at_end.assign(3 * padded, 0.0f);
+    rays.resize(width);
     camera.row_rays(y, rays.data());
     const RowRays r = ray_tails(rays.data(), width, 0.0, lights_.size(), false);
+    const EndTails e = end_tails(view, y, 0, r, width);
+    const float* const ends = e.ends;
     float* const* whole = r.whole;
-    float* const sums[3] = {at_end.data(), at_end.data() + padded, at_end.data() + 2 * padded};
-    tail_sums(table_, r.row, r.t0, whole);
-    for (size_t x = 0; x < width; ++x) {
-      const double depth = view.max_distance(static_cast<int>(x), y);
-      ends[x] = std::min(r.t1[x], std::isfinite(depth) ? static_cast<float>(depth) : INFINITY);
-      at[x] = std::isfinite(ends[x]) ? std::max(ends[x], r.t0[x]) : r.t0[x];  // an endless ray's tails at its entry stand in
-    }
-    // A row of endless rays (the sky in unbounded fog) needs no tails at the ends.
-    if (std::any_of(ends.begin(), ends.begin() + static_cast<std::ptrdiff_t>(width), [](float e) { return std::isfinite(e); }))
-      tail_sums(table_, r.row, at.data(), sums);
+    const float* const* sums = e.sums;
     for (size_t x = 0; x < width; ++x) {
       const auto px = static_cast<int>(x);
       Rgb l(0.0), t(1.0);
@@ -455,24 +475,15 @@ class AnalyticSolution final : public MethodSolution {
   // add_glow's pixels [x0, x1) of row y for light l: L_in = share (S(t0) - T(end) S(end)) per
   // channel, S the light's tails, `end` the ray's end in the medium (the view's depth or t1).
   void glow_row(const View& view, size_t l, double glow_angle, int y, int x0, int x1, ImageSpan out) const {
-    const auto count = static_cast<size_t>(x1 - x0), padded = (count + 15) / 16 * 16;
+    const auto count = static_cast<size_t>(x1 - x0);
     thread_local std::vector<Ray> rays;
-    thread_local std::vector<float> ends, at_end;
-    rays.resize(count), ends.assign(padded, 0.0f), at_end.assign(3 * padded, 0.0f);  // ends: the rays' ends in the medium
+    rays.resize(count);
     view.camera.row_rays(y, x0, x1, rays.data());
     const RowRays r = ray_tails(rays.data(), count, glow_angle, l, true);
-    for (size_t i = 0; i < count; ++i) {  // a NaN or negative depth ends the ray before the medium, as the composite takes it
-      const double depth = view.max_distance(x0 + static_cast<int>(i), y);
-      ends[i] = !(depth >= 0.0) ? r.t0[i] : std::min(r.t1[i], std::isfinite(depth) ? static_cast<float>(depth) : INFINITY);
-    }
+    const EndTails e = end_tails(view, y, x0, r, count);
+    const float* const ends = e.ends;
     float* const* whole = r.whole;
-    float* const sums[3] = {at_end.data(), at_end.data() + padded, at_end.data() + 2 * padded};
-    tail_sums(table_, r.row, r.t0, whole);
-    // A ray without end in unbounded fog takes all of S(t0): its tails at the entry stand in.
-    thread_local std::vector<float> at;
-    at.assign(padded, 0.0f);
-    for (size_t i = 0; i < count; ++i) at[i] = std::isfinite(ends[i]) ? std::max(ends[i], r.t0[i]) : r.t0[i];
-    tail_sums(table_, r.row, at.data(), sums);
+    const float* const* sums = e.sums;
     for (size_t i = 0; i < count; ++i) {
       if (!(ends[i] > r.t0[i])) continue;
       float* pixel = out.pixel(x0 + static_cast<int>(i), y);

@@ -9,7 +9,6 @@
 #include <haze/core/stopwatch.h>
 
 #include <algorithm>
-#include <string_view>
 
 namespace haze {
 
@@ -130,11 +129,20 @@ void RenderResult::set(int x, int y, const PixelLayers& pixel) {
 namespace {
 
 // A host's depth buffer: one value per pixel, each >= 0 or +inf.
-void check_depth(const View& view) {
+// A span of the camera's pixels, named `name` in its errors.
+void check_view_span(const ImageSpan& span, const char* name, const Camera& camera) {
+  check_span(span, name);
+  if (span.width != camera.width_px || span.height != camera.height_px)
+    throw Error(name, to_text(span.width) + " x " + to_text(span.height), "the view's size, " + to_text(camera.width_px) + " x " + to_text(camera.height_px));
+}
+
+// The view's depth: one value per pixel, and with `values` each a distance >= 0.
+void check_depth(const View& view, bool values = true) {
   if (view.depth.empty()) return;
   const size_t count = static_cast<size_t>(view.camera.width_px) * static_cast<size_t>(view.camera.height_px);
   if (view.depth.size() != count)
     throw Error("view.depth", to_text(view.depth.size()) + " values", to_text(count) + " (width_px x height_px), one distance per pixel");
+  if (!values) return;
   // A branch-free pass first (it vectorizes: a 1080p frame's check from 2.7 ms), then where.
   bool bad = false;
   for (size_t i = 0; i < count; ++i) bad |= !(view.depth[i] >= 0.0f);
@@ -166,12 +174,8 @@ RenderResult Solution::render(const View& view, const RenderOptions& options) co
 
 void Solution::render_layers(const View& view, LayerSpans out, const RenderOptions& options) const {
   const Camera& camera = view.camera;
-  for (const auto& [name, span] : {std::pair{"out.inscatter", out.inscatter}, std::pair{"out.transmittance", out.transmittance}, std::pair{"out.surface", out.surface}}) {
-    if (span.data == nullptr && std::string_view(name) == "out.surface") continue;
-    check_span(span, name);
-    if (span.width != camera.width_px || span.height != camera.height_px)
-      throw Error(name, to_text(span.width) + " x " + to_text(span.height), "the view's size, " + to_text(camera.width_px) + " x " + to_text(camera.height_px));
-  }
+  check_view_span(out.inscatter, "out.inscatter", camera), check_view_span(out.transmittance, "out.transmittance", camera);
+  if (out.surface.data) check_view_span(out.surface, "out.surface", camera);  // optional
   const State& s = *state_;
   check_depth(view);
   if (!s.solution->renders_layers())
@@ -182,14 +186,15 @@ void Solution::render_layers(const View& view, LayerSpans out, const RenderOptio
   const View layered{camera, view.depth, true};
   if (s.naming_lights([&] { return s.solution->render_layers(layered, out, o); })) return;
   const RenderResult r = render(layered, options);
-  for (int y = 0; y < camera.height_px; ++y)
-    for (int x = 0; x < camera.width_px; ++x)
-      for (const auto& [span, image] : {std::pair{out.inscatter, &*r.inscatter}, std::pair{out.transmittance, &*r.transmittance}, std::pair{out.surface, &*r.surface}}) {
-        if (!span.data) continue;
+  for (const auto& [span, image] : {std::pair{out.inscatter, &*r.inscatter}, std::pair{out.transmittance, &*r.transmittance}, std::pair{out.surface, &*r.surface}}) {
+    if (!span.data) continue;
+    for (int y = 0; y < camera.height_px; ++y)
+      for (int x = 0; x < camera.width_px; ++x) {
         const Rgb v = image->at(x, y);
         float* p = span.pixel(x, y);
         p[0] = static_cast<float>(v.r), p[1] = static_cast<float>(v.g), p[2] = static_cast<float>(v.b);
       }
+  }
 }
 
 void Solution::render_distances(const View& view, std::span<const double> distances, DistanceLayers out, const RenderOptions& options) const {
@@ -220,15 +225,10 @@ void Solution::render_distances(const View& view, std::span<const double> distan
 }
 
 void Solution::add_glow(const View& view, double glow_angle, ImageSpan out, const RenderOptions& options) const {
-  check_span(out, "out");
+  check_view_span(out, "out", view.camera);
   // The depth's size only: its values are read near the lights alone, where a NaN or negative
-  // distance ends the ray before the medium, as the composite takes it (a full check would cost
-  // a frame a millisecond).
-  const size_t pixels = static_cast<size_t>(view.camera.width_px) * static_cast<size_t>(view.camera.height_px);
-  if (!view.depth.empty() && view.depth.size() != pixels)
-    throw Error("view.depth", to_text(view.depth.size()) + " values", to_text(pixels) + " (width_px x height_px), one distance per pixel");
-  if (out.width != view.camera.width_px || out.height != view.camera.height_px)
-    throw Error("out", to_text(out.width) + " x " + to_text(out.height), "the view's size, " + to_text(view.camera.width_px) + " x " + to_text(view.camera.height_px));
+  // distance ends the ray before the medium, as the composite takes it.
+  check_depth(view, false);
   if (!(glow_angle >= 0.0 && glow_angle < 1.0)) throw Error("glow_angle", to_text(glow_angle), "an angle in [0, 1) radians");
   if (glow_angle == 0.0) return;
   const State& s = *state_;
