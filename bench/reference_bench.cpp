@@ -2,6 +2,7 @@
 // (issue target: >= 10 million per second on 2 threads), reported as a counter with the median.
 // Run: build/release/bench/haze_bench_reference --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
 #include <haze/core/method.h>
+#include <haze/reference/methods.h>
 
 #include <benchmark/benchmark.h>
 
@@ -23,6 +24,7 @@ haze::Scene homogeneous_box(double albedo) {
 
 void BM_ReferenceHomogeneous(benchmark::State& state) {
   const int threads = static_cast<int>(state.range(0));
+  haze::reference::register_methods();
   haze::Scene scene = homogeneous_box(0.95);
   haze::RenderOptions options;
   options.threads = threads;

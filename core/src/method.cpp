@@ -1,4 +1,4 @@
-#include "builtin_methods.h"
+#include "registry.h"
 
 #include <haze/core/error.h>
 #include <haze/core/method.h>
@@ -18,10 +18,6 @@ struct Registry {
   std::mutex mutex;
   std::map<std::string, MethodInfo> methods;
   std::map<std::string, std::function<std::unique_ptr<Method>()>> splits;  // register_split
-  Registry() {
-    for (MethodInfo info : {internal::quadrature_info(), internal::reference_info()})
-      methods[info.name] = std::move(info);
-  }
 };
 
 Registry& registry() {
@@ -46,7 +42,7 @@ std::vector<MethodInfo> registered_methods() {
   return out;
 }
 
-// The registry's entry for a method (builtin_methods.h).
+// The registry's entry for a method (registry.h).
 MethodInfo method_info(const std::string& name) {
   auto& r = registry();
   std::lock_guard lock(r.mutex);

@@ -1,7 +1,7 @@
 // haze::prepare, haze::Solution and haze::render (method.h): the registry's method on the caller's
 // scene, less the lights that reach nothing (light_culling.h), and errors about lights naming the
 // caller's light.
-#include "builtin_methods.h"
+#include "registry.h"
 
 #include <haze/core/error.h>
 #include <haze/core/light_culling.h>

@@ -48,7 +48,7 @@ const Surface* nearest_surface(const std::vector<Surface>& surfaces, const Ray& 
   for (const auto& s : surfaces) {
     double ts;
     Vec3 n;
-    if (s.intersect(ray, 1e-7, t, ts, n)) t = ts, normal = n, hit = &s;
+    if (s.intersect(ray, kSurfaceOffset, t, ts, n)) t = ts, normal = n, hit = &s;
   }
   return hit;
 }
@@ -60,7 +60,7 @@ bool occluded(const std::vector<Surface>& surfaces, const Vec3& x, const Vec3& d
     double t;
     Vec3 n;
     const auto* mesh = std::get_if<Mesh>(&s.shape);
-    if (mesh ? mesh->triangles->occluded(ray, 1e-7, t_max) : s.intersect(ray, 1e-7, t_max, t, n)) return true;
+    if (mesh ? mesh->triangles->occluded(ray, kSurfaceOffset, t_max) : s.intersect(ray, kSurfaceOffset, t_max, t, n)) return true;
   }
   return false;
 }

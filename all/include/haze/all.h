@@ -1,6 +1,6 @@
-// Every module this build of Haze has, registered with core's registries in one call: method auto,
-// the methods of analytic, grids and particles (core's own, quadrature and reference, are always
-// there) and the density types of particles and vdb. The command, Python, the examples and the
+// Every module this build of Haze has, registered with core's registries in one call: the
+// yardsticks (reference, quadrature), method auto, the methods of analytic, grids and particles and
+// the density types of particles and vdb. The command, Python, the examples and the
 // tests call it.
 #pragma once
 

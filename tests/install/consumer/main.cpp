@@ -1,5 +1,6 @@
 // The API tour in README.md: a phase-function factorization, then a scene rendered with a method.
 #include <haze/haze.h>
+#include <haze/reference/methods.h>
 
 #include <iostream>
 
@@ -8,6 +9,10 @@ int main() {
   haze::PhaseMatrix matrix(haze::PhaseFunction::henyey_greenstein(0.5), haze::DirectionSet::fibonacci(128));
   haze::SeparablePhase separable(matrix, 24);
   std::cout << "separable phase: relative error " << separable.relative_error() << "\n";
+
+  // The yardstick methods, "quadrature" and "reference" (haze::register_all() in <haze/all.h>
+  // registers every module).
+  haze::reference::register_methods();
 
   // A scene in code; haze::Scene::load("scene.json") reads the same from a file.
   haze::Scene scene;

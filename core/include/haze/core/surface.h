@@ -45,7 +45,10 @@ struct Surface {
   Rgb brdf(const Vec3& wi, const Vec3& wo, const Vec3& n) const;
 };
 
-// The nearest of `surfaces` hit by the ray with t in (1e-7, t_max), or nullptr; writes its t and
+// How far a ray leaving a surface starts off it, along the normal: the least t a hit may have.
+inline constexpr double kSurfaceOffset = 1e-7;
+
+// The nearest of `surfaces` hit by the ray with t in (kSurfaceOffset, t_max), or nullptr; writes its t and
 // normal (facing the ray's origin).
 const Surface* nearest_surface(const std::vector<Surface>& surfaces, const Ray& ray, double t_max, double& t, Vec3& normal);
 // Whether a surface blocks the segment from x along the unit dir over distance (infinite for the

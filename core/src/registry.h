@@ -1,4 +1,4 @@
-// Core's own rendering methods, registered by method.cpp.
+// The registry's internals, for solution.cpp.
 #pragma once
 
 #include <haze/core/method.h>
@@ -16,12 +16,5 @@ namespace haze::internal {
 
 // The value of the haze::Error a MethodSolution without lighting fields throws.
 inline constexpr const char* kNoField = "not kept by this method";
-// How far a ray leaving a surface starts off it, along the normal.
-inline constexpr double kSurfaceOffset = 1e-7;
-
-// Deterministic single scattering by numerical quadrature (quadrature.cpp).
-MethodInfo quadrature_info();
-// The unbiased volumetric path tracer every fast method is measured against (reference.cpp).
-MethodInfo reference_info();
 
 }  // namespace haze::internal

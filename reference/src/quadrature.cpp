@@ -4,7 +4,8 @@
 // with Gauss-Legendre panels along the view ray (graded geometrically toward each point light's
 // closest approach, where the integrand peaks), sky in-scattering over a Fibonacci DirectionSet, and surface direct
 // lighting with shadows. Slow and simple on purpose: it checks the fast single-scattering methods.
-#include "builtin_methods.h"
+#include <haze/reference/methods.h>
+#include <haze/core/surface.h>
 
 #include <haze/core/directions.h>
 #include <haze/core/error.h>
@@ -12,7 +13,7 @@
 
 #include <algorithm>
 
-namespace haze::internal {
+namespace haze::reference {
 
 // The method's name, written once: the registry, its settings and its errors read it here.
 constexpr const char* kQuadratureName = "quadrature";
@@ -204,4 +205,4 @@ MethodInfo quadrature_info() {
   return info;
 }
 
-}  // namespace haze::internal
+}  // namespace haze::reference

@@ -3,7 +3,8 @@
 // (Kutz et al. 2017; pbrt-v4's DDA majorants), next-event estimation to point, spot and
 // directional lights and the sky with ratio-tracked transmittance (exact for homogeneous media),
 // phase-function importance sampling, Russian roulette; planes, spheres and meshes block and reflect.
-#include "builtin_methods.h"
+#include <haze/reference/methods.h>
+#include <haze/core/surface.h>
 
 #include <haze/core/error.h>
 #include <haze/core/majorant.h>
@@ -15,7 +16,7 @@
 #include <cmath>
 #include <optional>
 
-namespace haze::internal {
+namespace haze::reference {
 
 // The method's name, written once: the registry, its settings and its errors read it here.
 constexpr const char* kReferenceName = "reference";
@@ -476,4 +477,9 @@ MethodInfo reference_info() {
   return info;
 }
 
-}  // namespace haze::internal
+void register_methods() {
+  register_method(reference_info());
+  register_method(quadrature_info());
+}
+
+}  // namespace haze::reference
