@@ -8,12 +8,17 @@
 // the depth, into the renderer's buffers, reused). Medians over the frames, each stage's least
 // memory traffic as a share of the copy bandwidth measured on the same threads first; with the
 // per-pixel layers, the froxel composite's relative RMS difference from theirs over the host's
-// floor and sky at frame 0.
+// floor and sky at frame 0, without history and with the temporal froxels' settled at frame 0's
+// camera. Stage temporal_build times TemporalFroxels (jittered slices, the history reprojected
+// and blended) on the orbit, and measures the flicker of the composite of a still camera under
+// the jitter: the frame-to-frame relative RMS change, median over frames 20 to 39, with no
+// history and with the blend.
 #include "commands.h"
 
 #include <haze/core/error.h>
 #include <haze/core/stopwatch.h>
 #include <haze/froxels/froxels.h>
+#include <haze/froxels/temporal.h>
 
 #include <algorithm>
 #include <cmath>
@@ -32,11 +37,13 @@ struct FrameArgs {
   int frames = 30, threads = 2, width = 1920, height = 1080;
   std::vector<int> froxels{160, 90, 64};
   double glow_columns = 4.0;  // FroxelGrid::glow_columns: the glow of lights in view added per pixel
+  double blend = 0.1;         // TemporalFroxels::blend
   double stage_seconds = 60.0;  // a stage stops before this many seconds have passed, after 3 frames at least
   bool json = false;
 };
 
-constexpr const char* kStages[] = {"froxel_build", "composite", "per_pixel"};
+constexpr const char* kStages[] = {"froxel_build", "composite", "per_pixel", "temporal_build"};
+constexpr int kSettled = 40;  // frames of a still camera after which the temporal froxels count as settled
 
 // Frame f's camera: an orbit of radius 6 at height 1.5 around the origin, 0.1 rad a frame.
 Camera pose(const Camera& base, int f) {
@@ -79,8 +86,10 @@ struct StageRow {
   double items = 0.0;      // froxels or pixels a frame
   double bytes = 0.0;      // the least memory traffic a frame of the stage makes (what it must write and read)
   // per_pixel: the froxel composite's relative RMS difference from the layers' composite over the
-  // host's colour, frame 0 (NaN where not measured).
-  double froxel_error = std::numeric_limits<double>::quiet_NaN();
+  // host's colour, frame 0, without history and settled (NaN where not measured).
+  double froxel_error = std::numeric_limits<double>::quiet_NaN(), settled_error = froxel_error;
+  // temporal_build: the still camera's flicker without history and with it.
+  double flicker_without = froxel_error, flicker_with = froxel_error;
 };
 
 // Times `stage` frame by frame; `frame(f)` runs frame f's work and returns its milliseconds.
@@ -93,6 +102,34 @@ std::vector<double> time_frames(const FrameArgs& a, Frame frame) {
     if (f >= 2 && total.seconds() > a.stage_seconds) break;
   }
   return ms;
+}
+
+// The froxels composited over `colour` with the glow of lights in view added.
+void composite_frame(const Solution& solution, const Camera& camera, const Froxels& froxels, const std::vector<float>& depth, const Image& colour,
+                     Image& out, int threads) {
+  out.data() = colour.data();
+  const ImageSpan target{out.data().data(), out.width(), out.height()};
+  composite_froxels(froxels, ConstImageSpan{out.data().data(), out.width(), out.height()}, depth, target, threads);
+  add_glow(solution, camera, froxels, depth, target, threads);
+}
+
+// The temporal froxels of a still camera (frame 0's) with `blend`: after kSettled frames their
+// composite in `settled`; with `flicker`, the median over frames 20 to kSettled - 1 of the
+// composite's frame-to-frame relative RMS change.
+Image settle(const Solution& solution, const Camera& camera, const FroxelGrid& grid, double blend, const RenderOptions& options, double* flicker = nullptr) {
+  const std::vector<float> depth = floor_depth(camera);
+  const Image colour = host_colour(depth, camera.width_px, camera.height_px);
+  TemporalFroxels temporal;
+  temporal.blend = blend;
+  Image last(camera.width_px, camera.height_px), now(camera.width_px, camera.height_px);
+  std::vector<double> change;
+  for (int f = 0; f < kSettled; ++f) {
+    composite_frame(solution, camera, temporal.build(solution, camera, grid, options), depth, colour, now, options.threads);
+    if (f >= 20) change.push_back(relative_rmse(now, last));
+    std::swap(now, last);
+  }
+  if (flicker) *flicker = median(change);
+  return last;
 }
 
 std::vector<StageRow> run_scene(const std::filesystem::path& file, const FrameArgs& a) {
@@ -130,7 +167,7 @@ std::vector<StageRow> run_scene(const std::filesystem::path& file, const FrameAr
                       return 1e3 * watch.seconds();
                     }), pixels, 28.0 * pixels});  // colour read and written, depth read
   if (wanted(kStages[2])) {
-    double error = std::numeric_limits<double>::quiet_NaN();
+    double error = std::numeric_limits<double>::quiet_NaN(), settled = error;
     Image inscatter(a.width, a.height), transmittance(a.width, a.height);  // the renderer's layer buffers, reused
     rows.push_back({name, method, kStages[2], time_frames(a, [&](int f) {
                       const Camera camera = pose(scene.camera, f);
@@ -143,16 +180,28 @@ std::vector<StageRow> run_scene(const std::filesystem::path& file, const FrameAr
                       if (f == 0) {  // the froxels' composite against the layers', over the host's floor and sky
                         const Image colour = host_colour(depth, a.width, a.height);
                         build_froxels(solution, camera, froxels, grid, options);
-                        Image froxel = composite_froxels(froxels, colour, depth, a.threads);
-                        add_glow(solution, camera, froxels, depth, ImageSpan{froxel.data().data(), a.width, a.height}, a.threads);
-                        Image exact(a.width, a.height);
+                        Image froxel(a.width, a.height), exact(a.width, a.height);
+                        composite_frame(solution, camera, froxels, depth, colour, froxel, a.threads);
                         for (int y = 0; y < a.height; ++y)
                           for (int x = 0; x < a.width; ++x) exact.set(x, y, inscatter.at(x, y) + transmittance.at(x, y) * colour.at(x, y));
                         error = relative_rmse(froxel, exact);
+                        settled = relative_rmse(settle(solution, camera, grid, a.blend, options), exact);
                       }
                       return ms;
                     }), pixels, 28.0 * pixels});  // L_in and T written, depth read
-    rows.back().froxel_error = error;
+    rows.back().froxel_error = error, rows.back().settled_error = settled;
+  }
+  if (wanted(kStages[3])) {
+    TemporalFroxels temporal;
+    temporal.blend = a.blend;
+    rows.push_back({name, method, kStages[3], time_frames(a, [&](int f) {
+                      const Camera camera = pose(scene.camera, f);
+                      const Stopwatch watch;
+                      temporal.build(solution, camera, grid, options);
+                      return 1e3 * watch.seconds();
+                    }), static_cast<double>(grid.nx) * grid.ny * grid.nz, 72.0 * grid.nx * grid.ny * grid.nz});  // written, then the history read and blended
+    settle(solution, pose(scene.camera, 0), grid, 1.0, options, &rows.back().flicker_without);
+    settle(solution, pose(scene.camera, 0), grid, a.blend, options, &rows.back().flicker_with);
   }
   return rows;
 }
@@ -176,7 +225,7 @@ double copy_bandwidth(int threads) {
 int run(const FrameArgs& a) {
   for (const std::string& s : a.stages)
     if (std::find(std::begin(kStages), std::end(kStages), s) == std::end(kStages))
-      throw Error("--stage", s, "froxel_build, composite or per_pixel");
+      throw Error("--stage", s, "froxel_build, composite, per_pixel or temporal_build");
   std::vector<std::filesystem::path> files;
   std::error_code ec;
   for (const auto& entry : std::filesystem::directory_iterator(a.scenes, ec))
@@ -188,7 +237,7 @@ int run(const FrameArgs& a) {
   nlohmann::json out = nlohmann::json::array();
   const double bandwidth = copy_bandwidth(a.threads);
   if (!a.json)
-    std::printf("%dx%d, %d x %d x %d froxels, %d threads; medians over the frames; copy bandwidth %.1f GB/s\n%-18s %-12s %-13s %10s %7s %12s %10s\n",
+    std::printf("%dx%d, %d x %d x %d froxels, %d threads; medians over the frames; copy bandwidth %.1f GB/s\n%-18s %-12s %-14s %10s %7s %12s %10s\n",
                 a.width, a.height, a.froxels[0], a.froxels[1], a.froxels[2], a.threads, 1e-9 * bandwidth, "scene", "method", "stage", "median ms",
                 "frames", "ns per item", "of copy bw");
   for (const auto& file : files)
@@ -196,10 +245,15 @@ int run(const FrameArgs& a) {
       const double m = median(r.ms), ns = 1e6 * m / r.items, share = r.bytes / (1e-3 * m) / bandwidth;
       out.push_back({{"scene", r.scene}, {"method", r.method}, {"stage", r.stage}, {"median_ms", m}, {"frames", r.ms.size()}, {"items", r.items},
                      {"ns_per_item", ns}, {"bytes", r.bytes}, {"bandwidth_share", share}});
-      if (!std::isnan(r.froxel_error)) out.back()["froxel_error"] = r.froxel_error;
+      if (!std::isnan(r.froxel_error)) out.back()["froxel_error"] = r.froxel_error, out.back()["settled_error"] = r.settled_error;
+      if (!std::isnan(r.flicker_with)) out.back()["flicker_without"] = r.flicker_without, out.back()["flicker_with"] = r.flicker_with;
       if (!a.json) {
-        std::printf("%-18s %-12s %-13s %10.1f %7zu %12.2f %9.1f%%", r.scene.c_str(), r.method.c_str(), r.stage.c_str(), m, r.ms.size(), ns, 100.0 * share);
-        if (!std::isnan(r.froxel_error)) std::printf("  (froxel composite %.2f%% off)", 100.0 * r.froxel_error);
+        std::printf("%-18s %-12s %-14s %10.1f %7zu %12.2f %9.1f%%", r.scene.c_str(), r.method.c_str(), r.stage.c_str(), m, r.ms.size(), ns, 100.0 * share);
+        if (!std::isnan(r.froxel_error))
+          std::printf("  (froxel composite %.2f%% off, %.2f%% with settled history)", 100.0 * r.froxel_error, 100.0 * r.settled_error);
+        if (!std::isnan(r.flicker_with))
+          std::printf("  (still camera's flicker %.3f%% without history, %.3f%% with: %.1fx less)", 100.0 * r.flicker_without, 100.0 * r.flicker_with,
+                      r.flicker_without / r.flicker_with);
         std::printf("\n");
       }
       std::fflush(stdout);
@@ -215,7 +269,7 @@ Command add_bench_frame(CLI::App& bench) {
   auto a = std::make_shared<FrameArgs>();
   sub->add_option("--scenes", a->scenes, "Directory of the frame scenes, each naming its method")->capture_default_str();
   sub->add_option("--scene", a->only, "Only these scenes (by file stem)");
-  sub->add_option("--stage", a->stages, "Only these stages: froxel_build, composite, per_pixel");
+  sub->add_option("--stage", a->stages, "Only these stages: froxel_build, composite, per_pixel, temporal_build");
   sub->add_option("--frames", a->frames, "Frames per stage")->capture_default_str()->check(CLI::Range(1, 100000));
   sub->add_option("--stage-seconds", a->stage_seconds, "A stage stops after this long (3 frames at least)")->capture_default_str()->check(CLI::PositiveNumber);
   sub->add_option("--threads", a->threads, "Thread cap (0: all cores)")->capture_default_str()->check(CLI::NonNegativeNumber);
@@ -224,7 +278,8 @@ Command add_bench_frame(CLI::App& bench) {
   sub->add_option("--froxels", a->froxels, "Froxel columns across, down and slices")->expected(3)->capture_default_str()->check(CLI::Range(1, 4096));
   sub->add_option("--glow-columns", a->glow_columns, "FroxelGrid::glow_columns: lights' glow within this many columns added per pixel (0: none)")
       ->capture_default_str()->check(CLI::Range(0.0, 16.0));
-  sub->add_flag("--json", a->json, "Print a JSON list of {scene, method, stage, median_ms, frames, items, ns_per_item, bytes, bandwidth_share[, froxel_error]}");
+  sub->add_option("--blend", a->blend, "TemporalFroxels::blend, the new frame's weight")->capture_default_str()->check(CLI::Range(1e-3, 1.0));
+  sub->add_flag("--json", a->json, "Print a JSON list of {scene, method, stage, median_ms, frames, items, ns_per_item, bytes, bandwidth_share[, froxel_error, settled_error][, flicker_without, flicker_with]}");
   return {sub, [a] { return run(*a); }};
 }
 

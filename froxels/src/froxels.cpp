@@ -4,6 +4,8 @@
 
 #include <haze/froxels/composite_row.h>
 
+#include "build.h"
+
 #include <glm/ext/matrix_clip_space.hpp>
 #include <glm/ext/matrix_transform.hpp>
 #include <glm/trigonometric.hpp>
@@ -15,9 +17,8 @@
 
 namespace haze {
 
-namespace {
+namespace froxels_detail {
 
-// The camera whose pixels are the grid's columns: the same frustum at nx x ny.
 Camera column_camera(const Camera& c, int nx, int ny) {
   const double aspect = static_cast<double>(c.width_px) / c.height_px;
   switch (c.type) {
@@ -39,6 +40,10 @@ Camera column_camera(const Camera& c, int nx, int ny) {
     for (int i = 0; i < nx; ++i) rays->push_back(c.generate_ray((i + 0.5) * c.width_px / nx, (j + 0.5) * c.height_px / ny));
   return Camera::from_rays(rays, nx, ny);
 }
+
+}  // namespace froxels_detail
+
+namespace {
 
 void check(const FroxelGrid& g) {
   for (const auto& [name, n] : {std::pair{"nx", g.nx}, std::pair{"ny", g.ny}, std::pair{"nz", g.nz}})
@@ -90,14 +95,15 @@ PixelLayers Froxels::sample(double u, double v, double d) const {
   return out;
 }
 
-void build_froxels(const Solution& solution, const Camera& camera, Froxels& out, const FroxelGrid& grid, const RenderOptions& options) {
+void froxels_detail::build(const Solution& solution, const Camera& camera, Froxels& out, const FroxelGrid& grid, double jitter,
+                           const RenderOptions& options) {
   check(grid);
   out.grid = grid;
   const size_t froxels = static_cast<size_t>(grid.nx) * static_cast<size_t>(grid.ny) * static_cast<size_t>(grid.nz);
   out.inscatter.resize(froxels);
   out.transmittance.resize(froxels);
   std::array<double, 4096> boundaries;
-  for (int k = 0; k < grid.nz; ++k) boundaries[static_cast<size_t>(k)] = grid.boundary(k);
+  for (int k = 0; k < grid.nz; ++k) boundaries[static_cast<size_t>(k)] = grid.near * std::pow(grid.far / grid.near, (k + 1 + jitter) / grid.nz);
   const Camera columns = column_camera(camera, grid.nx, grid.ny);
   // The glow angle: glow_columns times the angle between the middle column and its neighbour.
   out.glow_angle = 0.0;
@@ -108,6 +114,10 @@ void build_froxels(const Solution& solution, const Camera& camera, Froxels& out,
   }
   solution.render_distances(View{columns}, std::span<const double>(boundaries.data(), static_cast<size_t>(grid.nz)),
                             DistanceLayers{out.inscatter, out.transmittance, out.glow_angle}, options);
+}
+
+void build_froxels(const Solution& solution, const Camera& camera, Froxels& out, const FroxelGrid& grid, const RenderOptions& options) {
+  froxels_detail::build(solution, camera, out, grid, 0.0, options);
 }
 
 Froxels build_froxels(const Solution& solution, const Camera& camera, const FroxelGrid& grid, const RenderOptions& options) {

@@ -2,8 +2,10 @@
 // program replaces the global operator new to count every allocation made through it, on any
 // thread. The CPU composite into the caller's memory allocates nothing, and neither do the
 // froxel build of analytic or propagation, the glow of lights in view and analytic's per-pixel
-// layers into the caller's buffers once each thread's kept row buffers have grown.
+// layers into the caller's buffers once each thread's kept row buffers have grown; nor do the
+// temporal froxels' reprojection and blend.
 #include <haze/froxels/froxels.h>
+#include <haze/froxels/temporal.h>
 
 #include <gtest/gtest.h>
 
@@ -50,6 +52,21 @@ void expect_none_per_frame(int threads, Frame frame) {
   else EXPECT_LT(allocated, 10) << threads << " threads, 20 frames";
 }
 
+// expect_none_per_frame on 1 and 2 threads, frame(camera, options) with the camera moved along x
+// by `step` a frame.
+template <class Frame>
+void expect_none_per_moving_frame(const Camera& start, double step, Frame frame) {
+  for (int threads : {1, 2}) {
+    RenderOptions options;
+    options.threads = threads;
+    Camera camera = start;
+    expect_none_per_frame(threads, [&](int f) {
+      camera.position.x = 0.2 + step * f;
+      frame(camera, options);
+    });
+  }
+}
+
 TEST(FrameAllocations, TheCompositeIntoCallerMemoryAllocatesNothing) {
   const Scene scene = testing::fog_box(64, 36);
   const Solution solution = prepare(scene, "analytic");
@@ -79,17 +96,22 @@ TEST(FrameAllocations, TheFroxelBuildAllocatesNothingAfterTheFirstFrames) {
     if (std::string(method) == "propagation") prepared.settings = {{"resolution", 16}};
     const Solution solution = prepare(scene, method, prepared);
     Froxels froxels;
-    for (int threads : {1, 2}) {
-      RenderOptions options;
-      options.threads = threads;
-      Camera camera = scene.camera;
-      expect_none_per_frame(threads, [&](int f) {
-        camera.position.x = 0.2 + 0.05 * f;
-        build_froxels(solution, camera, froxels, grid, options);
-        add_glow(solution, camera, froxels, depth, ImageSpan{out.data(), 64, 36}, threads);
-      });
-    }
+    expect_none_per_moving_frame(scene.camera, 0.05, [&](const Camera& camera, const RenderOptions& options) {
+      build_froxels(solution, camera, froxels, grid, options);
+      add_glow(solution, camera, froxels, depth, ImageSpan{out.data(), 64, 36}, options.threads);
+    });
   }
+}
+
+// The temporal froxels, the camera moving: the build, the history's reprojection and its blend
+// reuse their two volumes.
+TEST(FrameAllocations, TheTemporalFroxelsAllocateNothingAfterTheFirstFrames) {
+  const Scene scene = testing::fog_box(64, 36, Vec3(0.1, -0.1, 0.4));
+  const Solution solution = prepare(scene, "analytic");
+  TemporalFroxels temporal;
+  expect_none_per_moving_frame(scene.camera, 0.01, [&](const Camera& camera, const RenderOptions& options) {
+    temporal.build(solution, camera, FroxelGrid{16, 9, 12, 0.1, 20.0, 4.0}, options);
+  });
 }
 
 // The per-pixel layers into the caller's buffers (render_layers), the camera moving: analytic's
@@ -99,15 +121,9 @@ TEST(FrameAllocations, TheAnalyticLayersIntoCallerMemoryAllocateNothing) {
   const Solution solution = prepare(scene, "analytic");
   std::vector<float> l(3 * 64 * 36), t(l.size()), c(l.size());
   const std::vector<float> depth(64 * 36, 3.0f);
-  for (int threads : {1, 2}) {
-    RenderOptions options;
-    options.threads = threads;
-    Camera camera = scene.camera;
-    expect_none_per_frame(threads, [&](int f) {
-      camera.position.x = 0.2 + 0.05 * f;
-      solution.render_layers(View{camera, depth}, {ImageSpan{l.data(), 64, 36}, ImageSpan{t.data(), 64, 36}, ImageSpan{c.data(), 64, 36}}, options);
-    });
-  }
+  expect_none_per_moving_frame(scene.camera, 0.05, [&](const Camera& camera, const RenderOptions& options) {
+    solution.render_layers(View{camera, depth}, {ImageSpan{l.data(), 64, 36}, ImageSpan{t.data(), 64, 36}, ImageSpan{c.data(), 64, 36}}, options);
+  });
 }
 
 }  // namespace

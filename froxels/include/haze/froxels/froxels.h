@@ -37,9 +37,10 @@ struct FroxelGrid {
 struct Froxels {
   FroxelGrid grid;
   double glow_angle = 0.0;  // grid.glow_columns as an angle from the eye (radians), what add_glow adds
-  // [(k * ny + j) * nx + i]: L_in and T along column (i, j)'s ray from the camera to boundary(k).
-  // Column (i, j) is the camera's ray through film position ((i + 0.5) W / nx, (j + 0.5) H / ny)
-  // of its W x H image, rows top to bottom.
+  // [(k * ny + j) * nx + i]: L_in and T along column (i, j)'s ray from the camera to boundary(k)
+  // (TemporalFroxels: to the frame's jittered boundary, held as boundary(k)'s). Column (i, j) is
+  // the camera's ray through film position ((i + 0.5) W / nx, (j + 0.5) H / ny) of its W x H
+  // image, rows top to bottom.
   std::vector<Vec3f> inscatter, transmittance;
 
   // The layers at film position (u, v) in [0, 1]^2 of the image (u across, v down) and distance d
