@@ -183,7 +183,8 @@ void AirlightTable::refine() {
   std::vector<float> log_t(t_.size());
   // T > 0 but for underflow: log 1e-30 is e^-69 below every value the lanes can resolve.
   for (size_t k = 0; k < t_.size(); ++k) log_t[k] = std::log(std::max(t_[k], 1e-30f));
-  log_fine_.assign(static_cast<size_t>(fine_eta_samples()) * na, 0.0f);
+  const auto nf = static_cast<size_t>(fine_eta_samples());
+  log_fine_.assign(nf * na, 0.0f);
   for (int fine = 0; fine < fine_eta_samples(); ++fine) {
     const int j = std::min(fine / kFineEta, neta_ - 2);
     double w[4];
@@ -191,7 +192,7 @@ void AirlightTable::refine() {
     for (size_t i = 0; i < na; ++i) {
       double v = 0.0;
       for (int k = 0; k < 4; ++k) v += w[k] * static_cast<double>(log_t[static_cast<size_t>(std::clamp(j - 1 + k, 0, neta_ - 1)) * na + i]);
-      log_fine_[static_cast<size_t>(fine) * na + i] = static_cast<float>(v);
+      log_fine_[i * nf + static_cast<size_t>(fine)] = static_cast<float>(v);
     }
   }
 }

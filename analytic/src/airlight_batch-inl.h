@@ -31,9 +31,10 @@ HWY_INLINE V LogTail(D d, const float* HWY_RESTRICT table, int na, int ne, float
   V fi = hn::Min(hn::Floor(fa), hn::Set(d, static_cast<float>(na - 2)));
   V fj = hn::Min(hn::Floor(fe), hn::Set(d, static_cast<float>(ne - 2)));
   V x = hn::Sub(fa, fi), y = hn::Sub(fe, fj);
-  auto index = hn::ConvertTo(di, hn::MulAdd(fj, hn::Set(d, static_cast<float>(na)), fi));
-  V t00 = hn::GatherIndex(d, table, index), t10 = hn::GatherIndex(d, table + 1, index);
-  V t01 = hn::GatherIndex(d, table + na, index), t11 = hn::GatherIndex(d, table + na + 1, index);
+  // The table is eta fastest: the next a is ne values on, the next eta the next value.
+  auto index = hn::ConvertTo(di, hn::MulAdd(fi, hn::Set(d, static_cast<float>(ne)), fj));
+  V t00 = hn::GatherIndex(d, table, index), t10 = hn::GatherIndex(d, table + ne, index);
+  V t01 = hn::GatherIndex(d, table + 1, index), t11 = hn::GatherIndex(d, table + ne + 1, index);
   V t0 = hn::MulAdd(x, hn::Sub(t10, t00), t00), t1 = hn::MulAdd(x, hn::Sub(t11, t01), t01);
   scale = hn::Div(hn::Set(d, 2.0f), hn::Mul(hn::Add(one, w), hn::Add(one, a)));
   return hn::MulAdd(y, hn::Sub(t1, t0), t0);
@@ -125,36 +126,44 @@ HWY_NOINLINE void TailSums(const float* HWY_RESTRICT table, int na, int ne, floa
   }
 }
 
-HWY_NOINLINE void AirlightSlice(const float* HWY_RESTRICT table, int na, int ne, float eta_max, const TailRow& row, float distance,
-                                float* HWY_RESTRICT inscatter, float* HWY_RESTRICT transmittance) {
+// Slices `distances` of the row, a vector of rays through every slice before the next vector:
+// a ray's neighbouring slices look up neighbouring table values, still in cache.
+HWY_NOINLINE void AirlightSlices(const float* HWY_RESTRICT table, int na, int ne, float eta_max, const TailRow& row, const float* distances,
+                                 size_t slices, float* HWY_RESTRICT inscatter, float* HWY_RESTRICT transmittance, size_t slice_stride) {
   const hn::ScalableTag<float> d;
   using V = hn::Vec<decltype(d)>;
   const size_t lanes = hn::Lanes(d);
   const bool grey = row.sigma_t[0] == row.sigma_t[1] && row.sigma_t[1] == row.sigma_t[2];
-  const V zero = hn::Zero(d), one = hn::Set(d, 1.0f), at_slice = hn::Set(d, distance);
+  const V zero = hn::Zero(d), one = hn::Set(d, 1.0f);
   HWY_ALIGN float tail[3 * HWY_MAX_BYTES / sizeof(float)];
   for (size_t i = 0; i < row.count; i += lanes) {
     const V t0 = hn::LoadU(d, row.t0 + i), t1 = hn::LoadU(d, row.t1 + i);
-    const auto outside = hn::Or(hn::Le(at_slice, t0), hn::Le(t1, t0));
-    const V at = hn::Min(hn::Max(at_slice, t0), t1), inside = hn::Sub(at, t0);
-    V s0, s1, s2;
-    SumTails(d, table, na, ne, eta_max, row, i, at, s0, s1, s2);
-    const V T0 = hn::Exp(d, hn::Mul(hn::Set(d, -row.sigma_t[0]), inside));
-    const V T1 = grey ? T0 : hn::Exp(d, hn::Mul(hn::Set(d, -row.sigma_t[1]), inside));
-    const V T2 = grey ? T0 : hn::Exp(d, hn::Mul(hn::Set(d, -row.sigma_t[2]), inside));
-    const V l0 = hn::IfThenZeroElse(outside, hn::Max(zero, hn::NegMulAdd(T0, s0, hn::LoadU(d, row.whole[0] + i))));
-    const V l1 = hn::IfThenZeroElse(outside, hn::Max(zero, hn::NegMulAdd(T1, s1, hn::LoadU(d, row.whole[1] + i))));
-    const V l2 = hn::IfThenZeroElse(outside, hn::Max(zero, hn::NegMulAdd(T2, s2, hn::LoadU(d, row.whole[2] + i))));
-    const V u0 = hn::IfThenElse(outside, one, T0), u1 = hn::IfThenElse(outside, one, T1), u2 = hn::IfThenElse(outside, one, T2);
-    if (i + lanes <= row.count) {
-      hn::StoreInterleaved3(l0, l1, l2, d, inscatter + 3 * i);
-      hn::StoreInterleaved3(u0, u1, u2, d, transmittance + 3 * i);
-    } else {  // the row's last, partial vector
-      const size_t n = 3 * (row.count - i);
-      hn::StoreInterleaved3(l0, l1, l2, d, tail);
-      std::copy_n(tail, n, inscatter + 3 * i);
-      hn::StoreInterleaved3(u0, u1, u2, d, tail);
-      std::copy_n(tail, n, transmittance + 3 * i);
+    const V whole0 = hn::LoadU(d, row.whole[0] + i), whole1 = hn::LoadU(d, row.whole[1] + i), whole2 = hn::LoadU(d, row.whole[2] + i);
+    for (size_t k = 0; k < slices; ++k) {
+      const V at_slice = hn::Set(d, distances[k]);
+      const auto outside = hn::Or(hn::Le(at_slice, t0), hn::Le(t1, t0));
+      const V at = hn::Min(hn::Max(at_slice, t0), t1), inside = hn::Sub(at, t0);
+      V s0, s1, s2;
+      SumTails(d, table, na, ne, eta_max, row, i, at, s0, s1, s2);
+      const V T0 = hn::Exp(d, hn::Mul(hn::Set(d, -row.sigma_t[0]), inside));
+      const V T1 = grey ? T0 : hn::Exp(d, hn::Mul(hn::Set(d, -row.sigma_t[1]), inside));
+      const V T2 = grey ? T0 : hn::Exp(d, hn::Mul(hn::Set(d, -row.sigma_t[2]), inside));
+      const V l0 = hn::IfThenZeroElse(outside, hn::Max(zero, hn::NegMulAdd(T0, s0, whole0)));
+      const V l1 = hn::IfThenZeroElse(outside, hn::Max(zero, hn::NegMulAdd(T1, s1, whole1)));
+      const V l2 = hn::IfThenZeroElse(outside, hn::Max(zero, hn::NegMulAdd(T2, s2, whole2)));
+      const V u0 = hn::IfThenElse(outside, one, T0), u1 = hn::IfThenElse(outside, one, T1), u2 = hn::IfThenElse(outside, one, T2);
+      float* const l_out = inscatter + k * slice_stride + 3 * i;
+      float* const t_out = transmittance + k * slice_stride + 3 * i;
+      if (i + lanes <= row.count) {
+        hn::StoreInterleaved3(l0, l1, l2, d, l_out);
+        hn::StoreInterleaved3(u0, u1, u2, d, t_out);
+      } else {  // the row's last, partial vector
+        const size_t n = 3 * (row.count - i);
+        hn::StoreInterleaved3(l0, l1, l2, d, tail);
+        std::copy_n(tail, n, l_out);
+        hn::StoreInterleaved3(u0, u1, u2, d, tail);
+        std::copy_n(tail, n, t_out);
+      }
     }
   }
 }

@@ -18,7 +18,7 @@ namespace haze::analytic {
 
 HWY_EXPORT(AirlightBatch);
 HWY_EXPORT(TailSums);
-HWY_EXPORT(AirlightSlice);
+HWY_EXPORT(AirlightSlices);
 
 namespace {
 
@@ -32,8 +32,8 @@ float log_tail_scalar(const AirlightTable& table, float u, float eta, float w, f
   float fe = (std::clamp(eta, -eta_max, eta_max) + eta_max) * (static_cast<float>(ne - 1) / (2.0f * eta_max));
   float fi = std::min(std::floor(fa), static_cast<float>(na - 2)), fj = std::min(std::floor(fe), static_cast<float>(ne - 2));
   float x = fa - fi, y = fe - fj;
-  const float* t = table.log_fine_values().data() + static_cast<size_t>(fj * static_cast<float>(na) + fi);
-  float t0 = t[0] + x * (t[1] - t[0]), t1 = t[na] + x * (t[na + 1] - t[na]);
+  const float* t = table.log_fine_values().data() + static_cast<size_t>(fi * static_cast<float>(ne) + fj);  // eta fastest
+  float t0 = t[0] + x * (t[ne] - t[0]), t1 = t[1] + x * (t[ne + 1] - t[1]);
   scale = 2.0f / ((1.0f + w) * (1.0f + a));
   return t0 + y * (t1 - t0);
 }
@@ -92,9 +92,15 @@ void tail_sums(const AirlightTable& table, const TailRow& row, const float* d, f
                                  static_cast<float>(AirlightTable::kEtaMax), row, d, sums);
 }
 
+void airlight_slices(const AirlightTable& table, const TailRow& row, std::span<const float> distances, float* inscatter, float* transmittance,
+                     size_t slice_stride) {
+  HWY_DYNAMIC_DISPATCH(AirlightSlices)(table.log_fine_values().data(), table.a_samples(), table.fine_eta_samples(),
+                                       static_cast<float>(AirlightTable::kEtaMax), row, distances.data(), distances.size(), inscatter,
+                                       transmittance, slice_stride);
+}
+
 void airlight_slice(const AirlightTable& table, const TailRow& row, float distance, float* inscatter, float* transmittance) {
-  HWY_DYNAMIC_DISPATCH(AirlightSlice)(table.log_fine_values().data(), table.a_samples(), table.fine_eta_samples(),
-                                      static_cast<float>(AirlightTable::kEtaMax), row, distance, inscatter, transmittance);
+  airlight_slices(table, row, std::span<const float>(&distance, 1), inscatter, transmittance, 0);
 }
 
 void tail_sums_reference(const AirlightTable& table, const TailRow& row, const float* d, float* const sums[3]) {

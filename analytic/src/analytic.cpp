@@ -237,7 +237,7 @@ class AnalyticSolution final : public MethodSolution {
   }
   bool renders_layers() const override { return true; }
 
-  // Point lights without surfaces, a row of rays per slice in SIMD lanes (airlight_slice): with
+  // Point lights without surfaces, a row of rays in SIMD lanes through the slices (airlight_slices): with
   // [t0, t1] a ray's stretch in the medium, L_in(d) = sum of sigma_s I (g(t0) - T(d) g(d)), one
   // unit tail per ray, light and distance, the ray's geometry toward each light in float64 once.
   // Its error is the table's relative to the whole ray's in-scatter, not to L_in(d): at most 1e-3
@@ -341,6 +341,8 @@ class AnalyticSolution final : public MethodSolution {
     float* const whole = t1 + padded;  // three channels
     float* const geometry = whole + 3 * padded;  // per light: t, h, share
     const Aabb bounds = medium_->bounds();
+    // A light within the glow angle of a ray's direction: t > 0 and h < t tan(angle) (angle <= 0.5).
+    const double tan_glow = std::tan(glow_angle);
     for (size_t x = 0; x < count; ++x) {
       const Ray& ray = rays[x];
       double a = 0.0, b = kInfinity;
@@ -352,7 +354,7 @@ class AnalyticSolution final : public MethodSolution {
         const double t = glm::dot(to_light, ray.direction), h = glm::length(to_light - t * ray.direction);
         float* g = geometry + 3 * l * padded;
         g[x] = static_cast<float>(t), g[padded + x] = static_cast<float>(h);
-        const double share = glow_angle > 0.0 ? glow_share(std::atan2(h, t), glow_angle) : 0.0;
+        const double share = glow_angle > 0.0 && t > 0.0 && h < t * tan_glow ? glow_share(std::atan2(h, t), glow_angle) : 0.0;
         g[2 * padded + x] = static_cast<float>(left ? share : 1.0 - share);
       }
     }
@@ -380,11 +382,10 @@ class AnalyticSolution final : public MethodSolution {
     camera.row_rays(y, rays.data());
     const RowRays r = ray_tails(rays.data(), width, glow_angle, lights_.size(), false);
     tail_sums(table_, r.row, r.t0, r.whole);
+    thread_local std::vector<float> at;
+    at.assign(distances.begin(), distances.end());
     const size_t rays_per_slice = width * static_cast<size_t>(camera.height_px), first = static_cast<size_t>(y) * width;
-    for (size_t k = 0; k < distances.size(); ++k) {
-      const size_t at = k * rays_per_slice + first;
-      airlight_slice(table_, r.row, static_cast<float>(distances[k]), &out.inscatter[at].x, &out.transmittance[at].x);
-    }
+    airlight_slices(table_, r.row, at, &out.inscatter[first].x, &out.transmittance[first].x, 3 * rays_per_slice);
   }
 
   // The ends in the medium of rays [x0, x0 + count) of row y (the view's depth or t1; t0 where the
@@ -487,8 +488,9 @@ class AnalyticSolution final : public MethodSolution {
     for (size_t i = 0; i < count; ++i) {
       if (!(ends[i] > r.t0[i])) continue;
       float* pixel = out.pixel(x0 + static_cast<int>(i), y);
+      double T = 0.0;
       for (int c = 0; c < 3; ++c) {
-        const double T = std::isfinite(ends[i]) ? std::exp(-sigma_t_[c] * static_cast<double>(ends[i] - r.t0[i])) : 0.0;
+        if (c == 0 || !grey_) T = std::isfinite(ends[i]) ? std::exp(-sigma_t_[c] * static_cast<double>(ends[i] - r.t0[i])) : 0.0;
         pixel[c] += static_cast<float>(std::max(0.0, static_cast<double>(whole[c][i]) - T * static_cast<double>(sums[c][i])));
       }
     }

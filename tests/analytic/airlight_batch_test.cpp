@@ -149,6 +149,18 @@ TEST_P(AirlightBatchTargets, SlicesMatchScalarReference) {
           ASSERT_NEAR(t[i], t_ref[i], 1e-6f * t_ref[i]) << "ray " << i / 3 << " at " << distance;
         }
       }
+      // Every slice at once, slice-major with room between slices, is each slice alone.
+      const std::vector<float> distances{0.05f, 0.4f, 2.0f, 30.0f};
+      const size_t stride = 3 * n + 5;
+      std::vector<float> l(stride * distances.size(), -1.0f), t(l.size(), -1.0f);
+      airlight_slices(table(), r.row, distances, l.data(), t.data(), stride);
+      for (size_t k = 0; k < distances.size(); ++k) {
+        std::vector<float> l_one(3 * n), t_one(3 * n);
+        airlight_slice(table(), r.row, distances[k], l_one.data(), t_one.data());
+        EXPECT_TRUE(std::equal(l_one.begin(), l_one.end(), l.begin() + static_cast<std::ptrdiff_t>(k * stride))) << "slice " << k;
+        EXPECT_TRUE(std::equal(t_one.begin(), t_one.end(), t.begin() + static_cast<std::ptrdiff_t>(k * stride))) << "slice " << k;
+        EXPECT_EQ(l[k * stride + 3 * n], -1.0f) << "written past slice " << k;
+      }
     }
 }
 

@@ -12,6 +12,7 @@
 #include <haze/analytic/airlight.h>
 
 #include <cstddef>
+#include <span>
 
 #pragma GCC visibility push(default)  // the public API: exported from shared builds
 
@@ -50,6 +51,11 @@ void tail_sums(const AirlightTable& table, const TailRow& row, const float* d, f
 // Slice `distance` of the row: L_in and T per ray as RGB triples into inscatter[3 i + c] and
 // transmittance[3 i + c] (count rays each): before t0 L_in 0 and T 1, past t1 their values at t1.
 void airlight_slice(const AirlightTable& table, const TailRow& row, float distance, float* inscatter, float* transmittance);
+// Every slice of `distances` the same way, slice k into inscatter[k slice_stride + 3 i + c]
+// (likewise transmittance): a vector of rays through all the slices before the next, so that a
+// ray's neighbouring slices find their table values in cache.
+void airlight_slices(const AirlightTable& table, const TailRow& row, std::span<const float> distances, float* inscatter, float* transmittance,
+                     size_t slice_stride);
 // The scalar references: the same float32 formulas, one ray at a time.
 void tail_sums_reference(const AirlightTable& table, const TailRow& row, const float* d, float* const sums[3]);
 void airlight_slice_reference(const AirlightTable& table, const TailRow& row, float distance, float* inscatter, float* transmittance);
