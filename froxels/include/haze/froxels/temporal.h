@@ -7,8 +7,6 @@
 
 #include <haze/froxels/froxels.h>
 
-#include <glm/vec4.hpp>
-
 #include <array>
 #include <vector>
 
@@ -40,19 +38,12 @@ class TemporalFroxels {
   // The jitter of frame n, in slices.
   static double jitter_of(long long n);
 
-  // What the reprojection needs of column (i, j)'s ray o + d u: the point's clip coordinates in
-  // the previous frame, A + d B, and |o + d u - previous eye|^2 = dd + d (du2 + d).
-  struct ColumnToPrevious {
-    glm::vec4 A, B;
-    float dd, du2;
-  };
-
  private:
   std::array<Froxels, 2> frames_;
   int current_ = 0;
   long long frames_built_ = 0, frame_ = 0;
   Camera camera_;  // the last frame's
-  std::vector<ColumnToPrevious> columns_;
+  std::vector<float> columns_;  // the reprojection's per column (reproject_row.h)
 };
 
 }  // namespace haze
