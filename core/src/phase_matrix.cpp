@@ -34,9 +34,15 @@ PhaseMatrix::PhaseMatrix(const PhaseFunction& phase, const DirectionSet& directi
 }
 
 Eigen::VectorXd PhaseMatrix::row(const Vec3& w) const {
-  Eigen::VectorXd r(size());
-  for (int j = 0; j < size(); ++j) r(j) = phase_.eval(glm::dot(w, directions_[j])) * directions_.weight(j) * scaling_(j);
-  return r / r.sum();
+  Eigen::VectorXd r;
+  row(w, r);
+  return r;
+}
+
+void PhaseMatrix::row(const Vec3& w, Eigen::VectorXd& out) const {
+  out.resize(size());
+  for (int j = 0; j < size(); ++j) out(j) = phase_.eval(glm::dot(w, directions_[j])) * directions_.weight(j) * scaling_(j);
+  out /= out.sum();
 }
 
 SeparablePhase::SeparablePhase(const PhaseMatrix& matrix, int terms) {

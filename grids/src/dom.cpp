@@ -15,6 +15,8 @@
 #include "dom_internal.h"
 
 #include <algorithm>
+#include <memory>
+#include <mutex>
 #include <cmath>
 
 namespace haze::grids {
@@ -276,24 +278,26 @@ class DomMethodSolution final : public GridSolution {
   // gathered in steps of its own (Gather::along_stretch) and the stretches chained front to back,
   // L(d_k) = L(d_k-1) + T(d_k-1) L_k, T(d_k) = T(d_k-1) T_k (what the layered render at d_k gives,
   // but for where the steps fall).
+  // The gather is made once per prepare or update (the scene less its sky, no surfaces), and each
+  // thread keeps its rays and weights: a frame allocates nothing once they have grown.
   bool render_distances(const View& view, std::span<const double> distances, const RenderOptions& options, DistanceLayers out) const override {
     if (!scene_.surfaces.empty() || volume_.emission.emits()) return false;
-    Rgb sky;
-    const Scene delta = without_sky(scene_, sky);
-    const dom::Gather gather(delta, volume_, depths_, solution_, step_cells_, options.threads, nullptr);
+    const dom::Gather& gather = froxel_gather();
     const Camera& camera = view.camera;
     const auto width = static_cast<size_t>(camera.width_px);
     const size_t per_slice = width * static_cast<size_t>(camera.height_px);
     const Aabb bounds = volume_.density.bounds();
     const auto rows = [&](long long y0, long long y1) {
-      std::vector<Ray> rays(width);
+      thread_local std::vector<Ray> rays;
+      thread_local Eigen::VectorXd row, c;
+      rays.resize(width);
       for (auto y = static_cast<int>(y0); y < y1; ++y) {
         camera.row_rays(y, rays.data());
         for (size_t x = 0; x < width; ++x) {
           const Ray& ray = rays[x];
           double t0 = 0.0, t1 = kInfinity;
           const bool inside = bounds.clip(ray, t0, t1) && t1 > t0;
-          const Eigen::VectorXd c = inside ? inscatter_weights(solution_, -ray.direction) : Eigen::VectorXd();
+          if (inside) inscatter_weights(solution_, -ray.direction, row, c);
           Rgb l(0.0), t(1.0);
           for (size_t k = 0; k < distances.size(); ++k) {
             const double from = std::max(t0, k == 0 ? 0.0 : distances[k - 1]), to = std::min(t1, distances[k]);
@@ -318,6 +322,7 @@ class DomMethodSolution final : public GridSolution {
   std::optional<UpdateReport> update(const Scene& scene, const SceneChange& change, const RenderOptions& options) override {
     UpdateReport report;
     Stopwatch watch;
+    gather_.reset();  // it views the scene, volume, depths and moments about to change
     depth_.threads = settings_.threads = options.threads;
     if (change.medium) {
       const std::array<int, 3> shape = volume_.density.resolution();
@@ -353,7 +358,22 @@ class DomMethodSolution final : public GridSolution {
   }
 
  private:
+  // render_distances' gather over the scene less its sky, made on first use after a prepare or
+  // update (renders may run on several threads at once: made under the lock).
+  const dom::Gather& froxel_gather() const {
+    std::lock_guard lock(gather_mutex_);
+    if (!gather_) {
+      Rgb sky;
+      delta_ = without_sky(scene_, sky);
+      gather_ = std::make_unique<dom::Gather>(delta_, volume_, depths_, solution_, step_cells_, 1, nullptr);
+    }
+    return *gather_;
+  }
+
   DomSolution solution_;
+  mutable std::mutex gather_mutex_;
+  mutable Scene delta_;
+  mutable std::unique_ptr<dom::Gather> gather_;
   CellCount cells_;
   DomSettings settings_;
   DepthOptions depth_;

@@ -445,4 +445,10 @@ Eigen::VectorXd inscatter_weights(const DomSolution& solution, const Vec3& w) {
   return solution.separable->basis().transpose() * solution.matrix->row(w);
 }
 
+void inscatter_weights(const DomSolution& solution, const Vec3& w, Eigen::VectorXd& row, Eigen::VectorXd& out) {
+  solution.matrix->row(w, row);
+  out.resize(solution.separable->basis().cols());
+  out.noalias() = solution.separable->basis().transpose() * row;
+}
+
 }  // namespace haze::grids

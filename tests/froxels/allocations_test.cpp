@@ -1,7 +1,7 @@
 // Heap allocations in a frame (issue 51: after the first frame, a frame allocates nothing). This
 // program replaces the global operator new to count every allocation made through it, on any
 // thread. The CPU composite into the caller's memory allocates nothing, and neither do the
-// froxel build of analytic or propagation, the glow of lights in view and analytic's per-pixel
+// froxel build of analytic, propagation or dom, the glow of lights in view and analytic's per-pixel
 // layers into the caller's buffers once each thread's kept row buffers have grown; nor do the
 // temporal froxels' reprojection and blend.
 #include <haze/froxels/froxels.h>
@@ -85,15 +85,16 @@ TEST(FrameAllocations, TheCompositeIntoCallerMemoryAllocatesNothing) {
 
 // The froxel build into the same Froxels, the camera moving every frame, a light in view and its
 // glow added per pixel: after ten frames (each thread's kept row buffers grown once it has taken
-// a row), the analytic and propagation paths allocate nothing.
+// a row), the analytic, propagation and dom paths allocate nothing.
 TEST(FrameAllocations, TheFroxelBuildAllocatesNothingAfterTheFirstFrames) {
   const Scene scene = testing::fog_box(64, 36, Vec3(0.1, -0.1, 0.4));
   const FroxelGrid grid{16, 9, 12, 0.1, 20.0, 4.0};
   std::vector<float> out(3 * 64 * 36, 0.0f);
   const std::vector<float> depth(64 * 36, 3.0f);
-  for (const char* method : {"analytic", "propagation"}) {
+  for (const char* method : {"analytic", "propagation", "dom"}) {
     RenderOptions prepared;
     if (std::string(method) == "propagation") prepared.settings = {{"resolution", 16}};
+    if (std::string(method) == "dom") prepared.settings = {{"resolution", 12}, {"directions", 32}, {"terms", 9}};
     const Solution solution = prepare(scene, method, prepared);
     Froxels froxels;
     expect_none_per_moving_frame(scene.camera, 0.05, [&](const Camera& camera, const RenderOptions& options) {

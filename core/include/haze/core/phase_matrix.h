@@ -30,6 +30,8 @@ class PhaseMatrix {
   // That row at w, normalized to sum to 1: the in-scattering weights of the D directions toward a
   // direction off the set (a camera's view; seed 000's separable form and seed 001's splats).
   Eigen::VectorXd row(const Vec3& w) const;
+  // The same into `out` (resized to size(): no allocation once it has that size).
+  void row(const Vec3& w, Eigen::VectorXd& out) const;
   // out_i = sum_j P_ij in_j: the direct O(D^2) in-scattering sum (seed 000 eq. 6).
   Eigen::VectorXd apply(const Eigen::VectorXd& in) const { return matrix_ * in; }
 

@@ -239,6 +239,9 @@ DomSolution solve_dom(const ExtinctionVolume& volume, const std::vector<Light>& 
 // sum_j P(w, w_j) L_j ~ sum_k c_k m_k, the row of P at w extended off the direction set
 // (PhaseMatrix::row) and projected on the kept eigenvectors.
 Eigen::VectorXd inscatter_weights(const DomSolution& solution, const Vec3& w);
+// The same into `out`, through `row` (the phase matrix's row at w): no allocation once both have
+// their sizes.
+void inscatter_weights(const DomSolution& solution, const Vec3& w, Eigen::VectorXd& row, Eigen::VectorXd& out);
 
 // The image of a solved scene seen in `view` (its camera and depth; with view.layers, L_in, T and
 // C per pixel: the gathered and unscattered light summed, seen through the unscattered march's
