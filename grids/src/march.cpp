@@ -192,33 +192,64 @@ bool simd_volume(const Marcher& m, std::vector<MarchLight>& lights, MarchVolume&
   return true;
 }
 
-// One image row through the SIMD kernel; surfaces and the background per pixel after it.
-void march_row(const Marcher& m, const MarchVolume& v, const View& view, int y, RenderResult& result) {
-  const Camera& camera = view.camera;
-  const auto width = static_cast<size_t>(camera.width_px);
-  std::vector<float> in(9 * width), out(6 * width, 0.0f);
-  std::vector<Ray> rays(width);
-  std::vector<Hit> hits(width);
-  camera.row_rays(y, rays.data());
+// Row y's rays to their hits (a surface or the view's depth) through the SIMD kernel, into each
+// thread's kept buffers: L_in in result's rows 0 to 2 and T in rows 3 to 5 (rows of width floats;
+// row 0 and 3 alone when grey).
+struct RowMarch {
+  std::vector<Ray> rays;
+  std::vector<Hit> hits;
+  std::vector<float> in, result;
+  const float* at(size_t row) const { return result.data() + row * rays.size(); }
+};
+const RowMarch& march_row_rays(const Marcher& m, const MarchVolume& v, const View& view, int y) {
+  thread_local RowMarch r;
+  const auto width = static_cast<size_t>(view.camera.width_px);
+  r.rays.resize(width), r.hits.resize(width), r.in.resize(9 * width), r.result.assign(6 * width, 0.0f);
+  view.camera.row_rays(y, r.rays.data());
   for (size_t x = 0; x < width; ++x) {
-    hits[x] = m.hit(rays[x], view.max_distance(static_cast<int>(x), y));
-    const Steps s = m.steps(rays[x], hits[x].t);
-    const double values[9] = {rays[x].origin.x, rays[x].origin.y, rays[x].origin.z, rays[x].direction.x, rays[x].direction.y,
-                              rays[x].direction.z, s.t0, s.dt, static_cast<double>(s.count)};
-    for (size_t a = 0; a < 9; ++a) in[a * width + x] = static_cast<float>(values[a]);
+    r.hits[x] = m.hit(r.rays[x], view.max_distance(static_cast<int>(x), y));
+    const Steps s = m.steps(r.rays[x], r.hits[x].t);
+    const double values[9] = {r.rays[x].origin.x, r.rays[x].origin.y, r.rays[x].origin.z, r.rays[x].direction.x, r.rays[x].direction.y,
+                              r.rays[x].direction.z, s.t0, s.dt, static_cast<double>(s.count)};
+    for (size_t a = 0; a < 9; ++a) r.in[a * width + x] = static_cast<float>(values[a]);
   }
   auto row = [&](std::vector<float>& buffer, size_t a) { return buffer.data() + a * width; };
-  RayPacket packet{row(in, 0), row(in, 1), row(in, 2), row(in, 3), row(in, 4), row(in, 5), row(in, 6), row(in, 7), row(in, 8), width,
-                         {row(out, 0), row(out, 1), row(out, 2)}, {row(out, 3), row(out, 4), row(out, 5)}};
+  RayPacket packet{row(r.in, 0), row(r.in, 1), row(r.in, 2), row(r.in, 3), row(r.in, 4), row(r.in, 5), row(r.in, 6), row(r.in, 7), row(r.in, 8), width,
+                   {row(r.result, 0), row(r.result, 1), row(r.result, 2)}, {row(r.result, 3), row(r.result, 4), row(r.result, 5)}};
   march_rays(v, m.volume.phase, packet);
-  for (size_t x = 0; x < width; ++x) {
+  return r;
+}
+
+// One image row through the SIMD kernel; surfaces and the background per pixel after it.
+void march_row(const Marcher& m, const MarchVolume& v, const View& view, int y, RenderResult& result) {
+  const RowMarch& r = march_row_rays(m, v, view, y);
+  for (size_t x = 0; x < r.rays.size(); ++x) {
     Rgb radiance, transmittance;
     for (int c = 0; c < 3; ++c) {
       const size_t channel = v.channels == 1 ? 0 : static_cast<size_t>(c);
-      radiance[c] = static_cast<double>(row(out, channel)[x]);
-      transmittance[c] = static_cast<double>(row(out, 3 + channel)[x]);
+      radiance[c] = static_cast<double>(r.at(channel)[x]);
+      transmittance[c] = static_cast<double>(r.at(3 + channel)[x]);
     }
-    result.set(static_cast<int>(x), y, m.finish(rays[x], hits[x], radiance, transmittance));
+    result.set(static_cast<int>(x), y, m.finish(r.rays[x], r.hits[x], radiance, transmittance));
+  }
+}
+
+// Row y's layers into the caller's spans (march_layers), the surface layer from Marcher::finish.
+void march_row_layers(const Marcher& m, const MarchVolume& v, const View& view, int y, LayerSpans out) {
+  const RowMarch& r = march_row_rays(m, v, view, y);
+  for (size_t x = 0; x < r.rays.size(); ++x) {
+    const auto px = static_cast<int>(x);
+    float* l = out.inscatter.pixel(px, y);
+    float* t = out.transmittance.pixel(px, y);
+    for (int c = 0; c < 3; ++c) {
+      const size_t channel = v.channels == 1 ? 0 : static_cast<size_t>(c);
+      l[c] = r.at(channel)[x], t[c] = r.at(3 + channel)[x];
+    }
+    if (out.surface.data) {
+      const Rgb surface = m.finish(r.rays[x], r.hits[x], Rgb(0.0), Rgb(1.0)).surface;
+      float* si = out.surface.pixel(px, y);
+      for (int c = 0; c < 3; ++c) si[c] = static_cast<float>(surface[c]);
+    }
   }
 }
 
@@ -319,6 +350,22 @@ bool march_distances(const Scene& scene, const ExtinctionVolume& volume, const s
   };
   // A body of one reference: std::function keeps it without allocating.
   parallel_for(camera.height_px, options.threads, 1, [&rows](long long y0, long long y1) { rows(y0, y1); });
+  return true;
+}
+
+bool march_layers(const Scene& scene, const ExtinctionVolume& volume, const std::vector<DenseGrid>& depths, const MarchSettings& settings,
+                  const RenderOptions& options, const View& view, LayerSpans out, const PackedLights* packed) {
+  const Vec3 h = volume.density.cell_size();
+  const Marcher marcher(scene, volume, depths, settings.step_cells * std::min({h.x, h.y, h.z}), options.threads, packed, settings.surface_gather);
+  thread_local std::vector<MarchLight> lights;  // kept, as march_distances' (rows read it while this thread waits)
+  lights.clear();
+  MarchVolume simd_view;
+  if (settings.scalar || marcher.gather || !simd_volume(marcher, lights, simd_view)) return false;
+  const auto rows = [&](long long y0, long long y1) {
+    for (auto y = static_cast<int>(y0); y < y1; ++y) march_row_layers(marcher, simd_view, view, y, out);
+  };
+  // A body of one reference: std::function keeps it without allocating.
+  parallel_for(view.camera.height_px, options.threads, 1, [&rows](long long y0, long long y1) { rows(y0, y1); });
   return true;
 }
 

@@ -47,6 +47,9 @@ class PropagationSolution final : public GridSolution {
   bool render_distances(const View& view, std::span<const double> distances, const RenderOptions& options, DistanceLayers out) const override {
     return march_distances(scene_, volume_, depths_, march_, options, view, distances, out, &packed_);  // the view's camera, not the scene's
   }
+  bool render_layers(const View& view, LayerSpans out, const RenderOptions& options) const override {
+    return march_layers(scene_, volume_, depths_, march_, options, view, out, &packed_);
+  }
 
   // A new density (re-injected by region where it can: replace_volume) redoes every light's depth,
   // new lights only the lights that differ.

@@ -199,8 +199,8 @@ TEST(Layers, AutoPassesTheChosenMethodsLayers) {
 // The layers into the caller's memory (render_layers) against render's: analytic's one pass
 // (the tails in SIMD lanes, short stretches through render's float64 path) within 1e-3 relative
 // RMS and 2e-3 per pixel of its layers, in a box, in unbounded fog and in a coloured medium, over a
-// host's floor and the sky; RGBA rows with padding left as they were; a method without the pass
-// (propagation) copied exactly.
+// host's floor and the sky; RGBA rows with padding left as they were; propagation's march into the
+// spans (march_layers: the rows of its render, the same kernel) as its render's.
 TEST(Layers, RenderLayersIntoCallerMemoryMatchesRender) {
   grids::register_methods();
   for (const std::string variant : {"box", "unbounded", "coloured", "propagation"}) {

@@ -109,6 +109,12 @@ bool march_distances(const Scene& scene, const ExtinctionVolume& volume, const s
                      const RenderOptions& options, const View& view, std::span<const double> distances, DistanceLayers out,
                      const PackedLights* packed = nullptr);
 
+// The same as march_view's layers (View::layers) into the caller's spans (LayerSpans, what
+// Solution::render_layers takes), each thread's buffers kept: a frame allocates nothing once they
+// have grown. False where the SIMD kernel cannot take the scene, or with surface_gather.
+bool march_layers(const Scene& scene, const ExtinctionVolume& volume, const std::vector<DenseGrid>& depths, const MarchSettings& settings,
+                  const RenderOptions& options, const View& view, LayerSpans out, const PackedLights* packed = nullptr);
+
 // Everything method "propagation" computes before it marches, from the scene and the method's
 // settings in options.settings (resolution, optical_depth, sweep_layers, step, cutoff; unknown
 // keys are an error), with the stats it reports. The GL display (haze::gl) shows the same fields.
