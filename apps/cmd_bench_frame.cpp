@@ -6,7 +6,8 @@
 // place (written just before, as a renderer's is), with the glow of lights in view added per
 // pixel (add_glow, 4 columns by default); and the per-pixel layers (Solution::render_layers with
 // the depth, into the renderer's buffers, reused). Medians over the frames, each stage's least
-// memory traffic as a share of the copy bandwidth measured on the same threads first; with the
+// memory traffic as a share of the copy bandwidth measured on the same threads first, and where
+// its kernels' operations per item are counted, their share of the FMA peak measured there; with the
 // per-pixel layers, the froxel composite's relative RMS difference from theirs over the host's
 // floor and sky at frame 0, without history and with the temporal froxels' settled at frame 0's
 // camera. Stage temporal_build times TemporalFroxels (jittered slices, the history reprojected
@@ -19,6 +20,7 @@
 #include <haze/core/stopwatch.h>
 #include <haze/froxels/froxels.h>
 #include <haze/froxels/temporal.h>
+#include <haze/analytic/methods.h>
 
 #include <algorithm>
 #include <cmath>
@@ -26,6 +28,11 @@
 #include <iostream>
 #include <limits>
 #include <memory>
+#include <thread>
+
+#if defined(__x86_64__)
+#include <immintrin.h>
+#endif
 
 namespace haze::app {
 namespace {
@@ -85,6 +92,10 @@ struct StageRow {
   std::vector<double> ms;  // per frame
   double items = 0.0;      // froxels or pixels a frame
   double bytes = 0.0;      // the least memory traffic a frame of the stage makes (what it must write and read)
+  // Floating-point operations an item takes, counted from the kernels' source (an FMA 2, Highway's
+  // Log and Exp as their polynomials, about 20 and 15): the composite's lookups, analytic's tails;
+  // 0 where the count depends on the scene (a march's steps).
+  double flops = 0.0;
   // per_pixel: the froxel composite's relative RMS difference from the layers' composite over the
   // host's colour, frame 0, without history and settled (NaN where not measured).
   double froxel_error = std::numeric_limits<double>::quiet_NaN(), settled_error = froxel_error;
@@ -146,6 +157,8 @@ std::vector<StageRow> run_scene(const std::filesystem::path& file, const FrameAr
   const auto wanted = [&](const std::string& stage) { return a.stages.empty() || std::count(a.stages.begin(), a.stages.end(), stage) > 0; };
   std::vector<StageRow> rows;
   const std::string name = file.stem().string(), method = solution.method();
+  const bool analytic = method == analytic::analytic_info().name;  // the kernels whose operations are counted per item
+  const auto lights = static_cast<double>(scene.lights.size());
   const double pixels = static_cast<double>(a.width) * a.height;
   if (wanted(kStages[0]))
     rows.push_back({name, method, kStages[0], time_frames(a, [&](int f) {
@@ -153,7 +166,8 @@ std::vector<StageRow> run_scene(const std::filesystem::path& file, const FrameAr
                       const Stopwatch watch;
                       build_froxels(solution, camera, froxels, grid, options);
                       return 1e3 * watch.seconds();
-                    }), static_cast<double>(grid.nx) * grid.ny * grid.nz, 24.0 * grid.nx * grid.ny * grid.nz});  // L_in and T written
+                    }), static_cast<double>(grid.nx) * grid.ny * grid.nz, 24.0 * grid.nx * grid.ny * grid.nz,  // L_in and T written
+                    analytic ? 90.0 * lights + 30.0 : 0.0});  // a tail per light (UnitTail), then T and L_in
   if (wanted(kStages[1]))
     rows.push_back({name, method, kStages[1], time_frames(a, [&](int f) {
                       const Camera camera = pose(scene.camera, f);
@@ -165,7 +179,7 @@ std::vector<StageRow> run_scene(const std::filesystem::path& file, const FrameAr
                       composite_froxels(froxels, ConstImageSpan{composed.data().data(), a.width, a.height}, depth, target, a.threads);
                       add_glow(solution, camera, froxels, depth, target, a.threads);
                       return 1e3 * watch.seconds();
-                    }), pixels, 28.0 * pixels});  // colour read and written, depth read
+                    }), pixels, 28.0 * pixels, 140.0});  // colour read and written, depth read; the lookup and its 8 taps (the glow not counted)
   if (wanted(kStages[2])) {
     double error = std::numeric_limits<double>::quiet_NaN(), settled = error;
     Image inscatter(a.width, a.height), transmittance(a.width, a.height);  // the renderer's layer buffers, reused
@@ -188,7 +202,7 @@ std::vector<StageRow> run_scene(const std::filesystem::path& file, const FrameAr
                         settled = relative_rmse(settle(solution, camera, grid, a.blend, options), exact);
                       }
                       return ms;
-                    }), pixels, 28.0 * pixels});  // L_in and T written, depth read
+                    }), pixels, 28.0 * pixels, analytic ? 202.0 * lights + 25.0 : 0.0});  // L_in and T written, depth read; two tails and the geometry per light
     rows.back().froxel_error = error, rows.back().settled_error = settled;
   }
   if (wanted(kStages[3])) {
@@ -204,6 +218,56 @@ std::vector<StageRow> run_scene(const std::filesystem::path& file, const FrameAr
     settle(solution, pose(scene.camera, 0), grid, a.blend, options, &rows.back().flicker_with);
   }
   return rows;
+}
+
+// The machine's peak arithmetic on the threads: 12 independent chains of FMAs per thread on the
+// widest vectors the CPU has (AVX-512, else AVX2; 2 flops per lane and FMA), the best of 5; 0
+// elsewhere.
+#if defined(__x86_64__)
+constexpr long long kFmaRounds = 1LL << 21;
+__attribute__((target("avx512f"))) float chains512(float seed) {
+  const __m512 b = _mm512_set1_ps(0.999999f), c = _mm512_set1_ps(1e-7f);
+  __m512 a[12];
+  for (int e = 0; e < 12; ++e) a[e] = _mm512_set1_ps(seed + 0.01f * static_cast<float>(e));  // equal chains would fold into one
+  for (long long r = 0; r < kFmaRounds; ++r)
+    for (__m512& v : a) v = _mm512_fmadd_ps(v, b, c);
+  __m512 sum = a[0];
+  for (int e = 1; e < 12; ++e) sum = _mm512_add_ps(sum, a[e]);
+  alignas(64) float lanes[16];
+  _mm512_store_ps(lanes, sum);
+  return lanes[0];
+}
+__attribute__((target("avx2,fma"))) float chains256(float seed) {
+  const __m256 b = _mm256_set1_ps(0.999999f), c = _mm256_set1_ps(1e-7f);
+  __m256 a[12];
+  for (int e = 0; e < 12; ++e) a[e] = _mm256_set1_ps(seed + 0.01f * static_cast<float>(e));
+  for (long long r = 0; r < kFmaRounds; ++r)
+    for (__m256& v : a) v = _mm256_fmadd_ps(v, b, c);
+  __m256 sum = a[0];
+  for (int e = 1; e < 12; ++e) sum = _mm256_add_ps(sum, a[e]);
+  return _mm_cvtss_f32(_mm256_castps256_ps128(sum));
+}
+#endif
+
+double fma_peak(int threads) {
+#if defined(__x86_64__)
+  const bool wide = __builtin_cpu_supports("avx512f"), avx2 = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+  if (!wide && !avx2) return 0.0;
+  const int lanes = wide ? 16 : 8, n = std::max(1, threads > 0 ? threads : static_cast<int>(std::thread::hardware_concurrency()));
+  std::vector<float> sink(static_cast<size_t>(n));
+  double best = 0.0;
+  for (int r = 0; r < 5; ++r) {
+    const Stopwatch watch;
+    parallel_for(n, n, 1, [&](long long t0, long long t1) {
+      for (auto t = t0; t < t1; ++t) sink[static_cast<size_t>(t)] = wide ? chains512(1.0f + 0.1f * static_cast<float>(t)) : chains256(1.0f + 0.1f * static_cast<float>(t));
+    });
+    best = std::max(best, 2.0 * 12 * lanes * static_cast<double>(kFmaRounds) * n / watch.seconds());
+  }
+  if (std::all_of(sink.begin(), sink.end(), [](float v) { return std::isnan(v); })) return 0.0;  // keeps the chains
+  return best;
+#else
+  return 0.0;
+#endif
 }
 
 // The machine's copy bandwidth on the threads (STREAM's copy: bytes read plus written per second),
@@ -235,20 +299,25 @@ int run(const FrameArgs& a) {
   if (files.empty()) throw Error("--scenes", a.scenes, "a directory holding the scenes asked for (bench/frame)");
   std::sort(files.begin(), files.end());
   nlohmann::json out = nlohmann::json::array();
-  const double bandwidth = copy_bandwidth(a.threads);
+  const double bandwidth = copy_bandwidth(a.threads), peak = fma_peak(a.threads);
   if (!a.json)
-    std::printf("%dx%d, %d x %d x %d froxels, %d threads; medians over the frames; copy bandwidth %.1f GB/s\n%-18s %-12s %-14s %10s %7s %12s %10s\n",
-                a.width, a.height, a.froxels[0], a.froxels[1], a.froxels[2], a.threads, 1e-9 * bandwidth, "scene", "method", "stage", "median ms",
-                "frames", "ns per item", "of copy bw");
+    std::printf("%dx%d, %d x %d x %d froxels, %d threads; medians over the frames; copy bandwidth %.1f GB/s, FMA peak %.0f GFLOP/s\n"
+                "%-18s %-12s %-14s %10s %7s %12s %10s %11s\n",
+                a.width, a.height, a.froxels[0], a.froxels[1], a.froxels[2], a.threads, 1e-9 * bandwidth, 1e-9 * peak, "scene", "method", "stage",
+                "median ms", "frames", "ns per item", "of copy bw", "of FMA peak");
   for (const auto& file : files)
     for (const StageRow& r : run_scene(file, a)) {
       const double m = median(r.ms), ns = 1e6 * m / r.items, share = r.bytes / (1e-3 * m) / bandwidth;
+      const double arithmetic = r.flops > 0.0 && peak > 0.0 ? r.flops * r.items / (1e-3 * m) / peak : std::numeric_limits<double>::quiet_NaN();
       out.push_back({{"scene", r.scene}, {"method", r.method}, {"stage", r.stage}, {"median_ms", m}, {"frames", r.ms.size()}, {"items", r.items},
                      {"ns_per_item", ns}, {"bytes", r.bytes}, {"bandwidth_share", share}});
+      if (!std::isnan(arithmetic)) out.back()["flops_per_item"] = r.flops, out.back()["fma_peak_share"] = arithmetic;
       if (!std::isnan(r.froxel_error)) out.back()["froxel_error"] = r.froxel_error, out.back()["settled_error"] = r.settled_error;
       if (!std::isnan(r.flicker_with)) out.back()["flicker_without"] = r.flicker_without, out.back()["flicker_with"] = r.flicker_with;
       if (!a.json) {
         std::printf("%-18s %-12s %-14s %10.1f %7zu %12.2f %9.1f%%", r.scene.c_str(), r.method.c_str(), r.stage.c_str(), m, r.ms.size(), ns, 100.0 * share);
+        if (std::isnan(arithmetic)) std::printf(" %11s", "-");
+        else std::printf(" %10.1f%%", 100.0 * arithmetic);
         if (!std::isnan(r.froxel_error))
           std::printf("  (froxel composite %.2f%% off, %.2f%% with settled history)", 100.0 * r.froxel_error, 100.0 * r.settled_error);
         if (!std::isnan(r.flicker_with))
@@ -279,7 +348,7 @@ Command add_bench_frame(CLI::App& bench) {
   sub->add_option("--glow-columns", a->glow_columns, "FroxelGrid::glow_columns: lights' glow within this many columns added per pixel (0: none)")
       ->capture_default_str()->check(CLI::Range(0.0, 16.0));
   sub->add_option("--blend", a->blend, "TemporalFroxels::blend, the new frame's weight")->capture_default_str()->check(CLI::Range(1e-3, 1.0));
-  sub->add_flag("--json", a->json, "Print a JSON list of {scene, method, stage, median_ms, frames, items, ns_per_item, bytes, bandwidth_share[, froxel_error, settled_error][, flicker_without, flicker_with]}");
+  sub->add_flag("--json", a->json, "Print a JSON list of {scene, method, stage, median_ms, frames, items, ns_per_item, bytes, bandwidth_share[, flops_per_item, fma_peak_share][, froxel_error, settled_error][, flicker_without, flicker_with]}");
   return {sub, [a] { return run(*a); }};
 }
 
