@@ -124,9 +124,9 @@ void composite_frame(const Solution& solution, const Camera& camera, const Froxe
   add_glow(solution, camera, froxels, depth, target, threads);
 }
 
-// The temporal froxels of a still camera (frame 0's) with `blend`: after kSettled frames their
-// composite in `settled`; with `flicker`, the median over frames 20 to kSettled - 1 of the
-// composite's frame-to-frame relative RMS change.
+// The composite of the temporal froxels of a still camera (frame 0's) with `blend` after kSettled
+// frames; with `flicker`, the median over frames 20 to kSettled - 1 of the composite's
+// frame-to-frame relative RMS change.
 Image settle(const Solution& solution, const Camera& camera, const FroxelGrid& grid, double blend, const RenderOptions& options, double* flicker = nullptr) {
   const std::vector<float> depth = floor_depth(camera);
   const Image colour = host_colour(depth, camera.width_px, camera.height_px);

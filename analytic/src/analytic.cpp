@@ -237,9 +237,10 @@ class AnalyticSolution final : public MethodSolution {
   }
   bool renders_layers() const override { return true; }
 
-  // Point lights without surfaces, a row of rays in SIMD lanes through the slices (airlight_slices): with
-  // [t0, t1] a ray's stretch in the medium, L_in(d) = sum of sigma_s I (g(t0) - T(d) g(d)), one
-  // unit tail per ray, light and distance, the ray's geometry toward each light in float64 once.
+  // Point lights without surfaces, a row of rays in SIMD lanes through the slices
+  // (airlight_slices): with [t0, t1] a ray's stretch in the medium, L_in(d) = sum of sigma_s I
+  // (g(t0) - T(d) g(d)), one unit tail per ray, light and distance, the ray's geometry toward each
+  // light in float64 once.
   // Its error is the table's relative to the whole ray's in-scatter, not to L_in(d): at most 1e-3
   // of it (froxels composite it over the host's colour, where that is what matters). The float64
   // kernel setting renders once per distance instead.

@@ -15,9 +15,9 @@
 #include "dom_internal.h"
 
 #include <algorithm>
+#include <cmath>
 #include <memory>
 #include <mutex>
-#include <cmath>
 
 namespace haze::grids {
 
@@ -278,8 +278,8 @@ class DomMethodSolution final : public GridSolution {
   // gathered in steps of its own (Gather::along_stretch) and the stretches chained front to back,
   // L(d_k) = L(d_k-1) + T(d_k-1) L_k, T(d_k) = T(d_k-1) T_k (what the layered render at d_k gives,
   // but for where the steps fall).
-  // The gather is made once per prepare or update (the scene less its sky, no surfaces), and each
-  // thread keeps its rays and weights: a frame allocates nothing once they have grown.
+  // The gather (the scene less its sky) is made on the first frame after a prepare or update, and
+  // each thread keeps its rays and weights: a frame allocates nothing once they have grown.
   bool render_distances(const View& view, std::span<const double> distances, const RenderOptions& options, DistanceLayers out) const override {
     if (!scene_.surfaces.empty() || volume_.emission.emits()) return false;
     const dom::Gather& gather = froxel_gather();
