@@ -50,9 +50,9 @@ struct Froxels {
 };
 
 // Builds the froxels of `camera`'s view from `solution` (any method that renders layers) through
-// Solution::render_distances: the method's one-pass path (analytic, propagation), or one layered
-// render of the nx x ny columns per slice with its boundary as the depth (the method's SIMD and
-// threads do the work; options.progress then sees the slices). A camera of type `rays` is
+// Solution::render_distances: the method's one-pass path (analytic, propagation, dom), or one
+// layered render of the nx x ny columns per slice with its boundary as the depth (the method's
+// SIMD and threads do the work; options.progress then sees the slices). A camera of type `rays` is
 // sampled at the columns' nearest pixels. Bad grids (a count below 1 or above 4096, near not in
 // (0, far)) are a haze::Error naming `froxels.<field>`.
 Froxels build_froxels(const Solution& solution, const Camera& camera, const FroxelGrid& grid = {}, const RenderOptions& options = {});
