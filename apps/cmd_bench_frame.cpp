@@ -64,11 +64,12 @@ Camera pose(const Camera& base, int f) {
 std::vector<float> floor_depth(const Camera& camera) {
   std::vector<float> depth;
   depth.reserve(static_cast<size_t>(camera.width_px) * static_cast<size_t>(camera.height_px));
-  for (int y = 0; y < camera.height_px; ++y)
-    for (int x = 0; x < camera.width_px; ++x) {
-      const Ray ray = camera.pixel_ray(x, y);
+  std::vector<Ray> rays(static_cast<size_t>(camera.width_px));
+  for (int y = 0; y < camera.height_px; ++y) {
+    camera.row_rays(y, rays.data());
+    for (const Ray& ray : rays)
       depth.push_back(ray.direction.y < 0.0 ? static_cast<float>((-1.5 - ray.origin.y) / ray.direction.y) : std::numeric_limits<float>::infinity());
-    }
+  }
   return depth;
 }
 

@@ -12,6 +12,8 @@
 #include <hwy/highway.h>
 
 #include <algorithm>
+#include <cfloat>
+#include <cmath>
 
 HWY_BEFORE_NAMESPACE();
 namespace haze::analytic::HWY_NAMESPACE {
@@ -87,42 +89,80 @@ HWY_NOINLINE size_t AirlightBatch(const float* HWY_RESTRICT table, int na, int n
 
 // The unit tail g(d) = G(d) / (sigma_s I) of rays whose light projects to t_c along them at
 // distance h_c from their lines, at distances `at` (airlight_batch.h, TailRow).
-template <class D, class V>
-HWY_INLINE V UnitTail(D d, const float* HWY_RESTRICT table, int na, int ne, float eta_max, V t_c, V h_c, V sigma, V at) {
-  const V zero = hn::Zero(d);
-  const V t = hn::Sub(t_c, at);
-  const V d_sv = hn::Sqrt(hn::MulAdd(t, t, hn::Mul(h_c, h_c)));
-  const V h = hn::Max(hn::Max(h_c, hn::Mul(hn::Set(d, 1e-6f), d_sv)), hn::Set(d, 1e-20f));
-  // w = (xi + r) / h without cancellation (xi = -t), floored where the point sits on the light.
-  const auto behind = hn::Le(t, zero);
-  const V w0 = hn::Max(hn::Div(hn::IfThenElse(behind, hn::Sub(d_sv, t), h), hn::IfThenElse(behind, h, hn::Add(d_sv, t))), hn::Set(d, 1e-30f));
-  V scale;
-  const V log_tail = LogTail(d, table, na, ne, eta_max, hn::Mul(sigma, h), hn::Log(d, w0), w0, scale);
-  return hn::Div(hn::Mul(hn::Exp(d, hn::NegMulAdd(sigma, d_sv, log_tail)), scale), h);
-}
-
-// s_c = sum over the row's lights of weight[c] g(at), for the vector of rays at i.
-template <class D, class V>
-HWY_INLINE void SumTails(D d, const float* HWY_RESTRICT table, int na, int ne, float eta_max, const TailRow& row, size_t i, V at,
-                         V& s0, V& s1, V& s2) {
-  s0 = s1 = s2 = hn::Zero(d);
-  for (size_t l = 0; l < row.light_count; ++l) {
-    const TailLight& light = row.lights[l];
-    V g = UnitTail(d, table, na, ne, eta_max, hn::LoadU(d, light.t + i), hn::LoadU(d, light.h + i), hn::Set(d, light.sigma_t), at);
-    if (light.share) g = hn::Mul(g, hn::LoadU(d, light.share + i));
-    s0 = hn::MulAdd(hn::Set(d, light.weight[0]), g, s0);
-    s1 = hn::MulAdd(hn::Set(d, light.weight[1]), g, s1);
-    s2 = hn::MulAdd(hn::Set(d, light.weight[2]), g, s2);
+// N vectors of rays at once, step by step across the N: N independent chains in program order,
+// which the CPU overlaps (one chain alone is a long run of dependent latencies).
+template <int N, class D, class V>
+HWY_INLINE void UnitTails(D d, const float* HWY_RESTRICT table, int na, int ne, float eta_max, const V* t_c, const V* h_c, V sigma, const V* at,
+                          V* g) {
+  const hn::RebindToSigned<D> di;
+  const V zero = hn::Zero(d), one = hn::Set(d, 1.0f);
+  V d_sv[N], h[N], w[N], a[N];
+  for (int n = 0; n < N; ++n) {
+    const V t = hn::Sub(t_c[n], at[n]);
+    d_sv[n] = hn::Sqrt(hn::MulAdd(t, t, hn::Mul(h_c[n], h_c[n])));
+    h[n] = hn::Max(hn::Max(h_c[n], hn::Mul(hn::Set(d, 1e-6f), d_sv[n])), hn::Set(d, 1e-20f));
+    // w = (xi + r) / h without cancellation (xi = -t), floored where the point sits on the light.
+    const auto behind = hn::Le(t, zero);
+    w[n] = hn::Max(hn::Div(hn::IfThenElse(behind, hn::Sub(d_sv[n], t), h[n]), hn::IfThenElse(behind, h[n], hn::Add(d_sv[n], t))), hn::Set(d, 1e-30f));
+    a[n] = hn::Min(hn::Mul(hn::Mul(sigma, h[n]), hn::Add(one, w[n])), hn::Set(d, 1e30f));
+  }
+  // LogTail's lookup, N at a time.
+  hn::Vec<decltype(di)> index[N];
+  V x[N], y[N];
+  for (int n = 0; n < N; ++n) {
+    const V fa = hn::Mul(hn::Sqrt(hn::Div(a[n], hn::Add(one, a[n]))), hn::Set(d, static_cast<float>(na - 1)));
+    const V e = hn::Min(hn::Max(hn::Log(d, w[n]), hn::Set(d, -eta_max)), hn::Set(d, eta_max));
+    const V fe = hn::Mul(hn::Add(e, hn::Set(d, eta_max)), hn::Set(d, static_cast<float>(ne - 1) / (2.0f * eta_max)));
+    const V fi = hn::Min(hn::Floor(fa), hn::Set(d, static_cast<float>(na - 2)));
+    const V fj = hn::Min(hn::Floor(fe), hn::Set(d, static_cast<float>(ne - 2)));
+    x[n] = hn::Sub(fa, fi), y[n] = hn::Sub(fe, fj);
+    index[n] = hn::ConvertTo(di, hn::MulAdd(fi, hn::Set(d, static_cast<float>(ne)), fj));
+  }
+  for (int n = 0; n < N; ++n) {
+    const V t00 = hn::GatherIndex(d, table, index[n]), t10 = hn::GatherIndex(d, table + ne, index[n]);
+    const V t01 = hn::GatherIndex(d, table + 1, index[n]), t11 = hn::GatherIndex(d, table + ne + 1, index[n]);
+    const V t0 = hn::MulAdd(x[n], hn::Sub(t10, t00), t00), t1 = hn::MulAdd(x[n], hn::Sub(t11, t01), t01);
+    const V log_tail = hn::MulAdd(y[n], hn::Sub(t1, t0), t0);
+    const V scale = hn::Div(hn::Set(d, 2.0f), hn::Mul(hn::Mul(hn::Add(one, w[n]), hn::Add(one, a[n])), h[n]));
+    g[n] = hn::Mul(hn::Exp(d, hn::NegMulAdd(sigma, d_sv[n], log_tail)), scale);
   }
 }
+
+// s[n][c] = sum over the row's lights of weight[c] g(at[n]), for the N vectors of rays at offsets i[n].
+template <int N, class D, class V>
+HWY_INLINE void SumTailsN(D d, const float* HWY_RESTRICT table, int na, int ne, float eta_max, const TailRow& row, const size_t* i, const V* at,
+                          V (*s)[3]) {
+  for (int n = 0; n < N; ++n) s[n][0] = s[n][1] = s[n][2] = hn::Zero(d);
+  for (size_t l = 0; l < row.light_count; ++l) {
+    const TailLight& light = row.lights[l];
+    V t_c[N], h_c[N], g[N];
+    for (int n = 0; n < N; ++n) t_c[n] = hn::LoadU(d, light.t + i[n]), h_c[n] = hn::LoadU(d, light.h + i[n]);
+    UnitTails<N>(d, table, na, ne, eta_max, t_c, h_c, hn::Set(d, light.sigma_t), at, g);
+    for (int n = 0; n < N; ++n) {
+      if (light.share) g[n] = hn::Mul(g[n], hn::LoadU(d, light.share + i[n]));
+      for (int c = 0; c < 3; ++c) s[n][c] = hn::MulAdd(hn::Set(d, light.weight[c]), g[n], s[n][c]);
+    }
+  }
+}
+
+// Chains UnitTails interleaves: four fill the out-of-order window on AVX-512 (1.3x over one).
+constexpr int kChains = 4;
 
 HWY_NOINLINE void TailSums(const float* HWY_RESTRICT table, int na, int ne, float eta_max, const TailRow& row, const float* at,
                            float* const* sums) {
   const hn::ScalableTag<float> d;
-  for (size_t i = 0; i < row.count; i += hn::Lanes(d)) {
-    hn::Vec<decltype(d)> s0, s1, s2;
-    SumTails(d, table, na, ne, eta_max, row, i, hn::LoadU(d, at + i), s0, s1, s2);
-    hn::StoreU(s0, d, sums[0] + i), hn::StoreU(s1, d, sums[1] + i), hn::StoreU(s2, d, sums[2] + i);
+  using V = hn::Vec<decltype(d)>;
+  const size_t lanes = hn::Lanes(d);
+  for (size_t i0 = 0; i0 < row.count; i0 += kChains * lanes) {
+    size_t i[kChains];
+    V at_i[kChains], s[kChains][3];
+    for (int n = 0; n < kChains; ++n) {
+      i[n] = std::min(i0 + n * lanes, i0 + (row.count - 1 - i0) / lanes * lanes);  // past the end: the last vector again
+      at_i[n] = hn::LoadU(d, at + i[n]);
+    }
+    SumTailsN<kChains>(d, table, na, ne, eta_max, row, i, at_i, s);
+    for (int n = 0; n < kChains && i0 + n * lanes < row.count; ++n)
+      for (int c = 0; c < 3; ++c) hn::StoreU(s[n][c], d, sums[c] + i[n]);
   }
 }
 
@@ -139,31 +179,123 @@ HWY_NOINLINE void AirlightSlices(const float* HWY_RESTRICT table, int na, int ne
   for (size_t i = 0; i < row.count; i += lanes) {
     const V t0 = hn::LoadU(d, row.t0 + i), t1 = hn::LoadU(d, row.t1 + i);
     const V whole0 = hn::LoadU(d, row.whole[0] + i), whole1 = hn::LoadU(d, row.whole[1] + i), whole2 = hn::LoadU(d, row.whole[2] + i);
-    for (size_t k = 0; k < slices; ++k) {
-      const V at_slice = hn::Set(d, distances[k]);
-      const auto outside = hn::Or(hn::Le(at_slice, t0), hn::Le(t1, t0));
-      const V at = hn::Min(hn::Max(at_slice, t0), t1), inside = hn::Sub(at, t0);
-      V s0, s1, s2;
-      SumTails(d, table, na, ne, eta_max, row, i, at, s0, s1, s2);
-      const V T0 = hn::Exp(d, hn::Mul(hn::Set(d, -row.sigma_t[0]), inside));
-      const V T1 = grey ? T0 : hn::Exp(d, hn::Mul(hn::Set(d, -row.sigma_t[1]), inside));
-      const V T2 = grey ? T0 : hn::Exp(d, hn::Mul(hn::Set(d, -row.sigma_t[2]), inside));
-      const V l0 = hn::IfThenZeroElse(outside, hn::Max(zero, hn::NegMulAdd(T0, s0, whole0)));
-      const V l1 = hn::IfThenZeroElse(outside, hn::Max(zero, hn::NegMulAdd(T1, s1, whole1)));
-      const V l2 = hn::IfThenZeroElse(outside, hn::Max(zero, hn::NegMulAdd(T2, s2, whole2)));
-      const V u0 = hn::IfThenElse(outside, one, T0), u1 = hn::IfThenElse(outside, one, T1), u2 = hn::IfThenElse(outside, one, T2);
-      float* const l_out = inscatter + k * slice_stride + 3 * i;
-      float* const t_out = transmittance + k * slice_stride + 3 * i;
-      if (i + lanes <= row.count) {
-        hn::StoreInterleaved3(l0, l1, l2, d, l_out);
-        hn::StoreInterleaved3(u0, u1, u2, d, t_out);
-      } else {  // the row's last, partial vector
-        const size_t n = 3 * (row.count - i);
-        hn::StoreInterleaved3(l0, l1, l2, d, tail);
-        std::copy_n(tail, n, l_out);
-        hn::StoreInterleaved3(u0, u1, u2, d, tail);
-        std::copy_n(tail, n, t_out);
+    constexpr int kN = kChains;
+    size_t same[kN];
+    std::fill_n(same, kN, i);
+    // Once T(d) g(d) is below 1e-6 of g(t0) in every lane and channel, L_in is g(t0) to that
+    // and further slices skip the tails: both factors only fall with d (g sums what lies past d).
+    bool spent = false;
+    for (size_t k0 = 0; k0 < slices; k0 += kN) {
+      V at[kN], inside[kN];
+      decltype(hn::Lt(zero, zero)) outside[kN];
+      for (int n = 0; n < kN; ++n) {
+        const V at_slice = hn::Set(d, distances[std::min(k0 + n, slices - 1)]);
+        outside[n] = hn::Or(hn::Le(at_slice, t0), hn::Le(t1, t0));
+        at[n] = hn::Min(hn::Max(at_slice, t0), t1), inside[n] = hn::Sub(at[n], t0);
       }
+      V s[kN][3];
+      if (spent) {
+        for (int n = 0; n < kN; ++n) s[n][0] = s[n][1] = s[n][2] = zero;
+      } else {
+        SumTailsN<kN>(d, table, na, ne, eta_max, row, same, at, s);
+      }
+      for (int n = 0; n < kN && k0 + n < slices; ++n) {
+        const size_t k = k0 + n;
+        const V T0 = hn::Exp(d, hn::Mul(hn::Set(d, -row.sigma_t[0]), inside[n]));
+        const V T1 = grey ? T0 : hn::Exp(d, hn::Mul(hn::Set(d, -row.sigma_t[1]), inside[n]));
+        const V T2 = grey ? T0 : hn::Exp(d, hn::Mul(hn::Set(d, -row.sigma_t[2]), inside[n]));
+        if (!spent && n == kN - 1) {
+          const V small = hn::Set(d, 1e-6f);
+          spent = hn::AllTrue(d, hn::And(hn::Le(hn::Mul(T0, s[n][0]), hn::Mul(small, whole0)),
+                                         hn::And(hn::Le(hn::Mul(T1, s[n][1]), hn::Mul(small, whole1)),
+                                                 hn::Le(hn::Mul(T2, s[n][2]), hn::Mul(small, whole2)))));
+        }
+        const V l0 = hn::IfThenZeroElse(outside[n], hn::Max(zero, hn::NegMulAdd(T0, s[n][0], whole0)));
+        const V l1 = hn::IfThenZeroElse(outside[n], hn::Max(zero, hn::NegMulAdd(T1, s[n][1], whole1)));
+        const V l2 = hn::IfThenZeroElse(outside[n], hn::Max(zero, hn::NegMulAdd(T2, s[n][2], whole2)));
+        const V u0 = hn::IfThenElse(outside[n], one, T0), u1 = hn::IfThenElse(outside[n], one, T1), u2 = hn::IfThenElse(outside[n], one, T2);
+        float* const l_out = inscatter + k * slice_stride + 3 * i;
+        float* const t_out = transmittance + k * slice_stride + 3 * i;
+        if (i + lanes <= row.count) {
+          hn::StoreInterleaved3(l0, l1, l2, d, l_out);
+          hn::StoreInterleaved3(u0, u1, u2, d, t_out);
+        } else {  // the row's last, partial vector
+          const size_t m = 3 * (row.count - i);
+          hn::StoreInterleaved3(l0, l1, l2, d, tail);
+          std::copy_n(tail, m, l_out);
+          hn::StoreInterleaved3(u0, u1, u2, d, tail);
+          std::copy_n(tail, m, t_out);
+        }
+      }
+    }
+  }
+}
+
+// layers_from_tails (airlight_batch.h).
+HWY_NOINLINE void LayersFromTails(const TailRow& row, const float* HWY_RESTRICT ends, const float* const* sums, float* HWY_RESTRICT inscatter,
+                                  float* HWY_RESTRICT transmittance, float* HWY_RESTRICT redo) {
+  const hn::ScalableTag<float> d;
+  using V = hn::Vec<decltype(d)>;
+  const size_t lanes = hn::Lanes(d);
+  const bool grey = row.sigma_t[0] == row.sigma_t[1] && row.sigma_t[1] == row.sigma_t[2];
+  const V zero = hn::Zero(d), one = hn::Set(d, 1.0f), three_quarters = hn::Set(d, 0.75f);
+  for (size_t i = 0; i < row.count; i += lanes) {
+    const V t0 = hn::LoadU(d, row.t0 + i), end = hn::LoadU(d, ends + i);
+    const auto inside = hn::Gt(end, t0), finite = hn::Lt(end, hn::Set(d, 3e38f));
+    const V length = hn::IfThenElseZero(finite, hn::Sub(end, t0));
+    V l[3], t[3];
+    auto cancels = hn::Lt(one, zero);
+    for (int c = 0; c < 3; ++c) {
+      t[c] = c > 0 && grey ? t[0] : hn::IfThenElseZero(finite, hn::Exp(d, hn::Mul(hn::Set(d, -row.sigma_t[c]), length)));
+      const V whole = hn::LoadU(d, row.whole[c] + i), far = hn::Mul(t[c], hn::LoadU(d, sums[c] + i));
+      cancels = hn::Or(cancels, hn::Gt(far, hn::Mul(three_quarters, whole)));
+      l[c] = hn::IfThenElseZero(inside, hn::Max(zero, hn::Sub(whole, far)));
+    }
+    for (int c = 0; c < 3; ++c) t[c] = hn::IfThenElse(inside, t[c], one);
+    hn::StoreInterleaved3(l[0], l[1], l[2], d, inscatter + 3 * i);
+    hn::StoreInterleaved3(t[0], t[1], t[2], d, transmittance + 3 * i);
+    hn::StoreU(hn::IfThenElseZero(hn::And(inside, cancels), one), d, redo + i);
+  }
+}
+
+// row_geometry (airlight_batch.h) in float64 lanes, Aabb::clip's slabs (a NaN of 0 inf on a face
+// leaves the stretch alone).
+HWY_NOINLINE void RowGeometryKernel(const RowGeometry& g, const double* origin, const double* a, const double* b, double px0, size_t count) {
+  const hn::ScalableTag<double> d;
+  const hn::Rebind<float, decltype(d)> df;
+  using V = hn::Vec<decltype(d)>;
+  const size_t lanes = hn::Lanes(d);
+  const V zero = hn::Zero(d), inf = hn::Set(d, HUGE_VAL);
+  for (size_t x = 0; x < count; x += lanes) {
+    const V px = hn::Iota(d, px0 + static_cast<double>(x));
+    V v[3];
+    for (int e = 0; e < 3; ++e) v[e] = hn::MulAdd(hn::Set(d, b[e]), px, hn::Set(d, a[e]));
+    const V inv_norm = hn::Div(hn::Set(d, 1.0), hn::Sqrt(hn::MulAdd(v[0], v[0], hn::MulAdd(v[1], v[1], hn::Mul(v[2], v[2])))));
+    for (int e = 0; e < 3; ++e) v[e] = hn::Mul(v[e], inv_norm);
+    V t0 = zero, t1 = inf;
+    for (int e = 0; e < 3; ++e) {
+      if (std::isinf(g.lo[e]) && std::isinf(g.hi[e])) continue;  // an unbounded slab: -inf to +inf, never clipping
+      const V inv = hn::Div(hn::Set(d, 1.0), v[e]);
+      V near = hn::Mul(hn::Set(d, g.lo[e] - origin[e]), inv), far = hn::Mul(hn::Set(d, g.hi[e] - origin[e]), inv);
+      const auto swap = hn::Gt(near, far);
+      const V n = hn::IfThenElse(swap, far, near), f = hn::IfThenElse(swap, near, far);
+      t0 = hn::IfThenElse(hn::Gt(n, t0), n, t0), t1 = hn::IfThenElse(hn::Lt(f, t1), f, t1);
+    }
+    const auto miss = hn::Not(hn::Gt(t1, t0));
+    hn::StoreU(hn::DemoteTo(df, hn::IfThenZeroElse(miss, t0)), df, g.t0 + x);
+    const auto t1_f = hn::DemoteTo(df, hn::IfThenZeroElse(miss, t1));  // some targets saturate infinity to the largest float
+    hn::StoreU(hn::IfThenElse(hn::Ge(t1_f, hn::Set(df, FLT_MAX)), hn::Set(df, HUGE_VALF), t1_f), df, g.t1 + x);
+    for (size_t l = 0; l < g.light_count; ++l) {
+      V to[3];
+      for (int e = 0; e < 3; ++e) to[e] = hn::Set(d, g.lights[3 * l + static_cast<size_t>(e)] - origin[e]);
+      const V t = hn::MulAdd(to[0], v[0], hn::MulAdd(to[1], v[1], hn::Mul(to[2], v[2])));
+      V h2 = zero;
+      for (int e = 0; e < 3; ++e) {
+        const V off = hn::NegMulAdd(t, v[e], to[e]);
+        h2 = hn::MulAdd(off, off, h2);
+      }
+      hn::StoreU(hn::DemoteTo(df, t), df, g.t[l] + x);
+      hn::StoreU(hn::Sqrt(hn::DemoteTo(df, h2)), df, g.h[l] + x);  // float's square root: within an ulp of float(sqrt(h2))
     }
   }
 }

@@ -19,6 +19,8 @@ namespace haze::analytic {
 HWY_EXPORT(AirlightBatch);
 HWY_EXPORT(TailSums);
 HWY_EXPORT(AirlightSlices);
+HWY_EXPORT(RowGeometryKernel);
+HWY_EXPORT(LayersFromTails);
 
 namespace {
 
@@ -101,6 +103,51 @@ void airlight_slices(const AirlightTable& table, const TailRow& row, std::span<c
 
 void airlight_slice(const AirlightTable& table, const TailRow& row, float distance, float* inscatter, float* transmittance) {
   airlight_slices(table, row, std::span<const float>(&distance, 1), inscatter, transmittance, 0);
+}
+
+void layers_from_tails(const TailRow& row, const float* ends, const float* const sums[3], float* inscatter, float* transmittance, float* redo) {
+  HWY_DYNAMIC_DISPATCH(LayersFromTails)(row, ends, sums, inscatter, transmittance, redo);
+}
+
+void layers_from_tails_reference(const TailRow& row, const float* ends, const float* const sums[3], float* inscatter, float* transmittance,
+                                 float* redo) {
+  const bool grey = row.sigma_t[0] == row.sigma_t[1] && row.sigma_t[1] == row.sigma_t[2];
+  for (size_t i = 0; i < row.count; ++i) {
+    const float t0 = row.t0[i], end = ends[i];
+    float* l = inscatter + 3 * i;
+    float* t = transmittance + 3 * i;
+    bool cancels = false;
+    for (int c = 0; c < 3; ++c) {
+      if (!(end > t0)) {
+        l[c] = 0.0f, t[c] = 1.0f;
+        continue;
+      }
+      t[c] = c > 0 && grey ? t[0] : std::isfinite(end) ? std::exp(-row.sigma_t[c] * (end - t0)) : 0.0f;
+      const float far = t[c] * sums[c][i];
+      cancels = cancels || far > 0.75f * row.whole[c][i];
+      l[c] = std::max(0.0f, row.whole[c][i] - far);
+    }
+    redo[i] = cancels ? 1.0f : 0.0f;
+  }
+}
+
+void row_geometry(const RowGeometry& g, const double origin[3], const double a[3], const double b[3], double px0, size_t count) {
+  HWY_DYNAMIC_DISPATCH(RowGeometryKernel)(g, origin, a, b, px0, count);
+}
+
+void row_geometry_rays(const RowGeometry& g, const Ray* rays, size_t count) {
+  const Aabb box{Vec3(g.lo[0], g.lo[1], g.lo[2]), Vec3(g.hi[0], g.hi[1], g.hi[2])};
+  for (size_t x = 0; x < count; ++x) {
+    const Ray& ray = rays[x];
+    double a = 0.0, b = kInfinity;
+    if (!box.clip(ray, a, b) || !(b > a)) a = b = 0.0;  // no medium: L_in 0, T 1 everywhere (a miss may leave a at +inf)
+    g.t0[x] = static_cast<float>(a), g.t1[x] = std::isfinite(b) ? static_cast<float>(b) : INFINITY;
+    for (size_t l = 0; l < g.light_count; ++l) {
+      const Vec3 to_light = Vec3(g.lights[3 * l], g.lights[3 * l + 1], g.lights[3 * l + 2]) - ray.origin;
+      const double t = glm::dot(to_light, ray.direction);
+      g.t[l][x] = static_cast<float>(t), g.h[l][x] = static_cast<float>(glm::length(to_light - t * ray.direction));
+    }
+  }
 }
 
 void tail_sums_reference(const AirlightTable& table, const TailRow& row, const float* d, float* const sums[3]) {

@@ -273,6 +273,15 @@ class AnalyticSolution final : public MethodSolution {
   void add_glow(const View& view, double glow_angle, ImageSpan out, const RenderOptions& options) const override {
     const Camera& camera = view.camera;
     if (!one_pass() || !glows(camera)) return;
+    struct Window {
+      size_t light;
+      double px, py, radius;
+      int y0, y1;
+    };
+    thread_local std::vector<Window> kept;  // a frame allocates nothing
+    std::vector<Window>& windows = kept;    // this thread's, which the loop's threads read
+    windows.clear();
+    long long y0 = camera.height_px, y1 = 0;  // the rows any window covers
     for (size_t l = 0; l < lights_.size(); ++l) {
       double px, py;
       if (!camera.film_position(lights_[l].position, px, py)) continue;
@@ -286,21 +295,26 @@ class AnalyticSolution final : public MethodSolution {
       const double radius = 1.25 * glow_angle / pixel + 2.0;
       // Clamped as doubles first: a light far off the film projects far outside int's range.
       const auto row = [&](double v) { return static_cast<int>(std::clamp(v, 0.0, static_cast<double>(camera.height_px))); };
-      const int y0 = row(std::floor(py - radius)), y1 = row(std::ceil(py + radius));
-      if (y0 >= y1) continue;
-      const auto body = [&](long long r0, long long r1) {
-        for (auto y = static_cast<int>(r0); y < r1; ++y) {  // the row's chord of the window's circle
-          const double dy = y + 0.5 - py, half = std::sqrt(std::max(0.0, radius * radius - dy * dy));
-          const auto column = [&](double v) { return static_cast<int>(std::clamp(v, 0.0, static_cast<double>(camera.width_px))); };
-          const int x0 = column(std::floor(px - half)), x1 = column(std::ceil(px + half));
-          if (x0 < x1) glow_row(view, l, glow_angle, y, x0, x1, out);
-        }
-      };
-      parallel_for(y1 - y0, options.threads, 4, [&body, y0](long long r0, long long r1) { body(y0 + r0, y0 + r1); });
+      const int first = row(std::floor(py - radius)), end = row(std::ceil(py + radius));
+      if (first >= end) continue;
+      windows.push_back({l, px, py, radius, first, end});
+      y0 = std::min<long long>(y0, first), y1 = std::max<long long>(y1, end);
     }
+    // The windows' rows in one parallel loop over image rows: a row adds every window over it, so
+    // that no two threads add into one pixel.
+    const auto body = [&](long long r0, long long r1) {
+      for (auto y = static_cast<int>(r0); y < r1; ++y)
+        for (const Window& w : windows) {
+          if (y < w.y0 || y >= w.y1) continue;
+          const double dy = y + 0.5 - w.py, half = std::sqrt(std::max(0.0, w.radius * w.radius - dy * dy));  // the row's chord
+          const auto column = [&](double v) { return static_cast<int>(std::clamp(v, 0.0, static_cast<double>(camera.width_px))); };
+          const int x0 = column(std::floor(w.px - half)), x1 = column(std::ceil(w.px + half));
+          if (x0 < x1) glow_row(view, w.light, glow_angle, y, x0, x1, out);
+        }
+    };
+    parallel_for(y1 - y0, options.threads, 4, [&body, y0](long long r0, long long r1) { body(y0 + r0, y0 + r1); });
   }
 
- private:
   // Point lights without surfaces, the SIMD kernel: render_distances' one pass (and add_glow's).
   bool one_pass() const {
     if (!scene_.surfaces.empty() || !airlight_ || kernel_ != &add_airlight) return false;
@@ -318,10 +332,10 @@ class AnalyticSolution final : public MethodSolution {
     return u * u * (3.0 - 2.0 * u);
   }
 
-  // One row of rays toward every light (or only light `only`): each ray's stretch [t0, t1] in the
-  // medium, its geometry toward each light in float64 (t and h), and with a glow angle each
-  // light's share per ray (taken, or left: `left`), into the thread's kept scratch; the TailRow
-  // over them.
+  // Pixels [x0, x0 + count) of row y toward every light (or only light `only`): each ray's stretch
+  // [t0, t1] in the medium, its geometry toward each light in float64 (t and h: row_geometry's
+  // lanes where the camera has a row frame), and with a glow angle each light's share per ray
+  // (taken, or left: `left`), into the thread's kept scratch; the TailRow over them.
   struct RowRays {
     TailRow row;
     float *t0, *t1, *whole[3];  // whole: where tail_sums puts the row's sums at t0 (row.whole)
@@ -329,42 +343,51 @@ class AnalyticSolution final : public MethodSolution {
   // The kernels' arrays hold whole vectors: count rounded up to 16 (airlight_batch.h).
   static size_t padded_count(size_t count) { return (count + 15) / 16 * 16; }
 
-  RowRays ray_tails(const Ray* rays, size_t count, double glow_angle, size_t only, bool left) const {
+  RowRays ray_tails(const Camera& camera, int y, int x0, size_t count, double glow_angle, size_t only, bool left) const {
     const size_t padded = padded_count(count);
     const size_t lights = lights_.size();
     // Per thread, kept between frames: a frame allocates nothing once they have grown.
     thread_local std::vector<float> scratch;
     thread_local std::vector<TailLight> tails;
+    thread_local std::vector<double> positions;
+    thread_local std::vector<float*> t_of, h_of;
+    thread_local std::vector<Ray> rays;
     scratch.assign((5 + 3 * lights) * padded, 0.0f);
-    tails.clear();
+    tails.clear(), positions.clear(), t_of.clear(), h_of.clear();
     float* const t0 = scratch.data();
     float* const t1 = t0 + padded;
     float* const whole = t1 + padded;  // three channels
     float* const geometry = whole + 3 * padded;  // per light: t, h, share
-    const Aabb bounds = medium_->bounds();
-    // A light within the glow angle of a ray's direction: t > 0 and h < t tan(angle) (angle <= 0.5).
-    const double tan_glow = std::tan(glow_angle);
-    for (size_t x = 0; x < count; ++x) {
-      const Ray& ray = rays[x];
-      double a = 0.0, b = kInfinity;
-      if (!bounds.clip(ray, a, b) || !(b > a)) a = b = 0.0;  // no medium: L_in 0, T 1 everywhere (a miss may leave a at +inf)
-      t0[x] = static_cast<float>(a), t1[x] = std::isfinite(b) ? static_cast<float>(b) : INFINITY;
-      for (size_t l = 0; l < lights; ++l) {
-        if (only < lights && l != only) continue;
-        const Vec3 to_light = lights_[l].position - ray.origin;
-        const double t = glm::dot(to_light, ray.direction), h = glm::length(to_light - t * ray.direction);
-        float* g = geometry + 3 * l * padded;
-        g[x] = static_cast<float>(t), g[padded + x] = static_cast<float>(h);
-        const double share = glow_angle > 0.0 && t > 0.0 && h < t * tan_glow ? glow_share(std::atan2(h, t), glow_angle) : 0.0;
-        g[2 * padded + x] = static_cast<float>(left ? share : 1.0 - share);
-      }
-    }
     for (size_t l = 0; l < lights; ++l) {
       if (only < lights && l != only) continue;
-      const float* g = geometry + 3 * l * padded;
-      const bool whole_light = !left && std::all_of(g + 2 * padded, g + 2 * padded + count, [](float s) { return s == 1.0f; });
+      const Vec3& p = lights_[l].position;
+      positions.insert(positions.end(), {p.x, p.y, p.z});
+      t_of.push_back(geometry + 3 * l * padded), h_of.push_back(geometry + (3 * l + 1) * padded);
+    }
+    const Aabb bounds = medium_->bounds();
+    const RowGeometry g{{bounds.lo.x, bounds.lo.y, bounds.lo.z}, {bounds.hi.x, bounds.hi.y, bounds.hi.z}, positions.data(), t_of.size(),
+                        t0, t1, t_of.data(), h_of.data()};
+    if (Vec3 a, b; camera.row_frame(y + 0.5, a, b)) {
+      const double origin[3] = {camera.position.x, camera.position.y, camera.position.z}, a3[3] = {a.x, a.y, a.z}, b3[3] = {b.x, b.y, b.z};
+      row_geometry(g, origin, a3, b3, x0 + 0.5, count);
+    } else {
+      rays.resize(count);
+      camera.row_rays(y, x0, x0 + static_cast<int>(count), rays.data());
+      row_geometry_rays(g, rays.data(), count);
+    }
+    // A light within the glow angle of a ray's direction: t > 0 and h < t tan(angle) (angle <= 0.5).
+    const double tan_glow = std::tan(glow_angle);
+    for (size_t l = 0; l < lights; ++l) {
+      if (only < lights && l != only) continue;
+      float* g_l = geometry + 3 * l * padded;
+      for (size_t x = 0; x < count; ++x) {
+        const double t = g_l[x], h = g_l[padded + x];
+        const double share = glow_angle > 0.0 && t > 0.0 && h < t * tan_glow ? glow_share(std::atan2(h, t), glow_angle) : 0.0;
+        g_l[2 * padded + x] = static_cast<float>(left ? share : 1.0 - share);
+      }
+      const bool whole_light = !left && std::all_of(g_l + 2 * padded, g_l + 2 * padded + count, [](float s) { return s == 1.0f; });
       for (int c = 0; c < (grey_ ? 1 : 3); ++c) {
-        TailLight tail{g, g + padded, static_cast<float>(sigma_t_[c]), {}, whole_light || glow_angle == 0.0 ? nullptr : g + 2 * padded};
+        TailLight tail{g_l, g_l + padded, static_cast<float>(sigma_t_[c]), {}, whole_light || glow_angle == 0.0 ? nullptr : g_l + 2 * padded};
         for (int e = 0; e < 3; ++e)
           if (grey_ || e == c) tail.weight[e] = static_cast<float>(sigma_s_[e] * lights_[l].intensity[e]);
         tails.push_back(tail);
@@ -378,10 +401,7 @@ class AnalyticSolution final : public MethodSolution {
   // render_distances' row y: the row's rays, then its slices.
   void slices_row(const Camera& camera, int y, std::span<const double> distances, double glow_angle, DistanceLayers out) const {
     const auto width = static_cast<size_t>(camera.width_px);
-    thread_local std::vector<Ray> rays;
-    rays.resize(width);
-    camera.row_rays(y, rays.data());
-    const RowRays r = ray_tails(rays.data(), width, glow_angle, lights_.size(), false);
+    const RowRays r = ray_tails(camera, y, 0, width, glow_angle, lights_.size(), false);
     tail_sums(table_, r.row, r.t0, r.whole);
     thread_local std::vector<float> at;
     at.assign(distances.begin(), distances.end());
@@ -419,37 +439,35 @@ class AnalyticSolution final : public MethodSolution {
   void layers_row(const View& view, int y, LayerSpans out) const {
     const Camera& camera = view.camera;
     const auto width = static_cast<size_t>(camera.width_px);
-    thread_local std::vector<Ray> rays;
-    rays.resize(width);
-    camera.row_rays(y, rays.data());
-    const RowRays r = ray_tails(rays.data(), width, 0.0, lights_.size(), false);
+    const RowRays r = ray_tails(camera, y, 0, width, 0.0, lights_.size(), false);
     const EndTails e = end_tails(view, y, 0, r, width);
-    const float* const ends = e.ends;
-    float* const* whole = r.whole;
-    const float* const* sums = e.sums;
-    for (size_t x = 0; x < width; ++x) {
-      const auto px = static_cast<int>(x);
-      Rgb l(0.0), t(1.0);
-      const double t0 = r.t0[x], end = ends[x];
-      if (end > t0) {
-        bool cancels = false;
-        for (int c = 0; c < 3; ++c) {
-          t[c] = c > 0 && grey_ ? t[0] : std::isfinite(end) ? std::exp(-sigma_t_[c] * (end - t0)) : 0.0;
-          const double far = t[c] * static_cast<double>(sums[c][x]);
-          cancels = cancels || far > 0.75 * static_cast<double>(whole[c][x]);
-          l[c] = std::max(0.0, static_cast<double>(whole[c][x]) - far);
-        }
-        if (cancels) l = exact_airlight(rays[x], t0, end);
+    const size_t padded = padded_count(width);
+    thread_local std::vector<float> layers;  // kept: L_in and T as RGB triples, then the pixels to redo
+    layers.resize(7 * padded);
+    float* const l_rgb = layers.data();
+    float* const t_rgb = l_rgb + 3 * padded;
+    layers_from_tails(r.row, e.ends, e.sums, l_rgb, t_rgb, t_rgb + 3 * padded);
+    const float* const redo_at = t_rgb + 3 * padded;
+    for (size_t x = 0; x < width; ++x)
+      if (redo_at[x] != 0.0f) {
+        const Rgb l = exact_airlight(camera.pixel_ray(static_cast<int>(x), y), r.t0[x], e.ends[x]);
+        for (int c = 0; c < 3; ++c) l_rgb[3 * x + c] = static_cast<float>(l[c]);
       }
-      float* li = out.inscatter.pixel(px, y);
-      float* ti = out.transmittance.pixel(px, y);
-      for (int c = 0; c < 3; ++c) li[c] = static_cast<float>(l[c]), ti[c] = static_cast<float>(t[c]);
-      if (out.surface.data) {  // the background where nothing ends the ray, else the host's (0)
+    const auto copy_row = [&](const float* rgb, ImageSpan to) {
+      if (to.channels == 3) {
+        std::copy_n(rgb, 3 * width, to.pixel(0, y));
+        return;
+      }
+      for (size_t x = 0; x < width; ++x) std::copy_n(rgb + 3 * x, 3, to.pixel(static_cast<int>(x), y));
+    };
+    copy_row(l_rgb, out.inscatter), copy_row(t_rgb, out.transmittance);
+    if (out.surface.data)  // the background where nothing ends the ray, else the host's (0)
+      for (size_t x = 0; x < width; ++x) {
+        const auto px = static_cast<int>(x);
         const Rgb surface = std::isinf(view.max_distance(px, y)) ? scene_.background : Rgb(0.0);
         float* si = out.surface.pixel(px, y);
         for (int c = 0; c < 3; ++c) si[c] = static_cast<float>(surface[c]);
       }
-    }
   }
 
   // The point lights' airlight along [t0, end] of a ray by the float64 segment path.
@@ -478,22 +496,15 @@ class AnalyticSolution final : public MethodSolution {
   // channel, S the light's tails, `end` the ray's end in the medium (the view's depth or t1).
   void glow_row(const View& view, size_t l, double glow_angle, int y, int x0, int x1, ImageSpan out) const {
     const auto count = static_cast<size_t>(x1 - x0);
-    thread_local std::vector<Ray> rays;
-    rays.resize(count);
-    view.camera.row_rays(y, x0, x1, rays.data());
-    const RowRays r = ray_tails(rays.data(), count, glow_angle, l, true);
+    const RowRays r = ray_tails(view.camera, y, x0, count, glow_angle, l, true);
     const EndTails e = end_tails(view, y, x0, r, count);
-    const float* const ends = e.ends;
-    float* const* whole = r.whole;
-    const float* const* sums = e.sums;
+    thread_local std::vector<float> layers;  // kept: L_in and T as RGB triples, then the flags (unused: no float64 redo here)
+    const size_t padded = padded_count(count);
+    layers.resize(7 * padded);
+    layers_from_tails(r.row, e.ends, e.sums, layers.data(), layers.data() + 3 * padded, layers.data() + 6 * padded);
     for (size_t i = 0; i < count; ++i) {
-      if (!(ends[i] > r.t0[i])) continue;
       float* pixel = out.pixel(x0 + static_cast<int>(i), y);
-      double T = 0.0;
-      for (int c = 0; c < 3; ++c) {
-        if (c == 0 || !grey_) T = std::isfinite(ends[i]) ? std::exp(-sigma_t_[c] * static_cast<double>(ends[i] - r.t0[i])) : 0.0;
-        pixel[c] += static_cast<float>(std::max(0.0, static_cast<double>(whole[c][i]) - T * static_cast<double>(sums[c][i])));
-      }
+      for (int c = 0; c < 3; ++c) pixel[c] += layers[3 * i + static_cast<size_t>(c)];
     }
   }
 

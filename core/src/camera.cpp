@@ -89,11 +89,9 @@ bool Camera::film_position(const Vec3& point, double& px, double& py) const {
   }
   if (type != Type::pinhole) return false;
   // row_rays_at's frame, inverted.
-  Vec3 forward = look_at - position, right;
-  make_unit(forward);
-  right = glm::cross(forward, up);
-  make_unit(right);
-  const Vec3 true_up = glm::cross(right, forward), d = point - position;
+  Vec3 forward, right, true_up;
+  frame(forward, right, true_up);
+  const Vec3 d = point - position;
   const double z = glm::dot(d, forward);
   if (!(z > 0.0)) return false;
   const double tan_half = std::tan(0.5 * fov_y_deg * kPi / 180.0), aspect = static_cast<double>(width_px) / height_px;
@@ -107,11 +105,8 @@ void Camera::row_rays_at(double py, const double* px, int count, Ray* out) const
     for (int i = 0; i < count; ++i) out[i] = generate_ray(px[i], py);
     return;
   }
-  Vec3 forward = look_at - position, right;
-  make_unit(forward);  // check_scene refuses a camera whose view or up gives no frame
-  right = glm::cross(forward, up);
-  make_unit(right);
-  const Vec3 true_up = glm::cross(right, forward);
+  Vec3 forward, right, true_up;
+  frame(forward, right, true_up);
   // Film coordinates in [-1, 1] vertically, aspect-scaled horizontally; row 0 at the top.
   const double aspect = static_cast<double>(width_px) / height_px;
   const double sy = 1.0 - 2.0 * py / height_px;
@@ -123,6 +118,39 @@ void Camera::row_rays_at(double py, const double* px, int count, Ray* out) const
   const double tan_half = std::tan(0.5 * fov_y_deg * kPi / 180.0);
   const Vec3 centre = forward + true_up * (sy * tan_half);
   for (int i = 0; i < count; ++i) out[i] = {position, glm::normalize(centre + right * ((2.0 * px[i] / width_px - 1.0) * aspect * tan_half))};
+}
+
+void Camera::frame(Vec3& forward, Vec3& right, Vec3& true_up) const {
+  forward = look_at - position;
+  make_unit(forward);  // check_scene refuses a camera whose view or up gives no frame
+  right = glm::cross(forward, up);
+  make_unit(right);
+  true_up = glm::cross(right, forward);
+}
+
+bool Camera::row_frame(double py, Vec3& a, Vec3& b) const {
+  if (type == Type::matrices) {
+    // generate_ray's near point P^-1 (nx, ny, -1, 1), linear in nx = 2 px / W - 1; its w must not
+    // depend on nx (a perspective projection's does not), so that dividing by it keeps it linear.
+    if (projection[2][3] == 0.0 || projection_inverse[0][3] != 0.0) return false;
+    const double ny = 1.0 - 2.0 * py / height_px;
+    const glm::dvec4 near = projection_inverse * glm::dvec4(-1.0, ny, -1.0, 1.0), per_px = projection_inverse[0] * (2.0 / width_px);
+    a = Vec3(view_inverse * glm::dvec4(Vec3(near) / near.w, 0.0)), b = Vec3(view_inverse * glm::dvec4(Vec3(per_px) / near.w, 0.0));
+    return true;
+  }
+  if (type != Type::pinhole) return false;
+  // row_rays_at's: centre + right ((2 px / W - 1) aspect tan_half).
+  Vec3 forward, right, true_up;
+  frame(forward, right, true_up);
+  const double tan_half = std::tan(0.5 * fov_y_deg * kPi / 180.0), aspect = static_cast<double>(width_px) / height_px;
+  const Vec3 right_px = right * (aspect * tan_half);
+  a = forward + true_up * ((1.0 - 2.0 * py / height_px) * tan_half) - right_px, b = right_px * (2.0 / width_px);
+  return true;
+}
+
+double Camera::pixel_angle() const {
+  const double x = 0.5 * width_px, y = 0.5 * height_px;
+  return std::acos(std::clamp(glm::dot(generate_ray(x, y).direction, generate_ray(x + 1.0, y).direction), -1.0, 1.0));
 }
 
 void Camera::row_rays(int y, int x0, int x1, Ray* out) const {

@@ -107,11 +107,7 @@ void froxels_detail::build(const Solution& solution, const Camera& camera, Froxe
   const Camera columns = column_camera(camera, grid.nx, grid.ny);
   // The glow angle: glow_columns times the angle between the middle column and its neighbour.
   out.glow_angle = 0.0;
-  if (grid.glow_columns > 0.0) {
-    const double i = 0.5 * grid.nx, j = 0.5 * grid.ny;
-    const double cos_pitch = glm::dot(columns.generate_ray(i, j).direction, columns.generate_ray(i + 1.0, j).direction);
-    out.glow_angle = std::min(grid.glow_columns * std::acos(std::clamp(cos_pitch, -1.0, 1.0)), 0.5);
-  }
+  if (grid.glow_columns > 0.0) out.glow_angle = std::min(grid.glow_columns * columns.pixel_angle(), 0.5);
   solution.render_distances(View{columns}, std::span<const double>(boundaries.data(), static_cast<size_t>(grid.nz)),
                             DistanceLayers{out.inscatter, out.transmittance, out.glow_angle}, options);
 }

@@ -287,6 +287,7 @@ class DomMethodSolution final : public GridSolution {
     const auto width = static_cast<size_t>(camera.width_px);
     const size_t per_slice = width * static_cast<size_t>(camera.height_px);
     const Aabb bounds = volume_.density.bounds();
+    const double pitch = camera.pixel_angle();  // a column's width per unit distance: no finer steps along it
     const auto rows = [&](long long y0, long long y1) {
       thread_local std::vector<Ray> rays;
       thread_local Eigen::VectorXd row, c;
@@ -303,7 +304,7 @@ class DomMethodSolution final : public GridSolution {
             const double from = std::max(t0, k == 0 ? 0.0 : distances[k - 1]), to = std::min(t1, distances[k]);
             if (inside && to > from) {
               Rgb t_k;
-              const Rgb l_k = gather.along_stretch(ray, from, to, c, t_k);
+              const Rgb l_k = gather.along_stretch(ray, from, to, c, t_k, pitch * from);
               l += t * l_k, t *= t_k;
             }
             const size_t at = k * per_slice + static_cast<size_t>(y) * width + x;

@@ -83,12 +83,12 @@ Rgb Gather::along(const Ray& ray, double t_end, const Eigen::VectorXd& c, Rgb& t
   return along(ray, 0.0, t_end, &c, nullptr, kAll, transmittance, cone);
 }
 
-Rgb Gather::along_stretch(const Ray& ray, double t_start, double t_end, const Eigen::VectorXd& c, Rgb& transmittance) const {
-  return along(ray, t_start, t_end, &c, nullptr, kAll, transmittance, 0.0);
+Rgb Gather::along_stretch(const Ray& ray, double t_start, double t_end, const Eigen::VectorXd& c, Rgb& transmittance, double least_step) const {
+  return along(ray, t_start, t_end, &c, nullptr, kAll, transmittance, 0.0, least_step);
 }
 
 Rgb Gather::along(const Ray& ray, double t_start, double t_end, const Eigen::VectorXd* c, const double* share, size_t only,
-                  Rgb& transmittance, double cone) const {
+                  Rgb& transmittance, double cone, double least_step) const {
   const DenseGrid& density = volume_.density;
   Rgb radiance(0.0);
   transmittance = Rgb(1.0);
@@ -98,7 +98,7 @@ Rgb Gather::along(const Ray& ray, double t_start, double t_end, const Eigen::Vec
   std::array<double, 64> small;  // the moments at a step: no allocation for up to 64 terms
   std::vector<double> large(n > small.size() ? n : 0);
   double* m = n > small.size() ? large.data() : small.data();
-  const double step = only == kAll ? step_ : kGlowStep * step_;
+  const double step = std::max(only == kAll ? step_ : kGlowStep * step_, least_step);
   const int steps = static_cast<int>(std::ceil((t1 - t0) / step));
   const double dt = (t1 - t0) / steps;
   const bool beside_spheres = c && surfaces_ && cone == 0.0 && !spheres_.empty();  // camera rays: sphere_correction

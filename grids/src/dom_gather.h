@@ -33,9 +33,10 @@ class Gather {
   // (equiangular_nodes) and a sphere it passes replaces the medium's light from its direction
   // (sphere_correction).
   Rgb along(const Ray& ray, double t_end, const Eigen::VectorXd& c, Rgb& transmittance, double cone = 0.0) const;
-  // The same over the ray's stretch [t_start, t_end] alone, in steps of its own (a camera ray's
-  // slice between two froxel boundaries: render_distances chains them).
-  Rgb along_stretch(const Ray& ray, double t_start, double t_end, const Eigen::VectorXd& c, Rgb& transmittance) const;
+  // The same over the ray's stretch [t_start, t_end] alone, in steps of its own, at least
+  // `least_step` long (a froxel column's slice between two boundaries, stepped no finer than the
+  // columns' spacing there: render_distances chains them).
+  Rgb along_stretch(const Ray& ray, double t_start, double t_end, const Eigen::VectorXd& c, Rgb& transmittance, double least_step = 0.0) const;
 
   // From now on along() takes only the steps whose midpoints lie in z planes [first, last), the
   // steps themselves unchanged, and reads moments from a solution holding planes from
@@ -109,10 +110,11 @@ class Gather {
   // Light l's single scattering arriving at `point` from direction w, up to the next surface.
   Rgb single(const Vec3& point, const Vec3& w, size_t l) const;
   // along() with the moments' in-scattering only given c, and each light's single scattering
-  // times share[l] (all of it without `share`), or only light `only`'s (in longer steps).
+  // times share[l] (all of it without `share`), or only light `only`'s (in longer steps), in
+  // steps at least `least_step` long.
   static constexpr size_t kAll = static_cast<size_t>(-1);
   Rgb along(const Ray& ray, double t_start, double t_end, const Eigen::VectorXd* c, const double* share, size_t only, Rgb& transmittance,
-            double cone) const;
+            double cone, double least_step = 0.0) const;
 
   const Scene& delta_;
   const ExtinctionVolume& volume_;

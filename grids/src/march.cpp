@@ -254,44 +254,80 @@ void march_row_layers(const Marcher& m, const MarchVolume& v, const View& view, 
 }
 
 // Row y's stretches between consecutive distances, one packet, chained per ray (march_distances).
-// The segments go slice by slice, so that a vector's lanes march the same slice of neighbouring
-// rays (similar step counts). Buffers are per thread and kept: a frame allocates nothing once
-// they have grown.
+// A stretch from distance d steps no finer than pitch d, the spacing of the view's rays there (a
+// froxel column's width: the froxels resolve no more across), unless a point or spot light lies
+// within two such steps of it: its 1 / d^2 peak there takes the marcher's own step (farther, the
+// midpoints of steps s take the peak of a light at h from the line to e^(-2 pi h / s) of its
+// integral). The segments go slice by slice, so that a vector's lanes march the same slice of
+// neighbouring rays (similar step counts). Buffers are per thread and kept: a frame allocates
+// nothing once they have grown.
 void march_row_distances(const Marcher& m, const MarchVolume& v, const View& view, std::span<const double> distances, int y,
-                         DistanceLayers out) {
+                         DistanceLayers out, double pitch) {
   const Camera& camera = view.camera;
   const auto width = static_cast<size_t>(camera.width_px), n = distances.size();
+  struct Column {
+    Ray ray;
+    double t0 = 0.0, t1 = 0.0;  // the ray's stretch in the medium
+    size_t k0 = 0, k1 = 0;      // the slices [k0, k1) that hold some of it
+    size_t near0 = 0, near1 = 0;  // its lights in `near`
+  };
+  // A point or spot light within two coarse steps of a ray (where it passes nearest, t along it
+  // and h from it): the segments that come as near take fine steps.
+  struct Near {
+    double t, h;
+  };
   thread_local std::vector<Ray> rays;
-  thread_local std::vector<std::pair<double, double>> inside;  // each ray's stretch in the medium
+  thread_local std::vector<Column> columns;
+  thread_local std::vector<Near> near;
   thread_local std::vector<float> packed, result;
   thread_local std::vector<Vec3f> l, t;  // each ray's layers so far
-  rays.resize(width), inside.resize(width);
+  rays.resize(width), columns.resize(width), near.clear();
   camera.row_rays(y, rays.data());
-  for (size_t x = 0; x < width; ++x) {
-    double a = 0.0, b = m.hit(rays[x]).t;
-    if (!m.volume.density.bounds().clip(rays[x], a, b) || !(b > a)) b = a;
-    inside[x] = {a, b};
-  }
-  // The stretch of ray x before distance k inside the medium: [from, to) when to > from.
-  const auto stretch = [&](size_t x, size_t k) {
-    return std::pair{std::max(inside[x].first, k == 0 ? 0.0 : distances[k - 1]), std::min(inside[x].second, distances[k])};
-  };
   size_t count = 0;
-  for (size_t k = 0; k < n; ++k)
-    for (size_t x = 0; x < width; ++x)
-      if (const auto [from, to] = stretch(x, k); to > from) ++count;
+  for (size_t x = 0; x < width; ++x) {
+    Column& c = columns[x];
+    c.ray = rays[x];
+    double a = 0.0, b = m.hit(c.ray).t;
+    if (!m.volume.density.bounds().clip(c.ray, a, b) || !(b > a)) b = a;
+    c.t0 = a, c.t1 = b;
+    // Slice k holds [max(t0, d_k-1), min(t1, d_k)): from the first d_k past t0 to the first at or past t1.
+    c.k0 = static_cast<size_t>(std::upper_bound(distances.begin(), distances.end(), a) - distances.begin());
+    c.k1 = b > a ? std::min(n, static_cast<size_t>(std::lower_bound(distances.begin(), distances.end(), b) - distances.begin()) + 1) : c.k0;
+    count += c.k1 > c.k0 ? c.k1 - c.k0 : 0;
+    c.near0 = near.size();
+    for (const Light& light : m.scene.lights) {
+      const Vec3* p = nullptr;
+      if (const auto* point = std::get_if<PointLight>(&light)) p = &point->position;
+      else if (const auto* spot = std::get_if<SpotLight>(&light)) p = &spot->position;
+      if (!p || !(b > a)) continue;
+      const Vec3 to_light = *p - c.ray.origin;
+      const double along = glm::dot(to_light, c.ray.direction), h = glm::length(to_light - along * c.ray.direction);
+      if (h < 2.0 * pitch * b) near.push_back({along, h});
+    }
+    c.near1 = near.size();
+  }
+  const auto fine = [&](const Column& c, double from, double to, double coarse) {
+    for (size_t e = c.near0; e < c.near1; ++e) {
+      const double off = near[e].t - std::clamp(near[e].t, from, to);
+      if (near[e].h * near[e].h + off * off < 4.0 * coarse * coarse) return true;
+    }
+    return false;
+  };
   packed.resize(9 * count), result.assign(6 * count, 0.0f);
   size_t i = 0;
   for (size_t k = 0; k < n; ++k)
-    for (size_t x = 0; x < width; ++x)
-      if (const auto [from, to] = stretch(x, k); to > from) {
-        const int steps = static_cast<int>(std::ceil((to - from) / m.step));
-        const Ray& r = rays[x];
-        const double segment[9] = {r.origin.x, r.origin.y, r.origin.z, r.direction.x, r.direction.y, r.direction.z, from, (to - from) / steps,
-                                   static_cast<double>(steps)};
-        for (size_t e = 0; e < 9; ++e) packed[e * count + i] = static_cast<float>(segment[e]);
-        ++i;
-      }
+    for (size_t x = 0; x < width; ++x) {
+      const Column& c = columns[x];
+      if (k < c.k0 || k >= c.k1) continue;
+      const double from = std::max(c.t0, k == 0 ? 0.0 : distances[k - 1]), to = std::min(c.t1, distances[k]);
+      const double coarse = pitch * from, step = coarse > m.step && !fine(c, from, to, coarse) ? coarse : m.step;
+      const int steps = std::max(1, static_cast<int>(std::ceil((to - from) / step)));
+      const Ray& r = c.ray;
+      const double segment[9] = {r.origin.x, r.origin.y, r.origin.z, r.direction.x, r.direction.y, r.direction.z, from, (to - from) / steps,
+                                 static_cast<double>(steps)};
+      for (size_t e = 0; e < 9; ++e) packed[e * count + i] = static_cast<float>(segment[e]);
+      ++i;
+    }
   auto row = [&](std::vector<float>& buffer, size_t a) { return buffer.data() + a * count; };
   RayPacket packet{row(packed, 0), row(packed, 1), row(packed, 2), row(packed, 3), row(packed, 4), row(packed, 5), row(packed, 6), row(packed, 7),
                          row(packed, 8), count, {row(result, 0), row(result, 1), row(result, 2)}, {row(result, 3), row(result, 4), row(result, 5)}};
@@ -299,18 +335,18 @@ void march_row_distances(const Marcher& m, const MarchVolume& v, const View& vie
   // Chained front to back: L(d_k) = L(d_k-1) + T(d_k-1) L_k, T(d_k) = T(d_k-1) T_k.
   l.assign(width, Vec3f(0.0f)), t.assign(width, Vec3f(1.0f));
   const size_t per_slice = width * static_cast<size_t>(camera.height_px), first = static_cast<size_t>(y) * width;
+  const size_t grey = v.channels == 1 ? 0 : 1;  // channel c's row: c times this
   i = 0;
-  for (size_t k = 0; k < n; ++k)
+  for (size_t k = 0; k < n; ++k) {
     for (size_t x = 0; x < width; ++x) {
-      if (const auto [from, to] = stretch(x, k); to > from) {
-        for (int c = 0; c < 3; ++c) {
-          const size_t channel = v.channels == 1 ? 0 : static_cast<size_t>(c);
-          l[x][c] += t[x][c] * row(result, channel)[i], t[x][c] *= row(result, 3 + channel)[i];
-        }
+      if (k >= columns[x].k0 && k < columns[x].k1) {
+        for (size_t c = 0; c < 3; ++c) l[x][c] += t[x][c] * row(result, c * grey)[i], t[x][c] *= row(result, 3 + c * grey)[i];
         ++i;
       }
-      out.inscatter[k * per_slice + first + x] = l[x], out.transmittance[k * per_slice + first + x] = t[x];
     }
+    std::copy(l.begin(), l.begin() + static_cast<std::ptrdiff_t>(width), out.inscatter.begin() + static_cast<std::ptrdiff_t>(k * per_slice + first));
+    std::copy(t.begin(), t.begin() + static_cast<std::ptrdiff_t>(width), out.transmittance.begin() + static_cast<std::ptrdiff_t>(k * per_slice + first));
+  }
 }
 
 }  // namespace
@@ -345,8 +381,9 @@ bool march_distances(const Scene& scene, const ExtinctionVolume& volume, const s
   MarchVolume simd_view;
   if (settings.scalar || !simd_volume(marcher, lights, simd_view)) return false;
   const Camera& camera = view.camera;
+  const double pitch = camera.pixel_angle();  // a column's width per unit distance: no finer steps along it
   const auto rows = [&](long long y0, long long y1) {
-    for (auto y = static_cast<int>(y0); y < y1; ++y) march_row_distances(marcher, simd_view, view, distances, y, out);
+    for (auto y = static_cast<int>(y0); y < y1; ++y) march_row_distances(marcher, simd_view, view, distances, y, out, pitch);
   };
   // A body of one reference: std::function keeps it without allocating.
   parallel_for(camera.height_px, options.threads, 1, [&rows](long long y0, long long y1) { rows(y0, y1); });

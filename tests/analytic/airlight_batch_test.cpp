@@ -1,10 +1,14 @@
 // The batched airlight on every compiled target against its scalar reference, and the reference
 // against the float64 table path.
+#include <haze/core/camera.h>
 #include <haze/core/rng.h>
 #include <haze/analytic/airlight_batch.h>
 
+#include <glm/ext/matrix_clip_space.hpp>
+#include <glm/ext/matrix_transform.hpp>
 #include <gtest/gtest.h>
 #include <algorithm>
+#include <array>
 #include <cstdio>
 #include <hwy/tests/hwy_gtest.h>
 
@@ -162,6 +166,94 @@ TEST_P(AirlightBatchTargets, SlicesMatchScalarReference) {
         EXPECT_EQ(l[k * stride + 3 * n], -1.0f) << "written past slice " << k;
       }
     }
+}
+
+// Many slices out to where the tails are spent (T g below 1e-6 of g(t0): the kernel stops
+// evaluating them) against each slice by the reference.
+TEST_P(AirlightBatchTargets, SpentSlicesMatchScalarReference) {
+  const size_t n = 37, padded = 48;
+  const SliceRow r(n, 23, Rgb(0.26), Rgb(0.234), table());
+  std::vector<float> distances;
+  for (int k = 0; k < 64; ++k) distances.push_back(static_cast<float>(0.1 * std::pow(1000.0, (k + 1) / 64.0)));
+  const size_t stride = 3 * n;
+  std::vector<float> l(stride * distances.size()), t(l.size());
+  airlight_slices(table(), r.row, distances, l.data(), t.data(), stride);
+  for (size_t k = 0; k < distances.size(); ++k) {
+    std::vector<float> l_ref(3 * n), t_ref(3 * n);
+    airlight_slice_reference(table(), r.row, distances[k], l_ref.data(), t_ref.data());
+    for (size_t i = 0; i < 3 * n; ++i) {
+      ASSERT_NEAR(l[k * stride + i], l_ref[i], 2e-5f * r.whole[(i % 3) * padded + i / 3] + 1e-30f) << "ray " << i / 3 << " slice " << k;
+      ASSERT_NEAR(t[k * stride + i], t_ref[i], 1e-6f * t_ref[i]) << "ray " << i / 3 << " slice " << k;
+    }
+  }
+}
+
+// Per-pixel layers from a row's tails at its entries and ends, against the reference; ends before
+// the entry, at infinity and nearly at it (the tails cancelling: flagged for float64) included.
+TEST_P(AirlightBatchTargets, LayersFromTailsMatchScalarReference) {
+  for (const Rgb& sigma_t : {Rgb(0.26), Rgb(0.05, 0.3, 2.0)}) {
+    const size_t n = 37, padded = 48;
+    const SliceRow r(n, 29, sigma_t, 0.9 * sigma_t, table());
+    std::vector<float> ends(padded, 0.0f), at(padded, 0.0f), sums(3 * padded, 0.0f);
+    for (size_t i = 0; i < n; ++i) {
+      ends[i] = i % 4 == 0 ? INFINITY : i % 4 == 1 ? r.t0[i] - 0.1f : r.t0[i] + (i % 4 == 2 ? 0.01f : 3.0f);
+      at[i] = std::isfinite(ends[i]) ? std::max(ends[i], r.t0[i]) : r.t0[i];
+    }
+    float* const s[3] = {sums.data(), sums.data() + padded, sums.data() + 2 * padded};
+    tail_sums_reference(table(), r.row, at.data(), s);
+    std::vector<float> l(3 * padded), t(3 * padded), redo(padded), l_ref(3 * padded), t_ref(3 * padded), redo_ref(padded);
+    layers_from_tails(r.row, ends.data(), s, l.data(), t.data(), redo.data());
+    layers_from_tails_reference(r.row, ends.data(), s, l_ref.data(), t_ref.data(), redo_ref.data());
+    size_t flagged = 0;
+    for (size_t i = 0; i < n; ++i) {
+      ASSERT_EQ(redo[i], redo_ref[i]) << "ray " << i;
+      flagged += redo[i] != 0.0f;
+      for (size_t c = 0; c < 3; ++c) {
+        ASSERT_NEAR(t[3 * i + c], t_ref[3 * i + c], 1e-6f * t_ref[3 * i + c]) << "ray " << i << " channel " << c;
+        ASSERT_NEAR(l[3 * i + c], l_ref[3 * i + c], 1e-6f * r.whole[c * padded + i] + 1e-30f) << "ray " << i << " channel " << c;
+      }
+    }
+    EXPECT_GT(flagged, 0u) << "the short stretches cancel";
+  }
+}
+
+// A row frame's geometry in float64 lanes against the same rays one at a time: pinhole and a host's
+// perspective matrices, in a box and unbounded, a light on a ray among them.
+TEST_P(AirlightBatchTargets, RowGeometryMatchesRays) {
+  Camera pinhole;
+  pinhole.position = Vec3(0.2, 1.5, 6.0), pinhole.look_at = Vec3(0.0, 0.5, 0.0), pinhole.width_px = 53, pinhole.height_px = 31;
+  const Camera host = Camera::from_matrices(glm::lookAt(glm::dvec3(0.2, 1.5, 6.0), glm::dvec3(0.0, 0.5, 0.0), glm::dvec3(0.0, 1.0, 0.0)),
+                                            glm::perspective(0.8, 53.0 / 31.0, 0.1, 100.0), 53, 31);
+  for (const Camera& camera : {pinhole, host}) {
+    const Ray on_ray = camera.pixel_ray(17, 9);
+    const std::vector<double> lights{0.3, -0.4, 0.5, on_ray.at(4.0).x, on_ray.at(4.0).y, on_ray.at(4.0).z, -2.0, 3.0, 1.0};
+    for (const Aabb& box : {Aabb{Vec3(-1.5), Vec3(1.5)}, Aabb{}}) {
+      const size_t n = 53, padded = 64;
+      std::vector<float> fast(8 * padded, 0.0f), slow(8 * padded, 0.0f);
+      const auto geometry = [&](std::vector<float>& v, std::array<float*, 3>& t, std::array<float*, 3>& h) {
+        for (size_t l = 0; l < 3; ++l) t[l] = v.data() + (2 + 2 * l) * padded, h[l] = v.data() + (3 + 2 * l) * padded;
+        return RowGeometry{{box.lo.x, box.lo.y, box.lo.z}, {box.hi.x, box.hi.y, box.hi.z}, lights.data(), 3, v.data(), v.data() + padded, t.data(), h.data()};
+      };
+      std::array<float*, 3> t_fast, h_fast, t_slow, h_slow;
+      Vec3 a, b;
+      ASSERT_TRUE(camera.row_frame(9.5, a, b));
+      const double origin[3] = {camera.position.x, camera.position.y, camera.position.z}, a3[3] = {a.x, a.y, a.z}, b3[3] = {b.x, b.y, b.z};
+      row_geometry(geometry(fast, t_fast, h_fast), origin, a3, b3, 0.5, n);
+      std::vector<Ray> rays(n);
+      camera.row_rays(9, rays.data());
+      row_geometry_rays(geometry(slow, t_slow, h_slow), rays.data(), n);
+      for (size_t x = 0; x < n; ++x) {
+        ASSERT_NEAR(fast[x], slow[x], 1e-6f * (1.0f + slow[x])) << "t0 of ray " << x;
+        if (std::isinf(slow[padded + x])) ASSERT_EQ(fast[padded + x], slow[padded + x]) << "t1 of ray " << x;
+        else ASSERT_NEAR(fast[padded + x], slow[padded + x], 1e-6f * (1.0f + slow[padded + x])) << "t1 of ray " << x;
+        for (size_t l = 0; l < 3; ++l) {
+          ASSERT_NEAR(t_fast[l][x], t_slow[l][x], 1e-6f * (1.0f + std::abs(t_slow[l][x]))) << "t of ray " << x << ", light " << l;
+          ASSERT_NEAR(h_fast[l][x], h_slow[l][x], 1e-6f * (1.0f + h_slow[l][x])) << "h of ray " << x << ", light " << l;
+        }
+      }
+      EXPECT_LT(h_fast[1][17], 1e-6f) << "the light on ray 17";
+    }
+  }
 }
 
 // Slices against adaptive quadrature of the stretch [t0, min(d, t1)]: within 1e-3 of the whole

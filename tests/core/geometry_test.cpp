@@ -63,10 +63,23 @@ TEST(Camera, HostMatricesAndRaysGiveTheSameRays) {
       EXPECT_NEAR(glm::length(a.direction - b.direction), 0.0, 1e-12) << px << " " << py;
     }
   }
+  // A row frame: a row's rays leave the eye along normalize(a + b px), for pinholes and perspective
+  // matrices only.
+  for (const Camera* camera : {static_cast<const Camera*>(&pin), &host})
+    for (double py : {0.5, 4.25, 9.0}) {
+      Vec3 a, b;
+      ASSERT_TRUE(camera->row_frame(py, a, b));
+      for (double px : {0.0, 3.5, 16.0})
+        EXPECT_NEAR(glm::length(glm::normalize(a + b * px) - camera->generate_ray(px, py).direction), 0.0, 1e-12) << px << " " << py;
+    }
+  Vec3 a, b;
+  EXPECT_FALSE(ortho.row_frame(0.5, a, b));
+  EXPECT_FALSE(host_ortho.row_frame(0.5, a, b));
   auto rays = std::make_shared<std::vector<Ray>>();
   for (int y = 0; y < 9; ++y)
     for (int x = 0; x < 16; ++x) rays->push_back(pin.pixel_ray(x, y));
   const Camera given = Camera::from_rays(rays, 16, 9);
+  EXPECT_FALSE(given.row_frame(0.5, a, b));
   EXPECT_EQ(given.pixel_ray(7, 4).direction, pin.pixel_ray(7, 4).direction);
   EXPECT_EQ(given.generate_ray(7.9, 4.1).origin, pin.pixel_ray(7, 4).origin);
   auto expect_error = [](auto make, const std::string& field) {

@@ -53,10 +53,11 @@ double relative_to(const Rgb& a, const Rgb& b) { return glm::length(a - b) / std
 // With one column per pixel, the froxels at a slice boundary are the layers of a render with that
 // boundary as every pixel's depth: the columns, the slices and the lookup line up, for every kind
 // of solution (the network on its particle cloud; analytic's own path in a box and in unbounded
-// fog, where its error is the table's relative to the whole ray's in-scatter). Dom's one pass
-// steps each slice's stretch on its own: against its gather at step 0.02 cells, the chained
-// stretches are 2.4e-3 off and the layered render 2.2e-3 (both at the default 0.5), so it is held
-// to that step error, not to 2e-4.
+// fog, where its error is the table's relative to the whole ray's in-scatter). Propagation's and
+// dom's one pass step each slice's stretch on its own, no finer than the columns' spacing there
+// (12 columns: 5 of propagation's steps at the far slices): held to that step error, 4e-3 (dom
+// against its gather at step 0.02 cells: the chained stretches 2.4e-3 off at the default step, the
+// layered render 2.2e-3), not to 2e-4.
 TEST(Froxels, HoldTheLayersAtColumnsAndBoundaries) {
   grids::register_methods();
   particles::register_methods();
@@ -78,7 +79,7 @@ TEST(Froxels, HoldTheLayersAtColumnsAndBoundaries) {
         for (int x = 0; x < 12; ++x) {
           const PixelLayers p = froxels.sample((x + 0.5) / 12.0, (y + 0.5) / 8.0, grid.boundary(k));
           const Rgb exact = r.inscatter->at(x, y);
-          const double step_error = method == "dom" ? 4e-3 : 2e-4;
+          const double step_error = method == "dom" || method == "propagation" ? 4e-3 : 2e-4;
           ASSERT_LE(glm::length(p.inscatter - exact), step_error * glm::length(exact) + 1e-3 * glm::length(whole.inscatter->at(x, y)))
               << method << " slice " << k << " at " << x << ", " << y << ": " << p.inscatter.r << " against " << exact.r;
           ASSERT_LT(relative_to(p.transmittance, r.transmittance->at(x, y)), 2e-4) << method << " slice " << k << " at " << x << ", " << y;

@@ -56,6 +56,34 @@ void airlight_slice(const AirlightTable& table, const TailRow& row, float distan
 // ray's neighbouring slices find their table values in cache.
 void airlight_slices(const AirlightTable& table, const TailRow& row, std::span<const float> distances, float* inscatter, float* transmittance,
                      size_t slice_stride);
+// Per-pixel layers from the tails at each ray's entry (row.whole) and its end: ray i ends at
+// ends[i] (+inf: never, T = 0), sums[c][i] its tails there; L_in = max(0, whole - T sums) and
+// T = e^(-sigma_t (end - t0)) as RGB triples into inscatter[3 i + c] and transmittance[3 i + c]
+// (L_in 0 and T 1 where end <= t0), and redo[i] 1 where T sums exceeds 3/4 of whole in a channel
+// (the difference would lose more than the table's 1e-3 to cancellation), else 0. Arrays hold
+// count rounded up to 16 (times 3 for the triples).
+void layers_from_tails(const TailRow& row, const float* ends, const float* const sums[3], float* inscatter, float* transmittance, float* redo);
+void layers_from_tails_reference(const TailRow& row, const float* ends, const float* const sums[3], float* inscatter, float* transmittance,
+                                 float* redo);
+
+// A row's geometry toward its lights, in float64, stored as float32 (the TailRow's inputs): ray x's
+// stretch [t0[x], t1[x]] inside the box [lo, hi] (0 and 0 where it misses; t1 +inf where the box
+// is unbounded that way), and per light l its projection t[l][x] = (p - o) . v along the ray and its
+// distance h[l][x] from the ray's line. Arrays hold count rounded up to 16.
+struct RowGeometry {
+  double lo[3], hi[3];
+  const double* lights;  // xyz per light
+  size_t light_count;
+  float *t0, *t1;
+  float* const* t;
+  float* const* h;
+};
+// Rays from one eye: ray x leaves `origin` along normalize(a + b (px0 + x)) (Camera::row_frame),
+// float64 lanes.
+void row_geometry(const RowGeometry& g, const double origin[3], const double a[3], const double b[3], double px0, size_t count);
+// Any rays, one at a time: the reference of row_geometry and the path of cameras without a row frame.
+void row_geometry_rays(const RowGeometry& g, const Ray* rays, size_t count);
+
 // The scalar references: the same float32 formulas, one ray at a time.
 void tail_sums_reference(const AirlightTable& table, const TailRow& row, const float* d, float* const sums[3]);
 void airlight_slice_reference(const AirlightTable& table, const TailRow& row, float distance, float* inscatter, float* transmittance);

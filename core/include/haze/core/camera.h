@@ -54,11 +54,19 @@ struct Camera {
   // pinhole camera or a host's perspective matrices; false for a point behind the eye and for
   // other cameras.
   bool film_position(const Vec3& point, double& px, double& py) const;
+  // The rays of film row py leave `position` along normalize(a + b px) for every px: a pinhole
+  // camera, or a host's perspective matrices (their w not depending on x); false for others.
+  bool row_frame(double py, Vec3& a, Vec3& b) const;
+  // The angle between the rays of the two pixels right of the film's centre (radians): a pixel's
+  // width as seen from the eye there.
+  double pixel_angle() const;
   bool operator==(const Camera&) const = default;
 
  private:
   // Film positions (px[i], py) of one row; pinhole and orthographic make their frame once.
   void row_rays_at(double py, const double* px, int count, Ray* out) const;
+  // A pinhole or orthographic camera's unit frame.
+  void frame(Vec3& forward, Vec3& right, Vec3& true_up) const;
 };
 
 }  // namespace haze
