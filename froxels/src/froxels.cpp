@@ -138,9 +138,12 @@ void composite_froxels(const Froxels& froxels, ConstImageSpan colour, std::span<
                                                static_cast<float>(g.near), std::log(static_cast<float>(g.near)),
                                                static_cast<float>(g.nz / std::log(g.far / g.near))};
   const auto composite_rows = [&](long long y0, long long y1) {
-    for (auto py = static_cast<int>(y0); py < y1; ++py)
+    for (auto py = static_cast<int>(y0); py < y1; ++py) {
+      const bool ahead = py + 1 < y1;
       froxels_detail::composite_row(volume, {colour.pixel(0, py), colour.channels, depth.data() + static_cast<size_t>(py) * static_cast<size_t>(w),
-                                             out.pixel(0, py), out.channels, w, h, py});
+                                             out.pixel(0, py), out.channels, w, h, py, ahead ? colour.pixel(0, py + 1) : nullptr,
+                                             ahead ? depth.data() + static_cast<size_t>(py + 1) * static_cast<size_t>(w) : nullptr});
+    }
   };
   // A body of one reference: std::function keeps it without allocating.
   parallel_for(h, threads, 8, [&composite_rows](long long y0, long long y1) { composite_rows(y0, y1); });

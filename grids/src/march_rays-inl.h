@@ -21,6 +21,23 @@ HWY_BEFORE_NAMESPACE();
 namespace haze::grids::HWY_NAMESPACE {
 namespace hn = hwy::HWY_NAMESPACE;
 
+#if HWY_TARGET != HWY_SCALAR
+// The float pairs (base[o], base[o + 1]) at each lane's offset o into `first` and `second`: one
+// 64-bit gather per half vector, half the loads of two float gathers.
+template <class D, class VI>
+HWY_INLINE void GatherPairs(D d, const float* HWY_RESTRICT base, VI offset, hn::Vec<D>& first, hn::Vec<D>& second) {
+  const hn::RebindToSigned<D> di;
+  const hn::Half<decltype(di)> dih;
+  const hn::Repartition<double, D> dd;
+  const hn::RebindToSigned<decltype(dd)> di64;
+  const VI bytes = hn::ShiftLeft<2>(offset);
+  const double* pairs = reinterpret_cast<const double*>(base);  // read as 8-byte lanes, never as doubles
+  const hn::Vec<D> a = hn::BitCast(d, hn::GatherOffset(dd, pairs, hn::PromoteTo(di64, hn::LowerHalf(dih, bytes))));
+  const hn::Vec<D> b = hn::BitCast(d, hn::GatherOffset(dd, pairs, hn::PromoteTo(di64, hn::UpperHalf(dih, bytes))));
+  first = hn::ConcatEven(d, b, a), second = hn::ConcatOdd(d, b, a);
+}
+#endif
+
 // One vector of rays starting at ray `first` (lanes past the end repeat the last ray), `C` channels.
 template <int C, class D>
 HWY_INLINE void MarchVector(D d, const MarchVolume& v, const simd::PhaseParams& phase, const RayPacket& rays, size_t first,
@@ -48,9 +65,11 @@ HWY_INLINE void MarchVector(D d, const MarchVolume& v, const simd::PhaseParams& 
     // Trilinear stencil on the cell-centred grid, clamped to the edge cells.
     V x[3], frac[3];
     VI lo[3], hi[3];
+    V u_x;
     for (int e = 0; e < 3; ++e) {
       x[e] = hn::MulAdd(t, dir[e], o[e]);
       const V u = hn::Sub(hn::Mul(hn::Sub(x[e], hn::Set(d, v.lo[e])), hn::Set(d, 1.0f / v.h[e])), half);
+      if (e == 0) u_x = u;
       const V fl = hn::Floor(u);
       frac[e] = hn::Sub(u, fl);
       const VI c = hn::ConvertTo(di, fl), last_cell = hn::Set(di, v.n[e] - 1);
@@ -66,6 +85,22 @@ HWY_INLINE void MarchVector(D d, const MarchVolume& v, const simd::PhaseParams& 
                           hn::Mul(by ? frac[1] : hn::Sub(one, frac[1]), bz ? frac[2] : hn::Sub(one, frac[2])));
     }
     V rho = zero;
+#if HWY_TARGET != HWY_SCALAR
+    if (v.n[0] >= 2) {
+      // Each (y, z) corner's two x neighbours as one pair from p = clamp(i, 0, n - 2): lo and hi
+      // (clamped at the faces) are p or p + 1.
+      const VI pair = hn::Min(hn::Max(hn::ConvertTo(di, hn::Floor(u_x)), hn::Zero(di)), hn::Set(di, v.n[0] - 2));
+      const V w_lo = hn::Sub(one, frac[0]), w_hi = frac[0];
+      const V w_first = hn::Add(hn::IfThenElseZero(hn::RebindMask(d, hn::Eq(lo[0], pair)), w_lo), hn::IfThenElseZero(hn::RebindMask(d, hn::Eq(hi[0], pair)), w_hi));
+      const V w_second = hn::Sub(one, w_first);
+      for (int m = 0; m < 8; m += 2) {
+        V a, b;
+        GatherPairs(d, v.density, hn::Add(pair, hn::Sub(offset[m], lo[0])), a, b);
+        const V yz = hn::Add(weight[m], weight[m + 1]);  // the corner's y and z weights (its x weights sum to 1)
+        rho = hn::MulAdd(yz, hn::MulAdd(w_second, b, hn::Mul(w_first, a)), rho);
+      }
+    } else
+#endif
     for (int m = 0; m < 8; ++m) rho = hn::MulAdd(weight[m], hn::GatherIndex(d, v.density, offset[m]), rho);
     active = hn::And(active, hn::Gt(rho, zero));
     if (hn::AllFalse(d, active)) continue;
@@ -74,9 +109,22 @@ HWY_INLINE void MarchVector(D d, const MarchVolume& v, const simd::PhaseParams& 
     // The corners' offsets into the per-light volumes ([cell * lights + l]).
     VI light_offset[8];
     for (int m = 0; m < 8; ++m) light_offset[m] = hn::Mul(offset[m], hn::Set(di, v.light_count));
+    V next_depth = zero;  // light l + 1's, gathered with light l's
     for (int l = 0; l < v.light_count; ++l) {
       const MarchLight& light = v.lights[l];
       V depth = zero;
+#if HWY_TARGET != HWY_SCALAR
+      if (l % 2 == 1) {
+        depth = next_depth;
+      } else if (l + 1 < v.light_count) {  // lights l and l + 1 side by side in each cell
+        next_depth = zero;
+        for (int m = 0; m < 8; ++m) {
+          V a, b;
+          GatherPairs(d, v.depths + l, light_offset[m], a, b);
+          depth = hn::MulAdd(weight[m], a, depth), next_depth = hn::MulAdd(weight[m], b, next_depth);
+        }
+      } else
+#endif
       for (int m = 0; m < 8; ++m) depth = hn::MulAdd(weight[m], hn::GatherIndex(d, v.depths + l, light_offset[m]), depth);
       V to[3], falloff;
       if (light.type == MarchLight::directional) {

@@ -26,6 +26,8 @@ struct CompositeRow {
   float* out;
   int out_channels;
   int width, height, py;
+  const float* colour_ahead = nullptr;  // the next row's colour and depth, fetched ahead (null: none)
+  const float* depth_ahead = nullptr;
 };
 
 void composite_row(const CompositeVolume& volume, const CompositeRow& row);
