@@ -107,6 +107,21 @@ HWY_NOINLINE void CompositeRowKernel(const CompositeVolume& v, const CompositeRo
       hn::Store(hn::Mul(not_a, not_c), d, w_of[0] + p), hn::Store(hn::Mul(a, not_c), d, w_of[1] + p);
       hn::Store(hn::Mul(not_a, c), d, w_of[2] + p), hn::Store(hn::Mul(a, c), d, w_of[3] + p);
     }
+#if HWY_TARGET <= HWY_AVX2  // eight-float vectors: a tap's L_in and T side by side, four FMAs a pixel
+    const hn::FixedTag<float, 8> d8;
+    hn::Vec<decltype(d8)> ylt[4];
+    for (int p = 0; p < n; ++p) {
+      const int k = k_of[p], i = i_of[p];
+      if (k != cached_k || i != cached_i) {
+        fill(i, k), cached_i = i, cached_k = k;
+        for (int e = 0; e < 4; ++e) ylt[e] = hn::Combine(d8, yt[e], yl[e]);
+      }
+      const auto lt = hn::Add(hn::MulAdd(hn::Set(d8, w_of[1][p]), ylt[1], hn::Mul(hn::Set(d8, w_of[0][p]), ylt[0])),
+                              hn::MulAdd(hn::Set(d8, w_of[3][p]), ylt[3], hn::Mul(hn::Set(d8, w_of[2][p]), ylt[2])));
+      hn::StoreU(hn::LowerHalf(d4, lt), d4, l_of + 3 * p);
+      hn::StoreU(hn::UpperHalf(d4, lt), d4, t_of + 3 * p);
+    }
+#else
     for (int p = 0; p < n; ++p) {
       const int k = k_of[p], i = i_of[p];
       if (k != cached_k || i != cached_i) fill(i, k), cached_i = i, cached_k = k;
@@ -114,6 +129,7 @@ HWY_NOINLINE void CompositeRowKernel(const CompositeVolume& v, const CompositeRo
       hn::StoreU(hn::Add(hn::MulAdd(w10, yl[1], hn::Mul(w00, yl[0])), hn::MulAdd(w11, yl[3], hn::Mul(w01, yl[2]))), d4, l_of + 3 * p);
       hn::StoreU(hn::Add(hn::MulAdd(w10, yt[1], hn::Mul(w00, yt[0])), hn::MulAdd(w11, yt[3], hn::Mul(w01, yt[2]))), d4, t_of + 3 * p);
     }
+#endif
     // colour = L_in + T colour, over the chunk's floats in full vectors where rows are RGB.
     const float* in = row.colour + static_cast<size_t>(x0) * static_cast<size_t>(row.colour_channels);
     float* to = row.out + static_cast<size_t>(x0) * static_cast<size_t>(row.out_channels);
