@@ -274,6 +274,43 @@ class DomMethodSolution final : public GridSolution {
   }
   bool renders_layers() const override { return true; }
 
+  // Without surfaces or emission, per pixel the gather along its ray to its depth (render's
+  // scattered light, its T' the delta-M scaled transmittance) into the caller's spans, C the
+  // background and the sky where no depth ends the ray: a frame allocates nothing once the
+  // threads' rays and weights have grown.
+  bool render_layers(const View& view, LayerSpans out, const RenderOptions& options) const override {
+    if (!scene_.surfaces.empty() || volume_.emission.emits()) return false;
+    const dom::Gather& gather = froxel_gather();
+    const Camera& camera = view.camera;
+    const auto width = static_cast<size_t>(camera.width_px);
+    const Rgb background = delta_.background + sky_;
+    const auto rows = [&](long long y0, long long y1) {
+      thread_local std::vector<Ray> rays;
+      thread_local Eigen::VectorXd row, c;
+      rays.resize(width);
+      for (auto y = static_cast<int>(y0); y < y1; ++y) {
+        camera.row_rays(y, rays.data());
+        for (size_t x = 0; x < width; ++x) {
+          const auto px = static_cast<int>(x);
+          const double depth = view.max_distance(px, y);
+          Rgb l(0.0), t(1.0);
+          inscatter_weights(solution_, -rays[x].direction, row, c);
+          l = gather.along(rays[x], depth, c, t);
+          float* li = out.inscatter.pixel(px, y);
+          float* ti = out.transmittance.pixel(px, y);
+          for (int ch = 0; ch < 3; ++ch) li[ch] = static_cast<float>(l[ch]), ti[ch] = static_cast<float>(t[ch]);
+          if (out.surface.data) {
+            const Rgb surface = std::isinf(depth) ? background : Rgb(0.0);
+            float* si = out.surface.pixel(px, y);
+            for (int ch = 0; ch < 3; ++ch) si[ch] = static_cast<float>(surface[ch]);
+          }
+        }
+      }
+    };
+    parallel_for(camera.height_px, options.threads, 1, [&rows](long long y0, long long y1) { rows(y0, y1); });
+    return true;
+  }
+
   // Without surfaces or emission, each ray marched once: its stretch between consecutive distances
   // gathered in steps of its own (Gather::along_stretch) and the stretches chained front to back,
   // L(d_k) = L(d_k-1) + T(d_k-1) L_k, T(d_k) = T(d_k-1) T_k (what the layered render at d_k gives,
@@ -364,8 +401,7 @@ class DomMethodSolution final : public GridSolution {
   const dom::Gather& froxel_gather() const {
     std::lock_guard lock(gather_mutex_);
     if (!gather_) {
-      Rgb sky;
-      delta_ = without_sky(scene_, sky);
+      delta_ = without_sky(scene_, sky_);
       gather_ = std::make_unique<dom::Gather>(delta_, volume_, depths_, solution_, step_cells_, 1, nullptr);
     }
     return *gather_;
@@ -374,6 +410,7 @@ class DomMethodSolution final : public GridSolution {
   DomSolution solution_;
   mutable std::mutex gather_mutex_;
   mutable Scene delta_;
+  mutable Rgb sky_;
   mutable std::unique_ptr<dom::Gather> gather_;
   CellCount cells_;
   DomSettings settings_;

@@ -1,8 +1,8 @@
 // Heap allocations in a frame (issue 51: after the first frame, a frame allocates nothing). This
 // program replaces the global operator new to count every allocation made through it, on any
 // thread. The CPU composite into the caller's memory allocates nothing, and neither do the
-// froxel build of analytic, propagation or dom, the glow of lights in view and analytic's and propagation's
-// per-pixel layers into the caller's buffers once each thread's kept row buffers have grown; nor do the
+// froxel build of analytic, propagation or dom, the glow of lights in view and the per-pixel layers
+// of all three into the caller's buffers once each thread's kept row buffers have grown; nor do the
 // temporal froxels' reprojection and blend.
 #include <haze/froxels/froxels.h>
 #include <haze/froxels/temporal.h>
@@ -129,14 +129,15 @@ TEST(FrameAllocations, TheTemporalFroxelsAllocateNothingAfterTheFirstFrames) {
 }
 
 // The per-pixel layers into the caller's buffers (render_layers), the camera moving: analytic's
-// one pass and propagation's march allocate nothing once warm.
+// one pass, propagation's march and dom's gather allocate nothing once warm.
 TEST(FrameAllocations, TheLayersIntoCallerMemoryAllocateNothing) {
   const Scene scene = testing::fog_box(64, 36, Vec3(0.1, -0.1, 0.4));
   std::vector<float> l(3 * 64 * 36), t(l.size()), c(l.size());
   const std::vector<float> depth(64 * 36, 3.0f);
-  for (const char* method : {"analytic", "propagation"}) {
+  for (const char* method : {"analytic", "propagation", "dom"}) {
     RenderOptions prepared;
     if (std::string(method) == "propagation") prepared.settings = {{"resolution", 16}};
+    if (std::string(method) == "dom") prepared.settings = {{"resolution", 12}, {"directions", 32}, {"terms", 9}};
     const Solution solution = prepare(scene, method, prepared);
     expect_none_per_moving_frame(scene.camera, 0.05, [&](const Camera& camera, const RenderOptions& options) {
       solution.render_layers(View{camera, depth}, {ImageSpan{l.data(), 64, 36}, ImageSpan{t.data(), 64, 36}, ImageSpan{c.data(), 64, 36}}, options);

@@ -203,7 +203,7 @@ TEST(Layers, AutoPassesTheChosenMethodsLayers) {
 // spans (march_layers: the rows of its render, the same kernel) as its render's.
 TEST(Layers, RenderLayersIntoCallerMemoryMatchesRender) {
   grids::register_methods();
-  for (const std::string variant : {"box", "unbounded", "coloured", "propagation"}) {
+  for (const std::string variant : {"box", "unbounded", "coloured", "propagation", "dom"}) {
     Scene scene = testing::fog_box(48, 32, Vec3(0.1, -0.1, 0.4));
     if (variant == "unbounded") scene.medium->bounds = Aabb{};
     if (variant == "coloured") scene.medium->albedo = Rgb(0.9, 0.7, 0.5);
@@ -216,7 +216,8 @@ TEST(Layers, RenderLayersIntoCallerMemoryMatchesRender) {
       }
     RenderOptions prepared;
     if (variant == "propagation") prepared.settings = {{"resolution", 16}};
-    const Solution solution = prepare(scene, variant == "propagation" ? "propagation" : "analytic", prepared);
+    if (variant == "dom") prepared.settings = {{"resolution", 12}, {"directions", 32}, {"terms", 9}};
+    const Solution solution = prepare(scene, variant == "propagation" || variant == "dom" ? variant : "analytic", prepared);
     const RenderResult exact = solution.render(View{scene.camera, depth, true});
     const size_t stride = 4 * 48 + 3;
     std::vector<float> l(stride * 32, -7.0f), t(3 * 48 * 32), c(3 * 48 * 32);
