@@ -276,38 +276,24 @@ class DomMethodSolution final : public GridSolution {
 
   // Without surfaces or emission, per pixel the gather along its ray to its depth (render's
   // scattered light, its T' the delta-M scaled transmittance) into the caller's spans, C the
-  // background and the sky where no depth ends the ray: a frame allocates nothing once the
-  // threads' rays and weights have grown.
+  // background and the sky where no depth ends the ray.
   bool render_layers(const View& view, LayerSpans out, const RenderOptions& options) const override {
     if (!scene_.surfaces.empty() || volume_.emission.emits()) return false;
     const dom::Gather& gather = froxel_gather();
-    const Camera& camera = view.camera;
-    const auto width = static_cast<size_t>(camera.width_px);
     const Rgb background = delta_.background + sky_;
-    const auto rows = [&](long long y0, long long y1) {
-      thread_local std::vector<Ray> rays;
-      thread_local Eigen::VectorXd row, c;
-      rays.resize(width);
-      for (auto y = static_cast<int>(y0); y < y1; ++y) {
-        camera.row_rays(y, rays.data());
-        for (size_t x = 0; x < width; ++x) {
-          const auto px = static_cast<int>(x);
-          const double depth = view.max_distance(px, y);
-          Rgb l(0.0), t(1.0);
-          inscatter_weights(solution_, -rays[x].direction, row, c);
-          l = gather.along(rays[x], depth, c, t);
-          float* li = out.inscatter.pixel(px, y);
-          float* ti = out.transmittance.pixel(px, y);
-          for (int ch = 0; ch < 3; ++ch) li[ch] = static_cast<float>(l[ch]), ti[ch] = static_cast<float>(t[ch]);
-          if (out.surface.data) {
-            const Rgb surface = std::isinf(depth) ? background : Rgb(0.0);
-            float* si = out.surface.pixel(px, y);
-            for (int ch = 0; ch < 3; ++ch) si[ch] = static_cast<float>(surface[ch]);
-          }
-        }
+    each_ray(view.camera, options, [&](int x, int y, const Ray& ray, const Eigen::VectorXd& c) {
+      const double depth = view.max_distance(x, y);
+      Rgb t;
+      const Rgb l = gather.along(ray, depth, c, t);
+      float* li = out.inscatter.pixel(x, y);
+      float* ti = out.transmittance.pixel(x, y);
+      for (int ch = 0; ch < 3; ++ch) li[ch] = static_cast<float>(l[ch]), ti[ch] = static_cast<float>(t[ch]);
+      if (out.surface.data) {
+        const Rgb surface = std::isinf(depth) ? background : Rgb(0.0);
+        float* si = out.surface.pixel(x, y);
+        for (int ch = 0; ch < 3; ++ch) si[ch] = static_cast<float>(surface[ch]);
       }
-    };
-    parallel_for(camera.height_px, options.threads, 1, [&rows](long long y0, long long y1) { rows(y0, y1); });
+    });
     return true;
   }
 
@@ -315,8 +301,6 @@ class DomMethodSolution final : public GridSolution {
   // gathered in steps of its own (Gather::along_stretch) and the stretches chained front to back,
   // L(d_k) = L(d_k-1) + T(d_k-1) L_k, T(d_k) = T(d_k-1) T_k (what the layered render at d_k gives,
   // but for where the steps fall).
-  // The gather (the scene less its sky) is made on the first frame after a prepare or update, and
-  // each thread keeps its rays and weights: a frame allocates nothing once they have grown.
   bool render_distances(const View& view, std::span<const double> distances, const RenderOptions& options, DistanceLayers out) const override {
     if (!scene_.surfaces.empty() || volume_.emission.emits()) return false;
     const dom::Gather& gather = froxel_gather();
@@ -325,32 +309,21 @@ class DomMethodSolution final : public GridSolution {
     const size_t per_slice = width * static_cast<size_t>(camera.height_px);
     const Aabb bounds = volume_.density.bounds();
     const double pitch = camera.pixel_angle();  // a column's width per unit distance: no finer steps along it
-    const auto rows = [&](long long y0, long long y1) {
-      thread_local std::vector<Ray> rays;
-      thread_local Eigen::VectorXd row, c;
-      rays.resize(width);
-      for (auto y = static_cast<int>(y0); y < y1; ++y) {
-        camera.row_rays(y, rays.data());
-        for (size_t x = 0; x < width; ++x) {
-          const Ray& ray = rays[x];
-          double t0 = 0.0, t1 = kInfinity;
-          const bool inside = bounds.clip(ray, t0, t1) && t1 > t0;
-          if (inside) inscatter_weights(solution_, -ray.direction, row, c);
-          Rgb l(0.0), t(1.0);
-          for (size_t k = 0; k < distances.size(); ++k) {
-            const double from = std::max(t0, k == 0 ? 0.0 : distances[k - 1]), to = std::min(t1, distances[k]);
-            if (inside && to > from) {
-              Rgb t_k;
-              const Rgb l_k = gather.along_stretch(ray, from, to, c, t_k, pitch * from);
-              l += t * l_k, t *= t_k;
-            }
-            const size_t at = k * per_slice + static_cast<size_t>(y) * width + x;
-            out.inscatter[at] = Vec3f(l), out.transmittance[at] = Vec3f(t);
-          }
+    each_ray(camera, options, [&](int x, int y, const Ray& ray, const Eigen::VectorXd& c) {
+      double t0 = 0.0, t1 = kInfinity;
+      const bool inside = bounds.clip(ray, t0, t1) && t1 > t0;
+      Rgb l(0.0), t(1.0);
+      for (size_t k = 0; k < distances.size(); ++k) {
+        const double from = std::max(t0, k == 0 ? 0.0 : distances[k - 1]), to = std::min(t1, distances[k]);
+        if (inside && to > from) {
+          Rgb t_k;
+          const Rgb l_k = gather.along_stretch(ray, from, to, c, t_k, pitch * from);
+          l += t * l_k, t *= t_k;
         }
+        const size_t at = k * per_slice + static_cast<size_t>(y) * width + static_cast<size_t>(x);
+        out.inscatter[at] = Vec3f(l), out.transmittance[at] = Vec3f(t);
       }
-    };
-    parallel_for(camera.height_px, options.threads, 1, [&rows](long long y0, long long y1) { rows(y0, y1); });
+    });
     return true;
   }
 
@@ -396,6 +369,29 @@ class DomMethodSolution final : public GridSolution {
   }
 
  private:
+  // fn(x, y, ray, c) for each pixel's ray of the camera, row by row on the threads, c its
+  // direction's in-scatter weights (inscatter_weights) where its ray meets the medium. Each thread
+  // keeps its rays and weights: a frame allocates nothing once they have grown.
+  template <class Fn>
+  void each_ray(const Camera& camera, const RenderOptions& options, const Fn& fn) const {
+    const auto width = static_cast<size_t>(camera.width_px);
+    const Aabb bounds = volume_.density.bounds();
+    const auto rows = [&](long long y0, long long y1) {
+      thread_local std::vector<Ray> rays;
+      thread_local Eigen::VectorXd row, c;
+      rays.resize(width);
+      for (auto y = static_cast<int>(y0); y < y1; ++y) {
+        camera.row_rays(y, rays.data());
+        for (size_t x = 0; x < width; ++x) {
+          double t0 = 0.0, t1 = kInfinity;
+          if (bounds.clip(rays[x], t0, t1) && t1 > t0) inscatter_weights(solution_, -rays[x].direction, row, c);
+          fn(static_cast<int>(x), y, rays[x], c);
+        }
+      }
+    };
+    parallel_for(camera.height_px, options.threads, 1, [&rows](long long y0, long long y1) { rows(y0, y1); });
+  }
+
   // render_distances' gather over the scene less its sky, made on first use after a prepare or
   // update (renders may run on several threads at once: made under the lock).
   const dom::Gather& froxel_gather() const {
