@@ -168,16 +168,17 @@ class Solution {
   RenderResult render(const View& view, const RenderOptions& options = {}) const;
   // The view's layers (L_in, T and C, as render with view.layers gives them) written into the
   // caller's memory, reused frame after frame: the method's own path where it has one (analytic
-  // with point lights and no surfaces of Haze's own; propagation's march: no allocation once
-  // warm), else a render copied into it. Spans of another size than the view's are a haze::Error naming them.
+  // with point lights and no surfaces of Haze's own; propagation's march; dom's gather without
+  // surfaces or emission: no allocation once warm), else a render copied into it. Spans of another size than the view's are a haze::Error naming them.
   void render_layers(const View& view, LayerSpans out, const RenderOptions& options = {}) const;
   RenderResult render(const RenderOptions& options = {}) const { return render(View{scene().camera}, options); }
   // L_in and T along each of the view's rays (its depth ignored; Haze's own surfaces still end
   // them) to each of `distances` (ascending, > 0), into the caller's `out` (width_px x height_px x
   // distances.size() entries each, slice-major), which a frame loop reuses. The method's one-pass
   // path where it has one (analytic with point lights and no surfaces; propagation; dom without
-  // surfaces or emission), else one layered render per distance. What build_froxels (froxels.h)
-  // calls.
+  // surfaces or emission; the marching ones step a stretch at distance d no finer than the
+  // view's pixel_angle() d, the rays' spacing there), else one layered render per distance. What
+  // build_froxels (froxels.h) calls.
   void render_distances(const View& view, std::span<const double> distances, DistanceLayers out, const RenderOptions& options = {}) const;
   // Adds to `out` (float32 RGB or RGBA rows of the view's size) what render_distances left out
   // when asked to for `glow_angle` (DistanceLayers::glow_angle): the glow of the point lights in
