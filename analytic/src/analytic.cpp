@@ -315,6 +315,7 @@ class AnalyticSolution final : public MethodSolution {
     parallel_for(y1 - y0, options.threads, 4, [&body, y0](long long r0, long long r1) { body(y0 + r0, y0 + r1); });
   }
 
+ private:
   // Point lights without surfaces, the SIMD kernel: render_distances' one pass (and add_glow's).
   bool one_pass() const {
     if (!scene_.surfaces.empty() || !airlight_ || kernel_ != &add_airlight) return false;
@@ -435,6 +436,16 @@ class AnalyticSolution final : public MethodSolution {
     return {ends.data(), {sums[0], sums[1], sums[2]}};
   }
 
+  // layers_from_tails over the row into the thread's kept buffer: L_in, then T (RGB triples), then
+  // the flags of the pixels to redo, each part count rounded up to 16 long.
+  static float* tails_to_layers(const RowRays& r, const EndTails& e, size_t count) {
+    thread_local std::vector<float> layers;
+    const size_t padded = padded_count(count);
+    layers.resize(7 * padded);
+    layers_from_tails(r.row, e.ends, e.sums, layers.data(), layers.data() + 3 * padded, layers.data() + 6 * padded);
+    return layers.data();
+  }
+
   // render_layers' row y.
   void layers_row(const View& view, int y, LayerSpans out) const {
     const Camera& camera = view.camera;
@@ -442,11 +453,8 @@ class AnalyticSolution final : public MethodSolution {
     const RowRays r = ray_tails(camera, y, 0, width, 0.0, lights_.size(), false);
     const EndTails e = end_tails(view, y, 0, r, width);
     const size_t padded = padded_count(width);
-    thread_local std::vector<float> layers;  // kept: L_in and T as RGB triples, then the pixels to redo
-    layers.resize(7 * padded);
-    float* const l_rgb = layers.data();
+    float* const l_rgb = tails_to_layers(r, e, width);
     float* const t_rgb = l_rgb + 3 * padded;
-    layers_from_tails(r.row, e.ends, e.sums, l_rgb, t_rgb, t_rgb + 3 * padded);
     const float* const redo_at = t_rgb + 3 * padded;
     for (size_t x = 0; x < width; ++x)
       if (redo_at[x] != 0.0f) {
@@ -497,11 +505,7 @@ class AnalyticSolution final : public MethodSolution {
   void glow_row(const View& view, size_t l, double glow_angle, int y, int x0, int x1, ImageSpan out) const {
     const auto count = static_cast<size_t>(x1 - x0);
     const RowRays r = ray_tails(view.camera, y, x0, count, glow_angle, l, true);
-    const EndTails e = end_tails(view, y, x0, r, count);
-    thread_local std::vector<float> layers;  // kept: L_in and T as RGB triples, then the flags (unused: no float64 redo here)
-    const size_t padded = padded_count(count);
-    layers.resize(7 * padded);
-    layers_from_tails(r.row, e.ends, e.sums, layers.data(), layers.data() + 3 * padded, layers.data() + 6 * padded);
+    const float* const layers = tails_to_layers(r, end_tails(view, y, x0, r, count), count);  // no float64 redo here
     for (size_t i = 0; i < count; ++i) {
       float* pixel = out.pixel(x0 + static_cast<int>(i), y);
       for (int c = 0; c < 3; ++c) pixel[c] += layers[3 * i + static_cast<size_t>(c)];

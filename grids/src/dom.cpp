@@ -11,6 +11,7 @@
 #include <haze/grids/solution.h>
 
 #include "dom_gather.h"
+#include "dom_toward_eye.h"
 #include "dom_surfaces.h"
 #include "dom_internal.h"
 
@@ -297,13 +298,29 @@ class DomMethodSolution final : public GridSolution {
     return true;
   }
 
-  // Without surfaces or emission, each ray marched once: its stretch between consecutive distances
-  // gathered in steps of its own (Gather::along_stretch) and the stretches chained front to back,
-  // L(d_k) = L(d_k-1) + T(d_k-1) L_k, T(d_k) = T(d_k-1) T_k (what the layered render at d_k gives,
-  // but for where the steps fall).
+  // Without surfaces or emission, each ray marched once. For rays from one eye, the propagation
+  // marcher's SIMD kernel (march_distances) with the moments' scattered light toward that eye as a
+  // radiance per cell (TowardEye, made each frame) beside the lights' single scattering, the
+  // delta-M scaled steps of the gather's formula (dom_gather.h); else each ray's stretch between
+  // consecutive distances gathered in steps of its own (Gather::along_stretch) and the stretches
+  // chained front to back, L(d_k) = L(d_k-1) + T(d_k-1) L_k, T(d_k) = T(d_k-1) T_k (what the
+  // layered render at d_k gives, but for where the steps fall).
   bool render_distances(const View& view, std::span<const double> distances, const RenderOptions& options, DistanceLayers out) const override {
     if (!scene_.surfaces.empty() || volume_.emission.emits()) return false;
     const dom::Gather& gather = froxel_gather();
+    if (Vec3 a, b; toward_eye_ && view.camera.row_frame(0.5, a, b)) {
+      thread_local std::vector<float> kept;  // this thread's frame after frame; the rows read it meanwhile
+      std::vector<float>& radiance = kept;
+      const double f = solution_.delta_m_fraction;
+      const Rgb single = volume_.albedo / (Rgb(1.0) - volume_.albedo * f), scattered = dom::delta_m_albedo(volume_.albedo, f);
+      Rgb scale(0.0);
+      for (int c = 0; c < 3; ++c) scale[c] = single[c] > 0.0 ? scattered[c] / single[c] : 0.0;
+      toward_eye_->fill(volume_.density, view.camera.position, scale, radiance, options.threads);
+      const MarchScattered toward{radiance.data(), toward_eye_->channels(), dom::delta_m_sigma_t(volume_.sigma_t_scale, volume_.albedo, f), single};
+      MarchSettings march;
+      march.step_cells = step_cells_;
+      if (march_distances(delta_, volume_, depths_, march, options, view, distances, out, &packed_, &toward)) return true;
+    }
     const Camera& camera = view.camera;
     const auto width = static_cast<size_t>(camera.width_px);
     const size_t per_slice = width * static_cast<size_t>(camera.height_px);
@@ -394,11 +411,18 @@ class DomMethodSolution final : public GridSolution {
 
   // render_distances' gather over the scene less its sky, made on first use after a prepare or
   // update (renders may run on several threads at once: made under the lock).
+  // With it, render_distances' kernel path: the weights' table and the lights' depths packed for
+  // the marcher (where the moments fit TowardEye's 64 terms and the solution holds the whole grid).
   const dom::Gather& froxel_gather() const {
     std::lock_guard lock(gather_mutex_);
     if (!gather_) {
       delta_ = without_sky(scene_, sky_);
       gather_ = std::make_unique<dom::Gather>(delta_, volume_, depths_, solution_, step_cells_, 1, nullptr);
+      toward_eye_.reset();
+      if (solution_.terms() <= 64 && solution_.first_plane == 0 && solution_.resolution == volume_.density.resolution()) {
+        toward_eye_ = std::make_unique<dom::TowardEye>(solution_);
+        packed_ = pack_lights(delta_, volume_, depths_, settings_.threads);
+      }
     }
     return *gather_;
   }
@@ -408,6 +432,8 @@ class DomMethodSolution final : public GridSolution {
   mutable Scene delta_;
   mutable Rgb sky_;
   mutable std::unique_ptr<dom::Gather> gather_;
+  mutable std::unique_ptr<dom::TowardEye> toward_eye_;
+  mutable PackedLights packed_;
   CellCount cells_;
   DomSettings settings_;
   DepthOptions depth_;

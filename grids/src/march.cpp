@@ -266,7 +266,6 @@ void march_row_distances(const Marcher& m, const MarchVolume& v, const View& vie
   const Camera& camera = view.camera;
   const auto width = static_cast<size_t>(camera.width_px), n = distances.size();
   struct Column {
-    Ray ray;
     double t0 = 0.0, t1 = 0.0;  // the ray's stretch in the medium
     size_t k0 = 0, k1 = 0;      // the slices [k0, k1) that hold some of it
     size_t near0 = 0, near1 = 0;  // its lights in `near`
@@ -286,9 +285,9 @@ void march_row_distances(const Marcher& m, const MarchVolume& v, const View& vie
   size_t count = 0;
   for (size_t x = 0; x < width; ++x) {
     Column& c = columns[x];
-    c.ray = rays[x];
-    double a = 0.0, b = m.hit(c.ray).t;
-    if (!m.volume.density.bounds().clip(c.ray, a, b) || !(b > a)) b = a;
+    const Ray& ray = rays[x];
+    double a = 0.0, b = m.hit(ray).t;
+    if (!m.volume.density.bounds().clip(ray, a, b) || !(b > a)) b = a;
     c.t0 = a, c.t1 = b;
     // Slice k holds [max(t0, d_k-1), min(t1, d_k)): from the first d_k past t0 to the first at or past t1.
     c.k0 = static_cast<size_t>(std::upper_bound(distances.begin(), distances.end(), a) - distances.begin());
@@ -300,8 +299,8 @@ void march_row_distances(const Marcher& m, const MarchVolume& v, const View& vie
       if (const auto* point = std::get_if<PointLight>(&light)) p = &point->position;
       else if (const auto* spot = std::get_if<SpotLight>(&light)) p = &spot->position;
       if (!p || !(b > a)) continue;
-      const Vec3 to_light = *p - c.ray.origin;
-      const double along = glm::dot(to_light, c.ray.direction), h = glm::length(to_light - along * c.ray.direction);
+      const Vec3 to_light = *p - ray.origin;
+      const double along = glm::dot(to_light, ray.direction), h = glm::length(to_light - along * ray.direction);
       if (h < 2.0 * pitch * b) near.push_back({along, h});
     }
     c.near1 = near.size();
@@ -322,7 +321,7 @@ void march_row_distances(const Marcher& m, const MarchVolume& v, const View& vie
       const double from = std::max(c.t0, k == 0 ? 0.0 : distances[k - 1]), to = std::min(c.t1, distances[k]);
       const double coarse = pitch * from, step = coarse > m.step && !fine(c, from, to, coarse) ? coarse : m.step;
       const int steps = std::max(1, static_cast<int>(std::ceil((to - from) / step)));
-      const Ray& r = c.ray;
+      const Ray& r = rays[x];
       const double segment[9] = {r.origin.x, r.origin.y, r.origin.z, r.direction.x, r.direction.y, r.direction.z, from, (to - from) / steps,
                                  static_cast<double>(steps)};
       for (size_t e = 0; e < 9; ++e) packed[e * count + i] = static_cast<float>(segment[e]);
@@ -371,7 +370,7 @@ PackedLights pack_lights(const Scene& scene, const ExtinctionVolume& volume, con
 
 bool march_distances(const Scene& scene, const ExtinctionVolume& volume, const std::vector<DenseGrid>& depths, const MarchSettings& settings,
                      const RenderOptions& options, const View& view, std::span<const double> distances, DistanceLayers out,
-                     const PackedLights* packed) {
+                     const PackedLights* packed, const MarchScattered* scattered) {
   const Vec3 h = volume.density.cell_size();
   const Marcher marcher(scene, volume, depths, settings.step_cells * std::min({h.x, h.y, h.z}), options.threads, packed, false);
   // Kept: a frame allocates nothing. The rows read it while this thread waits in parallel_for,
@@ -380,6 +379,15 @@ bool march_distances(const Scene& scene, const ExtinctionVolume& volume, const s
   lights.clear();
   MarchVolume simd_view;
   if (settings.scalar || !simd_volume(marcher, lights, simd_view)) return false;
+  if (scattered) {
+    simd_view.source = scattered->radiance, simd_view.source_channels = scattered->channels, simd_view.outer = true;
+    for (int c = 0; c < 3; ++c) {
+      const auto sigma_t = static_cast<float>(scattered->sigma_t[c]);
+      simd_view.depth_scale[c] = sigma_t > 0.0f ? simd_view.sigma_t[c] / sigma_t : 1.0f;
+      simd_view.sigma_t[c] = sigma_t, simd_view.albedo[c] = static_cast<float>(scattered->albedo[c]);
+    }
+    if (scattered->channels == 3 || !is_grey(scattered->sigma_t) || !is_grey(scattered->albedo)) simd_view.channels = 3;
+  }
   const Camera& camera = view.camera;
   const double pitch = camera.pixel_angle();  // a column's width per unit distance: no finer steps along it
   const auto rows = [&](long long y0, long long y1) {

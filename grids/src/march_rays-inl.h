@@ -65,13 +65,12 @@ HWY_INLINE void MarchVector(D d, const MarchVolume& v, const simd::PhaseParams& 
     // Trilinear stencil on the cell-centred grid, clamped to the edge cells.
     V x[3], frac[3];
     VI lo[3], hi[3];
-    V u_x;
+    V u[3];  // the point in cells, 0 at the first cell's centre
     for (int e = 0; e < 3; ++e) {
       x[e] = hn::MulAdd(t, dir[e], o[e]);
-      const V u = hn::Sub(hn::Mul(hn::Sub(x[e], hn::Set(d, v.lo[e])), hn::Set(d, 1.0f / v.h[e])), half);
-      if (e == 0) u_x = u;
-      const V fl = hn::Floor(u);
-      frac[e] = hn::Sub(u, fl);
+      u[e] = hn::Sub(hn::Mul(hn::Sub(x[e], hn::Set(d, v.lo[e])), hn::Set(d, 1.0f / v.h[e])), half);
+      const V fl = hn::Floor(u[e]);
+      frac[e] = hn::Sub(u[e], fl);
       const VI c = hn::ConvertTo(di, fl), last_cell = hn::Set(di, v.n[e] - 1);
       lo[e] = hn::Mul(hn::Min(hn::Max(c, hn::Zero(di)), last_cell), hn::Set(di, stride[e]));
       hi[e] = hn::Mul(hn::Min(hn::Max(hn::Add(c, hn::Set(di, 1)), hn::Zero(di)), last_cell), hn::Set(di, stride[e]));
@@ -84,31 +83,73 @@ HWY_INLINE void MarchVector(D d, const MarchVolume& v, const simd::PhaseParams& 
       weight[m] = hn::Mul(bx ? frac[0] : hn::Sub(one, frac[0]),
                           hn::Mul(by ? frac[1] : hn::Sub(one, frac[1]), bz ? frac[2] : hn::Sub(one, frac[2])));
     }
-    V rho = zero;
+    // The density, trilinear: on vector targets each (y, z)
+    // corner's two x neighbours as one pair from p = clamp(i, 0, n - 2) (lo and hi, clamped at the
+    // faces, are p or p + 1), else eight gathers.
 #if HWY_TARGET != HWY_SCALAR
-    if (v.n[0] >= 2) {
-      // Each (y, z) corner's two x neighbours as one pair from p = clamp(i, 0, n - 2): lo and hi
-      // (clamped at the faces) are p or p + 1.
-      const VI pair = hn::Min(hn::Max(hn::ConvertTo(di, hn::Floor(u_x)), hn::Zero(di)), hn::Set(di, v.n[0] - 2));
-      const V w_lo = hn::Sub(one, frac[0]), w_hi = frac[0];
-      const V w_first = hn::Add(hn::IfThenElseZero(hn::RebindMask(d, hn::Eq(lo[0], pair)), w_lo), hn::IfThenElseZero(hn::RebindMask(d, hn::Eq(hi[0], pair)), w_hi));
-      const V w_second = hn::Sub(one, w_first);
+    const bool pairs = v.n[0] >= 2;
+    VI pair_at[4];
+    V yz[4], w_first = zero, w_second = zero;
+    if (pairs) {
+      const VI pair = hn::Min(hn::Max(hn::ConvertTo(di, hn::Floor(u[0])), hn::Zero(di)), hn::Set(di, v.n[0] - 2));
+      w_first = hn::Add(hn::IfThenElseZero(hn::RebindMask(d, hn::Eq(lo[0], pair)), hn::Sub(one, frac[0])),
+                        hn::IfThenElseZero(hn::RebindMask(d, hn::Eq(hi[0], pair)), frac[0]));
+      w_second = hn::Sub(one, w_first);
       for (int m = 0; m < 8; m += 2) {
-        V a, b;
-        GatherPairs(d, v.density, hn::Add(pair, hn::Sub(offset[m], lo[0])), a, b);
-        const V yz = hn::Add(weight[m], weight[m + 1]);  // the corner's y and z weights (its x weights sum to 1)
-        rho = hn::MulAdd(yz, hn::MulAdd(w_second, b, hn::Mul(w_first, a)), rho);
+        pair_at[m / 2] = hn::Add(pair, hn::Sub(offset[m], lo[0]));
+        yz[m / 2] = hn::Add(weight[m], weight[m + 1]);  // the corner's y and z weights (its x weights sum to 1)
       }
-    } else
+    }
 #endif
-    for (int m = 0; m < 8; ++m) rho = hn::MulAdd(weight[m], hn::GatherIndex(d, v.density, offset[m]), rho);
+    const auto trilinear = [&](const float* HWY_RESTRICT field) {
+      V sum = zero;
+#if HWY_TARGET != HWY_SCALAR
+      if (pairs) {
+        for (int e = 0; e < 4; ++e) {
+          V a, b;
+          GatherPairs(d, field, pair_at[e], a, b);
+          sum = hn::MulAdd(yz[e], hn::MulAdd(w_second, b, hn::Mul(w_first, a)), sum);
+        }
+        return sum;
+      }
+#endif
+      for (int m = 0; m < 8; ++m) sum = hn::MulAdd(weight[m], hn::GatherIndex(d, field, offset[m]), sum);
+      return sum;
+    };
+    const V rho = trilinear(v.density);
     active = hn::And(active, hn::Gt(rho, zero));
     if (hn::AllFalse(d, active)) continue;
     V in[C];
     for (int c = 0; c < C; ++c) in[c] = zero;
+    // The lights' depths and the source: the density's stencil, or with v.outer (dom's gather) one
+    // that keeps the slope into the outer half cells, per axis the cells p = clamp(floor(u), 0,
+    // n - 2) and p + 1 weighted by u - p unclamped (an axis of one cell: that cell).
+    VI f_offset[8];
+    V f_weight[8];
+    if (v.outer) {
+      VI p[3];
+      V a[3];
+      for (int e = 0; e < 3; ++e) {
+        const bool two = v.n[e] >= 2;
+        p[e] = two ? hn::Min(hn::Max(hn::ConvertTo(di, hn::Floor(u[e])), hn::Zero(di)), hn::Set(di, v.n[e] - 2)) : hn::Zero(di);
+        a[e] = two ? hn::Sub(u[e], hn::ConvertTo(d, p[e])) : zero;
+      }
+      for (int m = 0; m < 8; ++m) {
+        VI at = hn::Zero(di);
+        V w = one;
+        for (int e = 0; e < 3; ++e) {
+          const bool bit = (m >> e) & 1;
+          at = hn::Add(at, hn::Mul(bit && v.n[e] >= 2 ? hn::Add(p[e], hn::Set(di, 1)) : p[e], hn::Set(di, stride[e])));
+          w = hn::Mul(w, bit ? a[e] : hn::Sub(one, a[e]));
+        }
+        f_offset[m] = at, f_weight[m] = w;
+      }
+    } else {
+      for (int m = 0; m < 8; ++m) f_offset[m] = offset[m], f_weight[m] = weight[m];
+    }
     // The corners' offsets into the per-light volumes ([cell * lights + l]).
     VI light_offset[8];
-    for (int m = 0; m < 8; ++m) light_offset[m] = hn::Mul(offset[m], hn::Set(di, v.light_count));
+    for (int m = 0; m < 8; ++m) light_offset[m] = hn::Mul(f_offset[m], hn::Set(di, v.light_count));
     V next_depth = zero;  // light l + 1's, gathered with light l's
     for (int l = 0; l < v.light_count; ++l) {
       const MarchLight& light = v.lights[l];
@@ -121,11 +162,13 @@ HWY_INLINE void MarchVector(D d, const MarchVolume& v, const simd::PhaseParams& 
         for (int m = 0; m < 8; ++m) {
           V a, b;
           GatherPairs(d, v.depths + l, light_offset[m], a, b);
-          depth = hn::MulAdd(weight[m], a, depth), next_depth = hn::MulAdd(weight[m], b, next_depth);
+          depth = hn::MulAdd(f_weight[m], a, depth), next_depth = hn::MulAdd(f_weight[m], b, next_depth);
         }
+        next_depth = hn::Max(next_depth, zero);  // the outer stencil may extrapolate below 0
       } else
 #endif
-      for (int m = 0; m < 8; ++m) depth = hn::MulAdd(weight[m], hn::GatherIndex(d, v.depths + l, light_offset[m]), depth);
+      for (int m = 0; m < 8; ++m) depth = hn::MulAdd(f_weight[m], hn::GatherIndex(d, v.depths + l, light_offset[m]), depth);
+      depth = hn::Max(depth, zero);
       V to[3], falloff;
       if (light.type == MarchLight::directional) {
         for (int e = 0; e < 3; ++e) to[e] = hn::Set(d, light.to_light[e]);
@@ -154,7 +197,15 @@ HWY_INLINE void MarchVector(D d, const MarchVolume& v, const simd::PhaseParams& 
       const V mu = hn::MulAdd(to[0], dir[0], hn::MulAdd(to[1], dir[1], hn::Mul(to[2], dir[2])));
       const V weight_l = hn::Mul(simd::HWY_NAMESPACE::EvalPhase(d, phase, mu), falloff);
       for (int c = 0; c < C; ++c)
-        in[c] = hn::MulAdd(hn::Mul(weight_l, hn::Set(d, light.intensity[c])), hn::Exp(d, hn::Mul(hn::Set(d, -v.sigma_t[c]), depth)), in[c]);
+        in[c] = hn::MulAdd(hn::Mul(weight_l, hn::Set(d, light.intensity[c])),
+                           hn::Exp(d, hn::Mul(hn::Set(d, -v.sigma_t[c] * v.depth_scale[c]), depth)), in[c]);
+    }
+    for (int c = 0; v.source && c < C; ++c) {
+      const int channel = v.source_channels == 1 ? 0 : c;
+      V source = zero;
+      for (int m = 0; m < 8; ++m)
+        source = hn::MulAdd(f_weight[m], hn::GatherIndex(d, v.source + channel, hn::Mul(f_offset[m], hn::Set(di, v.source_channels))), source);
+      in[c] = hn::Add(in[c], hn::Max(source, zero));
     }
     for (int c = 0; c < C; ++c) {
       const V step_transmittance = hn::Exp(d, hn::Mul(hn::Set(d, -v.sigma_t[c]), hn::Mul(rho, dt)));

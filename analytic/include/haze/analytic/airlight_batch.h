@@ -51,9 +51,10 @@ void tail_sums(const AirlightTable& table, const TailRow& row, const float* d, f
 // Slice `distance` of the row: L_in and T per ray as RGB triples into inscatter[3 i + c] and
 // transmittance[3 i + c] (count rays each): before t0 L_in 0 and T 1, past t1 their values at t1.
 void airlight_slice(const AirlightTable& table, const TailRow& row, float distance, float* inscatter, float* transmittance);
-// Every slice of `distances` the same way, slice k into inscatter[k slice_stride + 3 i + c]
-// (likewise transmittance): a vector of rays through all the slices before the next, so that a
-// ray's neighbouring slices find their table values in cache.
+// Every slice of `distances` (ascending) the same way, slice k into inscatter[k slice_stride + 3 i
+// + c] (likewise transmittance): a vector of rays through all the slices before the next, four
+// slices' tails at a time; once T g is below 1e-6 of g(t0) in every ray and channel, the further
+// slices take L_in = g(t0) without their tails (both factors only fall with distance).
 void airlight_slices(const AirlightTable& table, const TailRow& row, std::span<const float> distances, float* inscatter, float* transmittance,
                      size_t slice_stride);
 // Per-pixel layers from the tails at each ray's entry (row.whole) and its end: ray i ends at

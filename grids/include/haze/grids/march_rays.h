@@ -4,7 +4,8 @@
 //
 // Per ray, steps s < steps of length dt from t0, at the midpoints x:
 //   rho   = trilinear density, depth_l = trilinear optical depth to light l (cell-centred, clamped),
-//   L_in  = sum_l p(to_light_l . dir) E_l(x) V_l e^(-sigma_t depth_l)   (V_l trilinear visibility, or 1),
+//   L_in  = sum_l p(to_light_l . dir) E_l(x) V_l e^(-sigma_t depth_l)   (V_l trilinear visibility, or 1)
+//           + source(x)                                                  (trilinear, where given),
 //   L    += T albedo (1 - e^(-sigma_t rho dt)) L_in,   T *= e^(-sigma_t rho dt)   (per channel).
 #pragma once
 
@@ -35,6 +36,15 @@ struct MarchVolume {
   int light_count = 0;
   float sigma_t[3] = {1, 1, 1}, albedo[3] = {1, 1, 1};
   int channels = 3;  // 1 where sigma_t, albedo and every light are grey: channel 0 only
+  // A radiance per cell added to L_in, trilinear like the density ([cell * source_channels + c],
+  // one channel for all or three; null: none), and the lights' depths attenuated by sigma_t times
+  // depth_scale (dom's froxels: its scattered light from the moments, its delta-M scaled steps).
+  const float* source = nullptr;
+  int source_channels = 1;
+  float depth_scale[3] = {1, 1, 1};
+  // The depths and the source keep their slope into the outer half cells, clamped at 0 (dom's
+  // gather), instead of the edge cells' values.
+  bool outer = false;
 };
 
 struct RayPacket {

@@ -105,9 +105,17 @@ RenderResult march_view(const Scene& scene, const ExtinctionVolume& volume, cons
 // render_distances) in one march: each ray's stretch between consecutive distances is marched as
 // its own segment (the SIMD kernel's, all of a row's in one packet) and the segments are chained,
 // L(d_k) = L(d_k-1) + T(d_k-1) L_k, T(d_k) = T(d_k-1) T_k. Into out (slice-major, float32); false without the SIMD kernel.
+// With `scattered` (dom's froxels), L_in also takes that radiance per cell and the steps its own
+// extinction and albedo (MarchScattered).
+struct MarchScattered {
+  const float* radiance = nullptr;  // per cell, [cell * channels + c]: light scattered more than once, toward the eye
+  int channels = 1;                 // 1: the same for every channel
+  Rgb sigma_t{1.0};                 // the steps' extinction per density (the lights' depths keep the volume's)
+  Rgb albedo{1.0};                  // what scatters the lights' light and `radiance` alike
+};
 bool march_distances(const Scene& scene, const ExtinctionVolume& volume, const std::vector<DenseGrid>& depths, const MarchSettings& settings,
                      const RenderOptions& options, const View& view, std::span<const double> distances, DistanceLayers out,
-                     const PackedLights* packed = nullptr);
+                     const PackedLights* packed = nullptr, const MarchScattered* scattered = nullptr);
 
 // The same as march_view's layers (View::layers) into the caller's spans (LayerSpans, what
 // Solution::render_layers takes), each thread's buffers kept: a frame allocates nothing once they
