@@ -353,7 +353,7 @@ class AnalyticSolution final : public MethodSolution {
     thread_local std::vector<double> positions;
     thread_local std::vector<float*> t_of, h_of;
     thread_local std::vector<Ray> rays;
-    scratch.assign((5 + 3 * lights) * padded, 0.0f);
+    scratch.resize((5 + 3 * lights) * padded);  // each part's lanes past count zeroed below, the rest written
     tails.clear(), positions.clear(), t_of.clear(), h_of.clear();
     float* const t0 = scratch.data();
     float* const t1 = t0 + padded;
@@ -365,6 +365,7 @@ class AnalyticSolution final : public MethodSolution {
       positions.insert(positions.end(), {p.x, p.y, p.z});
       t_of.push_back(geometry + 3 * l * padded), h_of.push_back(geometry + (3 * l + 1) * padded);
     }
+    for (size_t part = 0; part < 5 + 3 * lights; ++part) std::fill(scratch.begin() + part * padded + count, scratch.begin() + (part + 1) * padded, 0.0f);
     const Aabb bounds = medium_->bounds();
     const RowGeometry g{{bounds.lo.x, bounds.lo.y, bounds.lo.z}, {bounds.hi.x, bounds.hi.y, bounds.hi.z}, positions.data(), t_of.size(),
                         t0, t1, t_of.data(), h_of.data()};
@@ -381,14 +382,14 @@ class AnalyticSolution final : public MethodSolution {
     for (size_t l = 0; l < lights; ++l) {
       if (only < lights && l != only) continue;
       float* g_l = geometry + 3 * l * padded;
-      for (size_t x = 0; x < count; ++x) {
+      for (size_t x = 0; glow_angle > 0.0 && x < count; ++x) {
         const double t = g_l[x], h = g_l[padded + x];
-        const double share = glow_angle > 0.0 && t > 0.0 && h < t * tan_glow ? glow_share(std::atan2(h, t), glow_angle) : 0.0;
+        const double share = t > 0.0 && h < t * tan_glow ? glow_share(std::atan2(h, t), glow_angle) : 0.0;
         g_l[2 * padded + x] = static_cast<float>(left ? share : 1.0 - share);
       }
-      const bool whole_light = !left && std::all_of(g_l + 2 * padded, g_l + 2 * padded + count, [](float s) { return s == 1.0f; });
+      const bool whole_light = glow_angle == 0.0 || (!left && std::all_of(g_l + 2 * padded, g_l + 2 * padded + count, [](float s) { return s == 1.0f; }));
       for (int c = 0; c < (grey_ ? 1 : 3); ++c) {
-        TailLight tail{g_l, g_l + padded, static_cast<float>(sigma_t_[c]), {}, whole_light || glow_angle == 0.0 ? nullptr : g_l + 2 * padded};
+        TailLight tail{g_l, g_l + padded, static_cast<float>(sigma_t_[c]), {}, whole_light ? nullptr : g_l + 2 * padded};
         for (int e = 0; e < 3; ++e)
           if (grey_ || e == c) tail.weight[e] = static_cast<float>(sigma_s_[e] * lights_[l].intensity[e]);
         tails.push_back(tail);
