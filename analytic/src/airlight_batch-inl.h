@@ -294,8 +294,8 @@ HWY_NOINLINE void RowGeometryKernel(const RowGeometry& g, const double* origin, 
         const V off = hn::NegMulAdd(t, v[e], to[e]);
         h2 = hn::MulAdd(off, off, h2);
       }
-      hn::StoreU(hn::DemoteTo(df, t), df, g.t[l] + x);
-      hn::StoreU(hn::Sqrt(hn::DemoteTo(df, h2)), df, g.h[l] + x);  // float's square root: within an ulp of float(sqrt(h2))
+      hn::StoreU(hn::DemoteTo(df, t), df, g.t(l) + x);
+      hn::StoreU(hn::Sqrt(hn::DemoteTo(df, h2)), df, g.h(l) + x);  // float's square root: within an ulp of float(sqrt(h2))
     }
   }
 }

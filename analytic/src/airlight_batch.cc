@@ -145,7 +145,7 @@ void row_geometry_rays(const RowGeometry& g, const Ray* rays, size_t count) {
     for (size_t l = 0; l < g.light_count; ++l) {
       const Vec3 to_light = Vec3(g.lights[3 * l], g.lights[3 * l + 1], g.lights[3 * l + 2]) - ray.origin;
       const double t = glm::dot(to_light, ray.direction);
-      g.t[l][x] = static_cast<float>(t), g.h[l][x] = static_cast<float>(glm::length(to_light - t * ray.direction));
+      g.t(l)[x] = static_cast<float>(t), g.h(l)[x] = static_cast<float>(glm::length(to_light - t * ray.direction));
     }
   }
 }

@@ -103,7 +103,9 @@ class AnalyticSolution final : public MethodSolution {
         kernel_(kernel),
         table_(std::move(table)),
         lambert_(std::move(lambert)),
-        phong_(std::move(phong)) {}
+        phong_(std::move(phong)) {
+    for (const AnalyticLight& light : lights_) positions_.insert(positions_.end(), {light.position.x, light.position.y, light.position.z});
+  }
 
   RenderResult render(const View& view, const RenderOptions& options) const override {
     const Camera& camera = view.camera;
@@ -350,25 +352,18 @@ class AnalyticSolution final : public MethodSolution {
     // Per thread, kept between frames: a frame allocates nothing once they have grown.
     thread_local std::vector<float> scratch;
     thread_local std::vector<TailLight> tails;
-    thread_local std::vector<double> positions;
-    thread_local std::vector<float*> t_of, h_of;
     thread_local std::vector<Ray> rays;
     scratch.resize((5 + 3 * lights) * padded);  // each part's lanes past count zeroed below, the rest written
-    tails.clear(), positions.clear(), t_of.clear(), h_of.clear();
+    tails.clear();
     float* const t0 = scratch.data();
     float* const t1 = t0 + padded;
     float* const whole = t1 + padded;  // three channels
     float* const geometry = whole + 3 * padded;  // per light: t, h, share
-    for (size_t l = 0; l < lights; ++l) {
-      if (only < lights && l != only) continue;
-      const Vec3& p = lights_[l].position;
-      positions.insert(positions.end(), {p.x, p.y, p.z});
-      t_of.push_back(geometry + 3 * l * padded), h_of.push_back(geometry + (3 * l + 1) * padded);
-    }
     for (size_t part = 0; part < 5 + 3 * lights; ++part) std::fill(scratch.begin() + part * padded + count, scratch.begin() + (part + 1) * padded, 0.0f);
     const Aabb bounds = medium_->bounds();
-    const RowGeometry g{{bounds.lo.x, bounds.lo.y, bounds.lo.z}, {bounds.hi.x, bounds.hi.y, bounds.hi.z}, positions.data(), t_of.size(),
-                        t0, t1, t_of.data(), h_of.data()};
+    const size_t first = only < lights ? only : 0;  // the lights computed: all, or `only`
+    const RowGeometry g{{bounds.lo.x, bounds.lo.y, bounds.lo.z}, {bounds.hi.x, bounds.hi.y, bounds.hi.z}, positions_.data() + 3 * first,
+                        only < lights ? 1 : lights, t0, t1, geometry + 3 * first * padded, 3 * padded, padded};
     if (Vec3 a, b; camera.row_frame(y + 0.5, a, b)) {
       const double origin[3] = {camera.position.x, camera.position.y, camera.position.z}, a3[3] = {a.x, a.y, a.z}, b3[3] = {b.x, b.y, b.z};
       row_geometry(g, origin, a3, b3, x0 + 0.5, count);
@@ -541,6 +536,7 @@ class AnalyticSolution final : public MethodSolution {
 
   const Scene scene_;
   const std::vector<AnalyticLight> lights_;
+  std::vector<double> positions_;  // the lights' positions, xyz each (RowGeometry::lights)
   const std::unique_ptr<Medium> medium_;
   const Rgb sigma_t_, sigma_s_;
   const bool grey_, airlight_, surface_airlight_;

@@ -281,6 +281,9 @@ void march_row_distances(const Marcher& m, const MarchVolume& v, const View& vie
   thread_local std::vector<float> packed, result;
   thread_local std::vector<Vec3f> l, t;  // each ray's layers so far
   rays.resize(width), columns.resize(width), near.clear();
+  // Grown once to the most a row can take (every column near every light, in every slice), so
+  // that no later frame's row grows them.
+  near.reserve(width * m.scene.lights.size()), packed.reserve(9 * width * n), result.reserve(6 * width * n);
   camera.row_rays(y, rays.data());
   size_t count = 0;
   for (size_t x = 0; x < width; ++x) {

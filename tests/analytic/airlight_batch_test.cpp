@@ -8,7 +8,6 @@
 #include <glm/ext/matrix_transform.hpp>
 #include <gtest/gtest.h>
 #include <algorithm>
-#include <array>
 #include <cstdio>
 #include <hwy/tests/hwy_gtest.h>
 
@@ -230,28 +229,28 @@ TEST_P(AirlightBatchTargets, RowGeometryMatchesRays) {
     for (const Aabb& box : {Aabb{Vec3(-1.5), Vec3(1.5)}, Aabb{}}) {
       const size_t n = 53, padded = 64;
       std::vector<float> fast(8 * padded, 0.0f), slow(8 * padded, 0.0f);
-      const auto geometry = [&](std::vector<float>& v, std::array<float*, 3>& t, std::array<float*, 3>& h) {
-        for (size_t l = 0; l < 3; ++l) t[l] = v.data() + (2 + 2 * l) * padded, h[l] = v.data() + (3 + 2 * l) * padded;
-        return RowGeometry{{box.lo.x, box.lo.y, box.lo.z}, {box.hi.x, box.hi.y, box.hi.z}, lights.data(), 3, v.data(), v.data() + padded, t.data(), h.data()};
+      const auto geometry = [&](std::vector<float>& v) {
+        return RowGeometry{{box.lo.x, box.lo.y, box.lo.z}, {box.hi.x, box.hi.y, box.hi.z}, lights.data(), 3, v.data(), v.data() + padded,
+                           v.data() + 2 * padded, 2 * padded, padded};
       };
-      std::array<float*, 3> t_fast, h_fast, t_slow, h_slow;
+      const RowGeometry g_fast = geometry(fast), g_slow = geometry(slow);
       Vec3 a, b;
       ASSERT_TRUE(camera.row_frame(9.5, a, b));
       const double origin[3] = {camera.position.x, camera.position.y, camera.position.z}, a3[3] = {a.x, a.y, a.z}, b3[3] = {b.x, b.y, b.z};
-      row_geometry(geometry(fast, t_fast, h_fast), origin, a3, b3, 0.5, n);
+      row_geometry(g_fast, origin, a3, b3, 0.5, n);
       std::vector<Ray> rays(n);
       camera.row_rays(9, rays.data());
-      row_geometry_rays(geometry(slow, t_slow, h_slow), rays.data(), n);
+      row_geometry_rays(g_slow, rays.data(), n);
       for (size_t x = 0; x < n; ++x) {
         ASSERT_NEAR(fast[x], slow[x], 1e-6f * (1.0f + slow[x])) << "t0 of ray " << x;
         if (std::isinf(slow[padded + x])) ASSERT_EQ(fast[padded + x], slow[padded + x]) << "t1 of ray " << x;
         else ASSERT_NEAR(fast[padded + x], slow[padded + x], 1e-6f * (1.0f + slow[padded + x])) << "t1 of ray " << x;
         for (size_t l = 0; l < 3; ++l) {
-          ASSERT_NEAR(t_fast[l][x], t_slow[l][x], 1e-6f * (1.0f + std::abs(t_slow[l][x]))) << "t of ray " << x << ", light " << l;
-          ASSERT_NEAR(h_fast[l][x], h_slow[l][x], 1e-6f * (1.0f + h_slow[l][x])) << "h of ray " << x << ", light " << l;
+          ASSERT_NEAR(g_fast.t(l)[x], g_slow.t(l)[x], 1e-6f * (1.0f + std::abs(g_slow.t(l)[x]))) << "t of ray " << x << ", light " << l;
+          ASSERT_NEAR(g_fast.h(l)[x], g_slow.h(l)[x], 1e-6f * (1.0f + g_slow.h(l)[x])) << "h of ray " << x << ", light " << l;
         }
       }
-      EXPECT_LT(h_fast[1][17], 1e-6f) << "the light on ray 17";
+      EXPECT_LT(g_fast.h(1)[17], 1e-6f) << "the light on ray 17";
     }
   }
 }

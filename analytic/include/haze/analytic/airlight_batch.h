@@ -69,15 +69,18 @@ void layers_from_tails_reference(const TailRow& row, const float* ends, const fl
 
 // A row's geometry toward its lights, in float64, stored as float32 (the TailRow's inputs): ray x's
 // stretch [t0[x], t1[x]] inside the box [lo, hi] (0 and 0 where it misses; t1 +inf where the box
-// is unbounded that way), and per light l its projection t[l][x] = (p - o) . v along the ray and its
-// distance h[l][x] from the ray's line. Arrays hold count rounded up to 16.
+// is unbounded that way), and per light l its projection t = (p - o) . v along the ray at
+// geometry[l light_stride + x] and its distance h from the ray's line at geometry[l light_stride +
+// h_offset + x]. Arrays hold count rounded up to 16.
 struct RowGeometry {
   double lo[3], hi[3];
   const double* lights;  // xyz per light
   size_t light_count;
   float *t0, *t1;
-  float* const* t;
-  float* const* h;
+  float* geometry;
+  size_t light_stride, h_offset;
+  float* t(size_t l) const { return geometry + l * light_stride; }
+  float* h(size_t l) const { return t(l) + h_offset; }
 };
 // Rays from one eye: ray x leaves `origin` along normalize(a + b (px0 + x)) (Camera::row_frame),
 // float64 lanes.
