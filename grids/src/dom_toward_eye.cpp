@@ -4,6 +4,7 @@
 #include <haze/core/progress.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 namespace haze::grids::dom {
@@ -34,7 +35,8 @@ TowardEye::TowardEye(const DomSolution& solution) : solution_(solution) {
 }
 
 void TowardEye::fill(const DenseGrid& density, const Vec3& eye, const Rgb& scale, std::vector<float>& out, int threads) const {
-  const auto [nx, ny, nz] = density.resolution();
+  const std::array<int, 3> n = density.resolution();
+  const int nx = n[0], ny = n[1], nz = n[2];  // named, not bound: the lambda below takes them
   const auto terms = static_cast<size_t>(solution_.terms()), channels = static_cast<size_t>(solution_.channels);
   const size_t plane = static_cast<size_t>(nx) * static_cast<size_t>(ny);
   out.resize(plane * static_cast<size_t>(nz) * channels);
