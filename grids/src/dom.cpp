@@ -282,7 +282,7 @@ class DomMethodSolution final : public GridSolution {
     if (!scene_.surfaces.empty() || volume_.emission.emits()) return false;
     const dom::Gather& gather = froxel_gather();
     const Rgb background = delta_.background + sky_;
-    each_ray(view.camera, options, [&](int x, int y, const Ray& ray, const Eigen::VectorXd& c) {
+    each_ray(view.camera, options, [&](int x, int y, const Ray& ray, const Eigen::VectorXd& c, double, double) {
       const double depth = view.max_distance(x, y);
       Rgb t;
       const Rgb l = gather.along(ray, depth, c, t);
@@ -324,11 +324,9 @@ class DomMethodSolution final : public GridSolution {
     const Camera& camera = view.camera;
     const auto width = static_cast<size_t>(camera.width_px);
     const size_t per_slice = width * static_cast<size_t>(camera.height_px);
-    const Aabb bounds = volume_.density.bounds();
     const double pitch = camera.pixel_angle();  // a column's width per unit distance: no finer steps along it
-    each_ray(camera, options, [&](int x, int y, const Ray& ray, const Eigen::VectorXd& c) {
-      double t0 = 0.0, t1 = kInfinity;
-      const bool inside = bounds.clip(ray, t0, t1) && t1 > t0;
+    each_ray(camera, options, [&](int x, int y, const Ray& ray, const Eigen::VectorXd& c, double t0, double t1) {
+      const bool inside = t1 > t0;
       Rgb l(0.0), t(1.0);
       for (size_t k = 0; k < distances.size(); ++k) {
         const double from = std::max(t0, k == 0 ? 0.0 : distances[k - 1]), to = std::min(t1, distances[k]);
@@ -386,9 +384,10 @@ class DomMethodSolution final : public GridSolution {
   }
 
  private:
-  // fn(x, y, ray, c) for each pixel's ray of the camera, row by row on the threads, c its
-  // direction's in-scatter weights (inscatter_weights) where its ray meets the medium. Each thread
-  // keeps its rays and weights: a frame allocates nothing once they have grown.
+  // fn(x, y, ray, c, t0, t1) for each pixel's ray of the camera, row by row on the threads:
+  // [t0, t1] its stretch in the medium (t1 <= t0 where it misses) and c its direction's in-scatter
+  // weights (inscatter_weights) where it meets it. Each thread keeps its rays and weights: a frame
+  // allocates nothing once they have grown.
   template <class Fn>
   void each_ray(const Camera& camera, const RenderOptions& options, const Fn& fn) const {
     const auto width = static_cast<size_t>(camera.width_px);
@@ -401,8 +400,9 @@ class DomMethodSolution final : public GridSolution {
         camera.row_rays(y, rays.data());
         for (size_t x = 0; x < width; ++x) {
           double t0 = 0.0, t1 = kInfinity;
-          if (bounds.clip(rays[x], t0, t1) && t1 > t0) inscatter_weights(solution_, -rays[x].direction, row, c);
-          fn(static_cast<int>(x), y, rays[x], c);
+          if (!bounds.clip(rays[x], t0, t1)) t1 = t0;
+          if (t1 > t0) inscatter_weights(solution_, -rays[x].direction, row, c);
+          fn(static_cast<int>(x), y, rays[x], c, t0, t1);
         }
       }
     };

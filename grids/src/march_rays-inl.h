@@ -83,9 +83,9 @@ HWY_INLINE void MarchVector(D d, const MarchVolume& v, const simd::PhaseParams& 
       weight[m] = hn::Mul(bx ? frac[0] : hn::Sub(one, frac[0]),
                           hn::Mul(by ? frac[1] : hn::Sub(one, frac[1]), bz ? frac[2] : hn::Sub(one, frac[2])));
     }
-    // The density, trilinear: on vector targets each (y, z)
-    // corner's two x neighbours as one pair from p = clamp(i, 0, n - 2) (lo and hi, clamped at the
-    // faces, are p or p + 1), else eight gathers.
+    // The density, trilinear: on vector targets each (y, z) corner's two x neighbours as one pair
+    // from p = clamp(i, 0, n - 2) (lo and hi, clamped at the faces, are p or p + 1), else eight
+    // gathers.
 #if HWY_TARGET != HWY_SCALAR
     const bool pairs = v.n[0] >= 2;
     VI pair_at[4];
@@ -200,12 +200,17 @@ HWY_INLINE void MarchVector(D d, const MarchVolume& v, const simd::PhaseParams& 
         in[c] = hn::MulAdd(hn::Mul(weight_l, hn::Set(d, light.intensity[c])),
                            hn::Exp(d, hn::Mul(hn::Set(d, -v.sigma_t[c] * v.depth_scale[c]), depth)), in[c]);
     }
+    // The source, once for all channels where it has one.
+    V source = zero;
     for (int c = 0; v.source && c < C; ++c) {
-      const int channel = v.source_channels == 1 ? 0 : c;
-      V source = zero;
-      for (int m = 0; m < 8; ++m)
-        source = hn::MulAdd(f_weight[m], hn::GatherIndex(d, v.source + channel, hn::Mul(f_offset[m], hn::Set(di, v.source_channels))), source);
-      in[c] = hn::Add(in[c], hn::Max(source, zero));
+      if (c == 0 || v.source_channels > 1) {
+        source = zero;
+        for (int m = 0; m < 8; ++m)
+          source = hn::MulAdd(f_weight[m], hn::GatherIndex(d, v.source + (v.source_channels > 1 ? c : 0), hn::Mul(f_offset[m], hn::Set(di, v.source_channels))),
+                              source);
+        source = hn::Max(source, zero);
+      }
+      in[c] = hn::Add(in[c], source);
     }
     for (int c = 0; c < C; ++c) {
       const V step_transmittance = hn::Exp(d, hn::Mul(hn::Set(d, -v.sigma_t[c]), hn::Mul(rho, dt)));

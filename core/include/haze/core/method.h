@@ -169,7 +169,8 @@ class Solution {
   // The view's layers (L_in, T and C, as render with view.layers gives them) written into the
   // caller's memory, reused frame after frame: the method's own path where it has one (analytic
   // with point lights and no surfaces of Haze's own; propagation's march; dom's gather without
-  // surfaces or emission: no allocation once warm), else a render copied into it. Spans of another size than the view's are a haze::Error naming them.
+  // surfaces or emission: no allocation once warm), else a render copied into it. Spans of
+  // another size than the view's are a haze::Error naming them.
   void render_layers(const View& view, LayerSpans out, const RenderOptions& options = {}) const;
   RenderResult render(const RenderOptions& options = {}) const { return render(View{scene().camera}, options); }
   // L_in and T along each of the view's rays (its depth ignored; Haze's own surfaces still end
