@@ -148,6 +148,13 @@ bool Camera::row_frame(double py, Vec3& a, Vec3& b) const {
   return true;
 }
 
+bool Camera::eye(Vec3& at) const {
+  if (type == Type::pinhole) return at = position, true;
+  // A perspective projection (row_frame's condition): its rays leave the eye, the view's origin.
+  if (type == Type::matrices && projection[2][3] != 0.0 && projection_inverse[0][3] == 0.0) return at = Vec3(view_inverse[3]), true;
+  return false;
+}
+
 double Camera::pixel_angle() const {
   const double x = 0.5 * width_px, y = 0.5 * height_px;
   return std::acos(std::clamp(glm::dot(generate_ray(x, y).direction, generate_ray(x + 1.0, y).direction), -1.0, 1.0));

@@ -308,14 +308,14 @@ class DomMethodSolution final : public GridSolution {
   bool render_distances(const View& view, std::span<const double> distances, const RenderOptions& options, DistanceLayers out) const override {
     if (!scene_.surfaces.empty() || volume_.emission.emits()) return false;
     const dom::Gather& gather = froxel_gather();
-    if (Vec3 a, b; toward_eye_ && view.camera.row_frame(0.5, a, b)) {
+    if (Vec3 eye; toward_eye_ && view.camera.eye(eye)) {
       thread_local std::vector<float> kept;  // this thread's frame after frame; the rows read it meanwhile
       std::vector<float>& radiance = kept;
       const double f = solution_.delta_m_fraction;
       const Rgb single = volume_.albedo / (Rgb(1.0) - volume_.albedo * f), scattered = dom::delta_m_albedo(volume_.albedo, f);
       Rgb scale(0.0);
       for (int c = 0; c < 3; ++c) scale[c] = single[c] > 0.0 ? scattered[c] / single[c] : 0.0;
-      toward_eye_->fill(volume_.density, view.camera.position, scale, radiance, options.threads);
+      toward_eye_->fill(volume_.density, eye, scale, radiance, options.threads);
       const MarchScattered toward{radiance.data(), toward_eye_->channels(), dom::delta_m_sigma_t(volume_.sigma_t_scale, volume_.albedo, f), single};
       MarchSettings march;
       march.step_cells = step_cells_;

@@ -39,7 +39,8 @@ void TowardEye::fill(const DenseGrid& density, const Vec3& eye, const Rgb& scale
   const int nx = n[0], ny = n[1], nz = n[2];  // named, not bound: the lambda below takes them
   const auto terms = static_cast<size_t>(solution_.terms()), channels = static_cast<size_t>(solution_.channels);
   const size_t plane = static_cast<size_t>(nx) * static_cast<size_t>(ny);
-  out.resize(plane * static_cast<size_t>(nz) * channels);
+  const size_t cells = plane * static_cast<size_t>(nz);
+  out.resize(cells * channels);
   const Vec3 lo = density.bounds().lo, h = density.cell_size();
   const float half = 0.5f * kSide;
   const auto planes = [&](long long z0, long long z1) {
@@ -72,7 +73,7 @@ void TowardEye::fill(const DenseGrid& density, const Vec3& eye, const Rgb& scale
             const float* m = solution_.moments[ch].data() + cell * terms;
             float j = 0.0f;
             for (size_t k = 0; k < terms; ++k) j += c[k] * m[k];
-            out[cell * channels + ch] = static_cast<float>(scale[static_cast<int>(ch)]) * std::max(0.0f, j);
+            out[ch * cells + cell] = static_cast<float>(scale[static_cast<int>(ch)]) * std::max(0.0f, j);
           }
         }
       }

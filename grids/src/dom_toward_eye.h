@@ -16,7 +16,7 @@ class TowardEye {
   explicit TowardEye(const DomSolution& solution);
   // Per cell of the solution's grid (`density`'s resolution and bounds) and channel:
   // scale[c] max(0, c(-w) . m_c), w the unit direction from `eye` to the cell's centre (c(-w)
-  // bilinear in the table), into out[cell * channels + c] (kept by the caller), on the threads.
+  // bilinear in the table), into out[c * cells + cell] (kept by the caller), on the threads.
   void fill(const DenseGrid& density, const Vec3& eye, const Rgb& scale, std::vector<float>& out, int threads) const;
   int channels() const { return solution_.channels; }
 

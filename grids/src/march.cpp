@@ -180,6 +180,7 @@ bool simd_volume(const Marcher& m, std::vector<MarchLight>& lights, MarchVolume&
       return false;
     }
     set(intensity, l.intensity);
+    l.slot = static_cast<int>(lights.size());
     all_grey = all_grey && is_grey(intensity);
     lights.push_back(l);
   }
@@ -187,7 +188,7 @@ bool simd_volume(const Marcher& m, std::vector<MarchLight>& lights, MarchVolume&
   v.depths = m.packed.depths.data();
   v.visibility = m.packed.visibility.empty() ? nullptr : m.packed.visibility.data();
   v.lights = lights.data();
-  v.light_count = static_cast<int>(lights.size());
+  v.light_count = v.depth_stride = static_cast<int>(lights.size());
   v.channels = all_grey ? 1 : 3;
   return true;
 }
@@ -364,6 +365,8 @@ PackedLights pack_lights(const Scene& scene, const ExtinctionVolume& volume, con
     return out;
   };
   PackedLights packed{interleave(depths), {}};
+  const std::vector<float>& values = volume.density.values();
+  packed.density_max = values.empty() ? 0.0f : *std::max_element(values.begin(), values.end());
   if (volume.albedo == Rgb(0.0) || scene.surfaces.empty()) return packed;  // no light in the medium to shadow
   if (visibility && visibility->size() != depths.size())
     throw Error("visibility", to_text(visibility->size()) + " volumes", "one per light (" + to_text(depths.size()) + ")");
@@ -409,6 +412,45 @@ bool march_layers(const Scene& scene, const ExtinctionVolume& volume, const std:
   lights.clear();
   MarchVolume simd_view;
   if (settings.scalar || marcher.gather || !simd_volume(marcher, lights, simd_view)) return false;
+  if (Vec3 eye; settings.toward_eye && view.camera.eye(eye)) {
+    thread_local std::vector<MarchLight> far;
+    thread_local std::vector<float> source;  // kept as `lights`
+    far.clear();
+    const DenseGrid& density = volume.density;
+    const auto n = density.resolution();
+    const float dense = MarchSettings::kFarDensity * marcher.packed.density_max;
+    const auto stays = [&](const MarchLight& l) {
+      if (l.type == MarchLight::directional) return false;
+      if (l.type == MarchLight::spot) return true;
+      // The cells within kFarCells of the light's (clamped to the grid's), against kFarDensity.
+      std::array<int, 3> lo, hi;
+      for (size_t e = 0; e < 3; ++e) {
+        const double u = (static_cast<double>(l.position[e]) - density.bounds().lo[static_cast<int>(e)]) / h[static_cast<int>(e)];
+        const double c = std::floor(std::clamp(u, -1e6, 1e6));
+        lo[e] = static_cast<int>(std::clamp(c - MarchSettings::kFarCells, 0.0, n[e] - 1.0));
+        hi[e] = static_cast<int>(std::clamp(c + MarchSettings::kFarCells, 0.0, n[e] - 1.0));
+        if (c + MarchSettings::kFarCells < 0.0 || c - MarchSettings::kFarCells > n[e] - 1.0) return false;  // no cell that near
+      }
+      for (int z = lo[2]; z <= hi[2]; ++z)
+        for (int y = lo[1]; y <= hi[1]; ++y)
+          for (int x = lo[0]; x <= hi[0]; ++x)
+            if (density.at(x, y, z) > dense) return true;
+      return false;
+    };
+    size_t kept = 0;
+    for (const MarchLight& l : lights) {
+      if (stays(l)) lights[kept++] = l;
+      else far.push_back(l);
+    }
+    lights.resize(kept);
+    if (!far.empty()) {
+      source.resize(static_cast<size_t>(n[0] + 2) * static_cast<size_t>(n[1] + 2) * static_cast<size_t>(n[2] + 2) * static_cast<size_t>(simd_view.channels));
+      const float at[3] = {static_cast<float>(eye.x), static_cast<float>(eye.y), static_cast<float>(eye.z)};
+      march_toward_eye(simd_view, volume.phase, at, far.data(), static_cast<int>(far.size()), source.data(), options.threads);
+      simd_view.source = source.data(), simd_view.source_channels = simd_view.channels, simd_view.source_ghosts = true;
+      simd_view.lights = lights.data(), simd_view.light_count = static_cast<int>(lights.size());
+    }
+  }
   const auto rows = [&](long long y0, long long y1) {
     for (auto y = static_cast<int>(y0); y < y1; ++y) march_row_layers(marcher, simd_view, view, y, out);
   };

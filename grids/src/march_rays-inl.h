@@ -15,7 +15,7 @@
 
 #include <algorithm>
 
-#include <haze/simd/phase_batch-inl.h>
+#include "march_light-inl.h"
 
 HWY_BEFORE_NAMESPACE();
 namespace haze::grids::HWY_NAMESPACE {
@@ -57,6 +57,13 @@ HWY_INLINE void MarchVector(D d, const MarchVolume& v, const simd::PhaseParams& 
   V radiance[C], transmittance[C];
   for (int c = 0; c < C; ++c) radiance[c] = zero, transmittance[c] = one;
   const int stride[3] = {1, v.n[0], v.n[0] * v.n[1]};
+  const int ghosts = v.source_ghosts ? 2 : 0;  // a source plane's cells
+  const size_t cells = static_cast<size_t>(v.n[0] + ghosts) * static_cast<size_t>(v.n[1] + ghosts) * static_cast<size_t>(v.n[2] + ghosts);
+  const int depth_stride = v.depth_stride > 0 ? v.depth_stride : v.light_count;
+  // Grey extinction: one exponential for all channels.
+  const float depth_0 = v.sigma_t[0] * v.depth_scale[0];
+  const bool grey_steps = v.sigma_t[1] == v.sigma_t[0] && v.sigma_t[2] == v.sigma_t[0];
+  const bool grey_depths = v.sigma_t[1] * v.depth_scale[1] == depth_0 && v.sigma_t[2] * v.depth_scale[2] == depth_0;
   float max_steps = 0.0f;
   for (size_t m = 0; m < lanes; ++m) max_steps = std::max(max_steps, buffer[8][m]);
   for (int s = 0; s < static_cast<int>(max_steps); ++s) {
@@ -119,13 +126,13 @@ HWY_INLINE void MarchVector(D d, const MarchVolume& v, const simd::PhaseParams& 
     const V rho = trilinear(v.density);
     active = hn::And(active, hn::Gt(rho, zero));
     if (hn::AllFalse(d, active)) continue;
-    V in[C];
+    V in[C], step_transmittance_0 = one;
     for (int c = 0; c < C; ++c) in[c] = zero;
-    // The lights' depths and the source: the density's stencil, or with v.outer (dom's gather) one
+    // The lights' depths (v.outer) and the source (v.source_outer): the density's stencil, or one
     // that keeps the slope into the outer half cells, per axis the cells p = clamp(floor(u), 0,
     // n - 2) and p + 1 weighted by u - p unclamped (an axis of one cell: that cell).
-    VI f_offset[8];
-    V f_weight[8];
+    VI o_offset[8];
+    V o_weight[8], o_x = zero;  // the outer stencil's x weight of cell p + 1
     if (v.outer) {
       VI p[3];
       V a[3];
@@ -142,78 +149,98 @@ HWY_INLINE void MarchVector(D d, const MarchVolume& v, const simd::PhaseParams& 
           at = hn::Add(at, hn::Mul(bit && v.n[e] >= 2 ? hn::Add(p[e], hn::Set(di, 1)) : p[e], hn::Set(di, stride[e])));
           w = hn::Mul(w, bit ? a[e] : hn::Sub(one, a[e]));
         }
-        f_offset[m] = at, f_weight[m] = w;
+        o_offset[m] = at, o_weight[m] = w;
       }
-    } else {
-      for (int m = 0; m < 8; ++m) f_offset[m] = offset[m], f_weight[m] = weight[m];
+      o_x = a[0];
     }
-    // The corners' offsets into the per-light volumes ([cell * lights + l]).
+    const VI* f_offset = v.outer ? o_offset : offset;
+    const V* f_weight = v.outer ? o_weight : weight;
+    // The source's stencil: the depths', or on the ghosted grid cells floor(u) + 1 and + 2 per axis
+    // at the density's weights (clamped only for lanes past their steps: u is in [-0.5, n - 0.5]
+    // inside the bounds).
+    VI g_offset[8];
+    if (v.source_ghosts) {
+      const int gx = v.n[0] + 2, gxy = gx * (v.n[1] + 2);
+      VI g[3];
+      for (int e = 0; e < 3; ++e) g[e] = hn::Min(hn::Max(hn::Add(hn::ConvertTo(di, hn::Floor(u[e])), hn::Set(di, 1)), hn::Zero(di)), hn::Set(di, v.n[e]));
+      const VI base = hn::Add(g[0], hn::Add(hn::Mul(g[1], hn::Set(di, gx)), hn::Mul(g[2], hn::Set(di, gxy))));
+      for (int m = 0; m < 8; ++m) g_offset[m] = hn::Add(base, hn::Set(di, (m & 1) + ((m >> 1) & 1) * gx + ((m >> 2) & 1) * gxy));
+    }
+    const VI* s_offset = v.source_ghosts ? g_offset : f_offset;
+    const V* s_weight = v.source_ghosts ? weight : f_weight;
+#if HWY_TARGET != HWY_SCALAR
+    // The source's stencil in x pairs (pairs: x cells p and p + 1 on two cells or more): pair
+    // offsets, y-z weights, x weights.
+    VI s_pair_at[4];
+    V s_yz[4], s_first = w_first, s_second = w_second;
+    if (pairs && v.source && v.source_ghosts) {
+      for (int e = 0; e < 4; ++e) s_pair_at[e] = g_offset[2 * e], s_yz[e] = yz[e];
+      s_first = hn::Sub(one, frac[0]), s_second = frac[0];
+    } else if (pairs && v.source && v.outer) {
+      for (int e = 0; e < 4; ++e) s_pair_at[e] = o_offset[2 * e], s_yz[e] = hn::Add(o_weight[2 * e], o_weight[2 * e + 1]);
+      s_first = hn::Sub(one, o_x), s_second = o_x;
+    } else if (pairs) {
+      for (int e = 0; e < 4; ++e) s_pair_at[e] = pair_at[e], s_yz[e] = yz[e];
+    }
+#endif
+    // The corners' offsets into the per-light volumes ([cell * depth_stride + slot]).
     VI light_offset[8];
-    for (int m = 0; m < 8; ++m) light_offset[m] = hn::Mul(f_offset[m], hn::Set(di, v.light_count));
+    for (int m = 0; m < 8 && v.light_count > 0; ++m) light_offset[m] = hn::Mul(f_offset[m], hn::Set(di, depth_stride));
     V next_depth = zero;  // light l + 1's, gathered with light l's
+    bool paired = false;  // next_depth holds light l's
     for (int l = 0; l < v.light_count; ++l) {
       const MarchLight& light = v.lights[l];
       V depth = zero;
 #if HWY_TARGET != HWY_SCALAR
-      if (l % 2 == 1) {
-        depth = next_depth;
-      } else if (l + 1 < v.light_count) {  // lights l and l + 1 side by side in each cell
-        next_depth = zero;
+      if (paired) {
+        depth = next_depth, paired = false;
+      } else if (l + 1 < v.light_count && v.lights[l + 1].slot == light.slot + 1) {  // lights l and l + 1 side by side in each cell
+        next_depth = zero, paired = true;
         for (int m = 0; m < 8; ++m) {
           V a, b;
-          GatherPairs(d, v.depths + l, light_offset[m], a, b);
+          GatherPairs(d, v.depths + light.slot, light_offset[m], a, b);
           depth = hn::MulAdd(f_weight[m], a, depth), next_depth = hn::MulAdd(f_weight[m], b, next_depth);
         }
         next_depth = hn::Max(next_depth, zero);  // the outer stencil may extrapolate below 0
       } else
 #endif
-      for (int m = 0; m < 8; ++m) depth = hn::MulAdd(f_weight[m], hn::GatherIndex(d, v.depths + l, light_offset[m]), depth);
+      for (int m = 0; m < 8; ++m) depth = hn::MulAdd(f_weight[m], hn::GatherIndex(d, v.depths + light.slot, light_offset[m]), depth);
       depth = hn::Max(depth, zero);
-      V to[3], falloff;
-      if (light.type == MarchLight::directional) {
-        for (int e = 0; e < 3; ++e) to[e] = hn::Set(d, light.to_light[e]);
-        falloff = one;
-      } else {
-        V w[3];
-        for (int e = 0; e < 3; ++e) w[e] = hn::Sub(hn::Set(d, light.position[e]), x[e]);
-        const V r2 = hn::MulAdd(w[0], w[0], hn::MulAdd(w[1], w[1], hn::Mul(w[2], w[2])));
-        const V inv_r = simd::HWY_NAMESPACE::ReciprocalSqrt(r2);
-        for (int e = 0; e < 3; ++e) to[e] = hn::Mul(w[e], inv_r);
-        falloff = hn::Mul(inv_r, inv_r);
-        if (light.type == MarchLight::spot) {
-          const V cos_theta = hn::Neg(hn::MulAdd(to[0], hn::Set(d, light.axis[0]),
-                                                 hn::MulAdd(to[1], hn::Set(d, light.axis[1]), hn::Mul(to[2], hn::Set(d, light.axis[2])))));
-          const auto inside = hn::And(hn::Ge(cos_theta, hn::Set(d, light.cos_cone)), hn::Gt(cos_theta, zero));
-          const V cone = hn::Exp(d, hn::Mul(hn::Set(d, light.exponent), hn::Log(d, hn::IfThenElse(inside, cos_theta, one))));
-          falloff = hn::IfThenElseZero(inside, hn::Mul(falloff, cone));
-        }
-      }
+      V visible = one;
       if (v.visibility) {
-        V visible = zero;
+        visible = zero;
         for (int m = 0; m < 8; ++m)
-          visible = hn::MulAdd(weight[m], hn::GatherIndex(d, v.visibility + l, light_offset[m]), visible);
-        falloff = hn::Mul(falloff, visible);
+          visible = hn::MulAdd(weight[m], hn::GatherIndex(d, v.visibility + light.slot, light_offset[m]), visible);
       }
-      const V mu = hn::MulAdd(to[0], dir[0], hn::MulAdd(to[1], dir[1], hn::Mul(to[2], dir[2])));
-      const V weight_l = hn::Mul(simd::HWY_NAMESPACE::EvalPhase(d, phase, mu), falloff);
-      for (int c = 0; c < C; ++c)
-        in[c] = hn::MulAdd(hn::Mul(weight_l, hn::Set(d, light.intensity[c])),
-                           hn::Exp(d, hn::Mul(hn::Set(d, -v.sigma_t[c] * v.depth_scale[c]), depth)), in[c]);
+      AddLight<C>(d, v, light, phase, x, dir, depth, visible, grey_depths, in);
     }
-    // The source, once for all channels where it has one.
+    // The source, once for all channels where it has one: in x pairs where the stencil's x cells
+    // are p and p + 1 (the density's, or the outer one's on two cells or more).
     V source = zero;
     for (int c = 0; v.source && c < C; ++c) {
       if (c == 0 || v.source_channels > 1) {
-        source = zero;
-        for (int m = 0; m < 8; ++m)
-          source = hn::MulAdd(f_weight[m], hn::GatherIndex(d, v.source + (v.source_channels > 1 ? c : 0), hn::Mul(f_offset[m], hn::Set(di, v.source_channels))),
-                              source);
+        const float* plane = v.source + (v.source_channels > 1 ? static_cast<size_t>(c) * cells : 0);
+#if HWY_TARGET != HWY_SCALAR
+        if (pairs) {
+          source = zero;
+          for (int e = 0; e < 4; ++e) {
+            V a, b;
+            GatherPairs(d, plane, s_pair_at[e], a, b);
+            source = hn::MulAdd(s_yz[e], hn::MulAdd(s_second, b, hn::Mul(s_first, a)), source);
+          }
+        } else
+#endif
+        {
+          source = zero;
+          for (int m = 0; m < 8; ++m) source = hn::MulAdd(s_weight[m], hn::GatherIndex(d, plane, s_offset[m]), source);
+        }
         source = hn::Max(source, zero);
       }
       in[c] = hn::Add(in[c], source);
     }
     for (int c = 0; c < C; ++c) {
-      const V step_transmittance = hn::Exp(d, hn::Mul(hn::Set(d, -v.sigma_t[c]), hn::Mul(rho, dt)));
+      const V step_transmittance = c > 0 && grey_steps ? step_transmittance_0 : hn::Exp(d, hn::Mul(hn::Set(d, -v.sigma_t[c]), hn::Mul(rho, dt)));
+      if (c == 0) step_transmittance_0 = step_transmittance;
       const V scattered = hn::Mul(hn::Mul(transmittance[c], hn::Set(d, v.albedo[c])), hn::Mul(hn::Sub(one, step_transmittance), in[c]));
       radiance[c] = hn::Add(radiance[c], hn::IfThenElseZero(active, scattered));
       transmittance[c] = hn::IfThenElse(active, hn::Mul(transmittance[c], step_transmittance), transmittance[c]);

@@ -57,6 +57,9 @@ struct Camera {
   // The rays of film row py leave `position` along normalize(a + b px) for every px: a pinhole
   // camera, or a host's perspective matrices (their w not depending on x); false for others.
   bool row_frame(double py, Vec3& a, Vec3& b) const;
+  // The point every ray leaves from: a pinhole camera's position, a host's perspective matrices'
+  // eye; false for others.
+  bool eye(Vec3& at) const;
   // The angle between the rays of the two pixels right of the film's centre (radians): a pixel's
   // width as seen from the eye there.
   double pixel_angle() const;

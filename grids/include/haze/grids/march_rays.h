@@ -12,6 +12,7 @@
 #include <haze/core/phase.h>
 
 #include <cstddef>
+#include <vector>
 
 #pragma GCC visibility push(default)  // the public API: exported from shared builds
 
@@ -24,27 +25,33 @@ struct MarchLight {
   float axis[3] = {0, 0, -1};     // spot: unit direction it shines along
   float intensity[3] = {1, 1, 1};  // I (point), I0 (spot), irradiance (directional)
   float cos_cone = 0.0f, exponent = 1.0f;  // spot: I0 cos^exponent(theta) where cos(theta) >= cos_cone
+  int slot = 0;  // its depths and visibility: depths[cell * depth_stride + slot]
 };
 
 struct MarchVolume {
   int n[3] = {1, 1, 1};
   float lo[3] = {0, 0, 0}, h[3] = {1, 1, 1};
   const float* density = nullptr;  // x fastest
-  const float* depths = nullptr;   // depths[cell * light_count + l]
+  const float* depths = nullptr;   // depths[cell * depth_stride + lights[l].slot]
   const float* visibility = nullptr;  // the same layout, in [0, 1] (surface shadows); null: 1
   const MarchLight* lights = nullptr;
   int light_count = 0;
+  int depth_stride = 0;  // the lights packed per cell (pack_lights: all the scene's)
   float sigma_t[3] = {1, 1, 1}, albedo[3] = {1, 1, 1};
   int channels = 3;  // 1 where sigma_t, albedo and every light are grey: channel 0 only
-  // A radiance per cell added to L_in, trilinear like the density ([cell * source_channels + c],
-  // one channel for all or three; null: none), and the lights' depths attenuated by sigma_t times
-  // depth_scale (dom's froxels: its scattered light from the moments, its delta-M scaled steps).
+  // A radiance per cell added to L_in, trilinear like the density (planes of cells,
+  // [c * cells + cell], one channel for all or three; null: none): lights folded in toward one
+  // eye (march_toward_eye), or dom's scattered light from the moments; and the lights' depths
+  // attenuated by sigma_t times depth_scale (dom's delta-M scaled steps).
   const float* source = nullptr;
   int source_channels = 1;
   float depth_scale[3] = {1, 1, 1};
   // The depths and the source keep their slope into the outer half cells, clamped at 0 (dom's
   // gather), instead of the edge cells' values.
   bool outer = false;
+  // The source on the grid with one ghost cell around it (n + 2 cells a side; march_toward_eye's),
+  // read between the centres of the cells and the ghosts beside them in the outer half cells.
+  bool source_ghosts = false;
 };
 
 struct RayPacket {
@@ -54,6 +61,22 @@ struct RayPacket {
   float* radiance[3];       // out, per channel (channels of the volume)
   float* transmittance[3];  // out, per channel
 };
+
+// The lights' part of L_in toward one eye, per cell: what march_rays evaluates at a step, at the
+// cell's centre with w the unit vector from `eye` to it,
+//   S(cell) = sum_l p(to_light_l . w) E_l V_l e^(-sigma_t depth_scale depth_l),
+// for `count` point or directional lights (a spot's cone edge is left to the march; haze::Error),
+// on the grid with one ghost cell around the volume's (a ghost's depths and visibility those of
+// the cell beside it, as the march's clamped reads have them; MarchVolume::source_ghosts),
+// prefiltered for trilinear reads: each cell less 1/12 of its second differences along the axes
+// (linear interpolation's mean error over a cell, h^2 f'' / 12, taken back), at least 0. Into
+// out[c * cells + cell], c < volume.channels, cells (n + 2)^3 of them, on the threads; each
+// worker's scratch (three planes) kept, so that a frame allocates nothing once it has grown.
+void march_toward_eye(const MarchVolume& volume, const PhaseFunction& phase, const float eye[3], const MarchLight* lights, int count, float* out,
+                      int threads);
+// Its float64 reference, one cell at a time (phase.eval, std::exp): the same layout.
+void march_toward_eye_reference(const MarchVolume& volume, const PhaseFunction& phase, const double eye[3], const MarchLight* lights, int count,
+                                std::vector<double>& out);
 
 // False for phase functions the kernel cannot evaluate (tabulated): use the float64 marcher.
 bool march_supported(const PhaseFunction& phase);

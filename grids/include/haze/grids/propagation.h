@@ -74,6 +74,17 @@ struct MarchSettings {
   // its hemisphere), through the BRDF, a point light's irradiance capped at the cone each direction
   // stands for. Method "propagation"'s setting surface_light; the GL display has it not.
   bool surface_gather = false;
+  // march_layers (a frame's per-pixel layers) from one eye: the directional lights, and the point
+  // lights with no cell within kFarCells cells of them denser than kFarDensity of the volume's
+  // largest, folded into a radiance per cell toward the eye (march_toward_eye, made each frame),
+  // read trilinearly with the density instead of every light's depth at every step; spots and
+  // the other point lights stay in the steps (near a light the folded radiance's curvature is
+  // more than its prefilter takes back: 1.5e-3 of the image for a light 4.5 cells above a cloud's
+  // top). Within 4e-4 relative RMS of the steps' layers on the frame benchmark's cloud
+  // (tests/grids/toward_eye_test.cpp).
+  bool toward_eye = true;
+  static constexpr int kFarCells = 8;
+  static constexpr float kFarDensity = 0.01f;
 };
 
 // The per-light volumes as the marcher reads them, all lights of a cell together ([cell * lights +
@@ -81,6 +92,7 @@ struct MarchSettings {
 // or where nothing scatters). 4 bytes a cell and light each: made once per solution, not per frame.
 struct PackedLights {
   std::vector<float> depths, visibility;
+  float density_max = 0.0f;  // the volume's largest cell (MarchSettings::toward_eye's measure)
 };
 // `visibility` when given (one grid per light), else computed here.
 PackedLights pack_lights(const Scene& scene, const ExtinctionVolume& volume, const std::vector<DenseGrid>& depths, int threads,
@@ -108,7 +120,7 @@ RenderResult march_view(const Scene& scene, const ExtinctionVolume& volume, cons
 // With `scattered` (dom's froxels), L_in also takes that radiance per cell and the steps its own
 // extinction and albedo (MarchScattered).
 struct MarchScattered {
-  const float* radiance = nullptr;  // per cell, [cell * channels + c]: light scattered more than once, toward the eye
+  const float* radiance = nullptr;  // per cell, [c * cells + cell]: light scattered more than once, toward the eye
   int channels = 1;                 // 1: the same for every channel
   Rgb sigma_t{1.0};                 // the steps' extinction per density (the lights' depths keep the volume's)
   Rgb albedo{1.0};                  // what scatters the lights' light and `radiance` alike
