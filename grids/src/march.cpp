@@ -149,6 +149,28 @@ struct Marcher {
   }
 };
 
+// Whether a point or spot light has a cell within MarchSettings::kFarCells cells of its own
+// (clamped to the grid) denser than kFarDensity of the volume's largest: there its 1 / r^2 peak
+// and turning directions need the march's own steps.
+bool near_dense_cells(const DenseGrid& density, float density_max, const MarchLight& light) {
+  const auto n = density.resolution();
+  const Vec3 h = density.cell_size();
+  std::array<int, 3> lo{}, hi{};
+  for (int e = 0; e < 3; ++e) {
+    const double u = (static_cast<double>(light.position[e]) - density.bounds().lo[e]) / h[e];
+    const double c = std::floor(std::clamp(u, -1e6, 1e6)), last = n[static_cast<size_t>(e)] - 1.0;
+    if (c + MarchSettings::kFarCells < 0.0 || c - MarchSettings::kFarCells > last) return false;  // no cell that near
+    lo[static_cast<size_t>(e)] = static_cast<int>(std::clamp(c - MarchSettings::kFarCells, 0.0, last));
+    hi[static_cast<size_t>(e)] = static_cast<int>(std::clamp(c + MarchSettings::kFarCells, 0.0, last));
+  }
+  const float dense = MarchSettings::kFarDensity * density_max;
+  for (int z = lo[2]; z <= hi[2]; ++z)
+    for (int y = lo[1]; y <= hi[1]; ++y)
+      for (int x = lo[0]; x <= hi[0]; ++x)
+        if (density.at(x, y, z) > dense) return true;
+  return false;
+}
+
 // The kernel's view of the volume and lights; false where it cannot take them (a tabulated phase
 // function, a sky light, emission).
 bool simd_volume(const Marcher& m, std::vector<MarchLight>& lights, MarchVolume& v) {
@@ -374,6 +396,71 @@ PackedLights pack_lights(const Scene& scene, const ExtinctionVolume& volume, con
   return packed;
 }
 
+double auto_step_cells(const Scene& scene, const ExtinctionVolume& volume, const std::vector<DenseGrid>& depths, const PackedLights& packed,
+                       int threads) {
+  const Vec3 h = volume.density.cell_size();
+  const double cell = std::min({h.x, h.y, h.z});
+  const Marcher marcher(scene, volume, depths, 0.5 * cell, threads, &packed, false);
+  std::vector<MarchLight> lights;
+  MarchVolume v;
+  if (!simd_volume(marcher, lights, v)) return kFinestAutoStep;
+  for (const MarchLight& light : lights)
+    if (light.type != MarchLight::directional && near_dense_cells(volume.density, packed.density_max, light)) return kFinestAutoStep;
+  // The probes: chords through the bounds along Fibonacci directions, each offset from the centre
+  // by a golden-angle spiral over the disc the bounds cover.
+  const Aabb& bounds = volume.density.bounds();
+  const Vec3 centre = 0.5 * (bounds.lo + bounds.hi);
+  const double radius = 0.5 * glm::length(bounds.hi - bounds.lo);
+  const DirectionSet directions = DirectionSet::fibonacci(kAutoStepProbes);
+  std::vector<Ray> rays;
+  std::vector<double> t0, t1;
+  for (int i = 0; i < kAutoStepProbes; ++i) {
+    const Vec3 w = directions[i];
+    const Vec3 a = glm::normalize(glm::cross(w, std::abs(w.x) < 0.9 ? Vec3(1.0, 0.0, 0.0) : Vec3(0.0, 1.0, 0.0))), b = glm::cross(w, a);
+    const double r = radius * std::sqrt((i + 0.5) / kAutoStepProbes), phi = 2.399963229728653 * i;  // the golden angle
+    const Ray ray{centre - 2.0 * radius * w + r * (std::cos(phi) * a + std::sin(phi) * b), w};
+    double a0 = 0.0, a1 = kInfinity;
+    if (bounds.clip(ray, a0, a1) && a1 > a0) rays.push_back(ray), t0.push_back(a0), t1.push_back(a1);
+  }
+  const size_t count = rays.size(), channels = static_cast<size_t>(v.channels);
+  if (count == 0) return kFinestAutoStep;
+  // Each candidate's L_in and T per probe and channel: rows of `count`, L then T.
+  const auto march = [&](double step) {
+    std::vector<float> in(9 * count), out(6 * count);
+    for (size_t i = 0; i < count; ++i) {
+      const int steps = std::max(1, static_cast<int>(std::ceil((t1[i] - t0[i]) / (step * cell))));
+      const double values[9] = {rays[i].origin.x, rays[i].origin.y, rays[i].origin.z, rays[i].direction.x, rays[i].direction.y, rays[i].direction.z,
+                                t0[i], (t1[i] - t0[i]) / steps, static_cast<double>(steps)};
+      for (size_t e = 0; e < 9; ++e) in[e * count + i] = static_cast<float>(values[e]);
+    }
+    const auto row = [&](std::vector<float>& buffer, size_t r) { return buffer.data() + r * count; };
+    march_rays(v, volume.phase, RayPacket{row(in, 0), row(in, 1), row(in, 2), row(in, 3), row(in, 4), row(in, 5), row(in, 6), row(in, 7), row(in, 8), count,
+                                          {row(out, 0), row(out, 1), row(out, 2)}, {row(out, 3), row(out, 4), row(out, 5)}});
+    return out;
+  };
+  const std::vector<float> finest = march(kFinestAutoStep);
+  // Relative RMS of L_in and of T over the probes and channels, the larger.
+  const auto error = [&](const std::vector<float>& got) {
+    double worst = 0.0;
+    for (size_t layer : {size_t(0), size_t(3)}) {
+      double d2 = 0.0, r2 = 0.0;
+      for (size_t c = 0; c < channels; ++c)
+        for (size_t i = 0; i < count; ++i) {
+          const double want = finest[(layer + c) * count + i], diff = static_cast<double>(got[(layer + c) * count + i]) - want;
+          d2 += diff * diff, r2 += want * want;
+        }
+      worst = std::max(worst, r2 > 0.0 ? std::sqrt(d2 / r2) : 0.0);
+    }
+    return worst;
+  };
+  double chosen = kFinestAutoStep;
+  for (double step : kAutoSteps) {  // the error grows with the step: the first beyond the tolerance ends the search
+    if (error(march(step)) > kAutoStepTolerance) break;
+    chosen = step;
+  }
+  return chosen;
+}
+
 bool march_distances(const Scene& scene, const ExtinctionVolume& volume, const std::vector<DenseGrid>& depths, const MarchSettings& settings,
                      const RenderOptions& options, const View& view, std::span<const double> distances, DistanceLayers out,
                      const PackedLights* packed, const MarchScattered* scattered) {
@@ -416,26 +503,10 @@ bool march_layers(const Scene& scene, const ExtinctionVolume& volume, const std:
     thread_local std::vector<MarchLight> far;
     thread_local std::vector<float> source;  // kept as `lights`
     far.clear();
-    const DenseGrid& density = volume.density;
-    const auto n = density.resolution();
-    const float dense = MarchSettings::kFarDensity * marcher.packed.density_max;
+    const auto n = volume.density.resolution();
+    // Spots and the point lights near dense cells stay in the steps.
     const auto stays = [&](const MarchLight& l) {
-      if (l.type == MarchLight::directional) return false;
-      if (l.type == MarchLight::spot) return true;
-      // The cells within kFarCells of the light's (clamped to the grid's), against kFarDensity.
-      std::array<int, 3> lo, hi;
-      for (size_t e = 0; e < 3; ++e) {
-        const double u = (static_cast<double>(l.position[e]) - density.bounds().lo[static_cast<int>(e)]) / h[static_cast<int>(e)];
-        const double c = std::floor(std::clamp(u, -1e6, 1e6));
-        lo[e] = static_cast<int>(std::clamp(c - MarchSettings::kFarCells, 0.0, n[e] - 1.0));
-        hi[e] = static_cast<int>(std::clamp(c + MarchSettings::kFarCells, 0.0, n[e] - 1.0));
-        if (c + MarchSettings::kFarCells < 0.0 || c - MarchSettings::kFarCells > n[e] - 1.0) return false;  // no cell that near
-      }
-      for (int z = lo[2]; z <= hi[2]; ++z)
-        for (int y = lo[1]; y <= hi[1]; ++y)
-          for (int x = lo[0]; x <= hi[0]; ++x)
-            if (density.at(x, y, z) > dense) return true;
-      return false;
+      return l.type == MarchLight::spot || (l.type == MarchLight::point && near_dense_cells(volume.density, marcher.packed.density_max, l));
     };
     size_t kept = 0;
     for (const MarchLight& l : lights) {
@@ -444,10 +515,10 @@ bool march_layers(const Scene& scene, const ExtinctionVolume& volume, const std:
     }
     lights.resize(kept);
     if (!far.empty()) {
-      source.resize(static_cast<size_t>(n[0] + 2) * static_cast<size_t>(n[1] + 2) * static_cast<size_t>(n[2] + 2) * static_cast<size_t>(simd_view.channels));
+      source.resize(static_cast<size_t>(n[0] + 2) * static_cast<size_t>(n[1] + 2) * static_cast<size_t>(n[2] + 2) * static_cast<size_t>(simd_view.channels + 1));
       const float at[3] = {static_cast<float>(eye.x), static_cast<float>(eye.y), static_cast<float>(eye.z)};
       march_toward_eye(simd_view, volume.phase, at, far.data(), static_cast<int>(far.size()), source.data(), options.threads);
-      simd_view.source = source.data(), simd_view.source_channels = simd_view.channels, simd_view.source_ghosts = true;
+      simd_view.folded = source.data();
       simd_view.lights = lights.data(), simd_view.light_count = static_cast<int>(lights.size());
     }
   }

@@ -22,21 +22,43 @@ namespace haze::grids::HWY_NAMESPACE {
 namespace hn = hwy::HWY_NAMESPACE;
 
 #if HWY_TARGET != HWY_SCALAR
-// The float pairs (base[o], base[o + 1]) at each lane's offset o into `first` and `second`: one
-// 64-bit gather per half vector, half the loads of two float gathers.
+// Lane offsets (in floats) as the two halves' byte offsets of 64-bit gathers.
+template <class D>
+struct PairOffsets {
+  hn::Vec<hn::RebindToSigned<hn::Repartition<double, D>>> lower, upper;
+};
 template <class D, class VI>
-HWY_INLINE void GatherPairs(D d, const float* HWY_RESTRICT base, VI offset, hn::Vec<D>& first, hn::Vec<D>& second) {
+HWY_INLINE PairOffsets<D> PairOffsetsOf(D, VI offset) {
   const hn::RebindToSigned<D> di;
   const hn::Half<decltype(di)> dih;
-  const hn::Repartition<double, D> dd;
-  const hn::RebindToSigned<decltype(dd)> di64;
+  const hn::RebindToSigned<hn::Repartition<double, D>> di64;
   const VI bytes = hn::ShiftLeft<2>(offset);
+  return {hn::PromoteTo(di64, hn::LowerHalf(dih, bytes)), hn::PromoteTo(di64, hn::UpperHalf(dih, bytes))};
+}
+// The float pairs (base[o], base[o + 1]) at each lane's offset o into `first` and `second`: one
+// 64-bit gather per half vector, half the loads of two float gathers.
+template <class D>
+HWY_INLINE void GatherPairsAt(D d, const float* HWY_RESTRICT base, const PairOffsets<D>& at, hn::Vec<D>& first, hn::Vec<D>& second) {
+  const hn::Repartition<double, D> dd;
   const double* pairs = reinterpret_cast<const double*>(base);  // read as 8-byte lanes, never as doubles
-  const hn::Vec<D> a = hn::BitCast(d, hn::GatherOffset(dd, pairs, hn::PromoteTo(di64, hn::LowerHalf(dih, bytes))));
-  const hn::Vec<D> b = hn::BitCast(d, hn::GatherOffset(dd, pairs, hn::PromoteTo(di64, hn::UpperHalf(dih, bytes))));
+  const hn::Vec<D> a = hn::BitCast(d, hn::GatherOffset(dd, pairs, at.lower));
+  const hn::Vec<D> b = hn::BitCast(d, hn::GatherOffset(dd, pairs, at.upper));
   first = hn::ConcatEven(d, b, a), second = hn::ConcatOdd(d, b, a);
 }
+template <class D, class VI>
+HWY_INLINE void GatherPairs(D d, const float* HWY_RESTRICT base, VI offset, hn::Vec<D>& first, hn::Vec<D>& second) {
+  GatherPairsAt(d, base, PairOffsetsOf(d, offset), first, second);
+}
 #endif
+
+// The packet's rays first .. first + lanes into buffer's rows (origin, direction, t0, dt, steps;
+// lanes past `last` repeat the last ray).
+template <size_t N>
+HWY_INLINE void LoadRays(const RayPacket& rays, size_t first, size_t last, size_t lanes, float (&buffer)[9][N]) {
+  const float* inputs[9] = {rays.ox, rays.oy, rays.oz, rays.dx, rays.dy, rays.dz, rays.t0, rays.dt, rays.steps};
+  for (int a = 0; a < 9; ++a)
+    for (size_t m = 0; m < lanes; ++m) buffer[a][m] = inputs[a][std::min(first + m, last)];
+}
 
 // One vector of rays starting at ray `first` (lanes past the end repeat the last ray), `C` channels.
 template <int C, class D>
@@ -47,9 +69,7 @@ HWY_INLINE void MarchVector(D d, const MarchVolume& v, const simd::PhaseParams& 
   using VI = hn::Vec<decltype(di)>;
   const size_t lanes = hn::Lanes(d);
   HWY_ALIGN float buffer[9][hn::MaxLanes(d)];
-  const float* inputs[9] = {rays.ox, rays.oy, rays.oz, rays.dx, rays.dy, rays.dz, rays.t0, rays.dt, rays.steps};
-  for (int a = 0; a < 9; ++a)
-    for (size_t m = 0; m < lanes; ++m) buffer[a][m] = inputs[a][std::min(first + m, last)];
+  LoadRays(rays, first, last, lanes, buffer);
   V o[3], dir[3];
   for (int e = 0; e < 3; ++e) o[e] = hn::Load(d, buffer[e]), dir[e] = hn::Load(d, buffer[3 + e]);
   const V t0 = hn::Load(d, buffer[6]), dt = hn::Load(d, buffer[7]), steps = hn::Load(d, buffer[8]);
@@ -57,8 +77,7 @@ HWY_INLINE void MarchVector(D d, const MarchVolume& v, const simd::PhaseParams& 
   V radiance[C], transmittance[C];
   for (int c = 0; c < C; ++c) radiance[c] = zero, transmittance[c] = one;
   const int stride[3] = {1, v.n[0], v.n[0] * v.n[1]};
-  const int ghosts = v.source_ghosts ? 2 : 0;  // a source plane's cells
-  const size_t cells = static_cast<size_t>(v.n[0] + ghosts) * static_cast<size_t>(v.n[1] + ghosts) * static_cast<size_t>(v.n[2] + ghosts);
+  const size_t cells = static_cast<size_t>(v.n[0]) * static_cast<size_t>(v.n[1]) * static_cast<size_t>(v.n[2]);  // a source plane's
   const int depth_stride = v.depth_stride > 0 ? v.depth_stride : v.light_count;
   // Grey extinction: one exponential for all channels.
   const float depth_0 = v.sigma_t[0] * v.depth_scale[0];
@@ -128,8 +147,8 @@ HWY_INLINE void MarchVector(D d, const MarchVolume& v, const simd::PhaseParams& 
     if (hn::AllFalse(d, active)) continue;
     V in[C], step_transmittance_0 = one;
     for (int c = 0; c < C; ++c) in[c] = zero;
-    // The lights' depths (v.outer) and the source (v.source_outer): the density's stencil, or one
-    // that keeps the slope into the outer half cells, per axis the cells p = clamp(floor(u), 0,
+    // The lights' depths and the source: the density's stencil, or with v.outer one that keeps the
+    // slope into the outer half cells, per axis the cells p = clamp(floor(u), 0,
     // n - 2) and p + 1 weighted by u - p unclamped (an axis of one cell: that cell).
     VI o_offset[8];
     V o_weight[8], o_x = zero;  // the outer stencil's x weight of cell p + 1
@@ -155,31 +174,15 @@ HWY_INLINE void MarchVector(D d, const MarchVolume& v, const simd::PhaseParams& 
     }
     const VI* f_offset = v.outer ? o_offset : offset;
     const V* f_weight = v.outer ? o_weight : weight;
-    // The source's stencil: the depths', or on the ghosted grid cells floor(u) + 1 and + 2 per axis
-    // at the density's weights (clamped only for lanes past their steps: u is in [-0.5, n - 0.5]
-    // inside the bounds).
-    VI g_offset[8];
-    if (v.source_ghosts) {
-      const int gx = v.n[0] + 2, gxy = gx * (v.n[1] + 2);
-      VI g[3];
-      for (int e = 0; e < 3; ++e) g[e] = hn::Min(hn::Max(hn::Add(hn::ConvertTo(di, hn::Floor(u[e])), hn::Set(di, 1)), hn::Zero(di)), hn::Set(di, v.n[e]));
-      const VI base = hn::Add(g[0], hn::Add(hn::Mul(g[1], hn::Set(di, gx)), hn::Mul(g[2], hn::Set(di, gxy))));
-      for (int m = 0; m < 8; ++m) g_offset[m] = hn::Add(base, hn::Set(di, (m & 1) + ((m >> 1) & 1) * gx + ((m >> 2) & 1) * gxy));
-    }
-    const VI* s_offset = v.source_ghosts ? g_offset : f_offset;
-    const V* s_weight = v.source_ghosts ? weight : f_weight;
 #if HWY_TARGET != HWY_SCALAR
     // The source's stencil in x pairs (pairs: x cells p and p + 1 on two cells or more): pair
     // offsets, y-z weights, x weights.
     VI s_pair_at[4];
     V s_yz[4], s_first = w_first, s_second = w_second;
-    if (pairs && v.source && v.source_ghosts) {
-      for (int e = 0; e < 4; ++e) s_pair_at[e] = g_offset[2 * e], s_yz[e] = yz[e];
-      s_first = hn::Sub(one, frac[0]), s_second = frac[0];
-    } else if (pairs && v.source && v.outer) {
+    if (pairs && v.source && v.outer) {
       for (int e = 0; e < 4; ++e) s_pair_at[e] = o_offset[2 * e], s_yz[e] = hn::Add(o_weight[2 * e], o_weight[2 * e + 1]);
       s_first = hn::Sub(one, o_x), s_second = o_x;
-    } else if (pairs) {
+    } else if (pairs && v.source) {
       for (int e = 0; e < 4; ++e) s_pair_at[e] = pair_at[e], s_yz[e] = yz[e];
     }
 #endif
@@ -232,11 +235,27 @@ HWY_INLINE void MarchVector(D d, const MarchVolume& v, const simd::PhaseParams& 
 #endif
         {
           source = zero;
-          for (int m = 0; m < 8; ++m) source = hn::MulAdd(s_weight[m], hn::GatherIndex(d, plane, s_offset[m]), source);
+          for (int m = 0; m < 8; ++m) source = hn::MulAdd(f_weight[m], hn::GatherIndex(d, plane, f_offset[m]), source);
         }
         source = hn::Max(source, zero);
       }
       in[c] = hn::Add(in[c], source);
+    }
+    // The lights folded in toward the eye: on the ghosted grid, cells floor(u) + 1 and + 2 per axis
+    // at the density's weights (clamped only for lanes past their steps: u is in [-0.5, n - 0.5]
+    // inside the bounds).
+    if (v.folded) {
+      const int gx = v.n[0] + 2, gxy = gx * (v.n[1] + 2), floats = C + 1;
+      VI g[3];
+      for (int e = 0; e < 3; ++e) g[e] = hn::Min(hn::Max(hn::Add(hn::ConvertTo(di, hn::Floor(u[e])), hn::Set(di, 1)), hn::Zero(di)), hn::Set(di, v.n[e]));
+      const VI base = hn::Mul(hn::Add(g[0], hn::Add(hn::Mul(g[1], hn::Set(di, gx)), hn::Mul(g[2], hn::Set(di, gxy)))), hn::Set(di, floats));
+      for (int c = 0; c < C; ++c) {
+        V folded = zero;
+        for (int m = 0; m < 8; ++m)
+          folded = hn::MulAdd(weight[m], hn::GatherIndex(d, v.folded + c, hn::Add(base, hn::Set(di, ((m & 1) + ((m >> 1) & 1) * gx + ((m >> 2) & 1) * gxy) * floats))),
+                              folded);
+        in[c] = hn::Add(in[c], hn::Max(folded, zero));
+      }
     }
     for (int c = 0; c < C; ++c) {
       const V step_transmittance = c > 0 && grey_steps ? step_transmittance_0 : hn::Exp(d, hn::Mul(hn::Set(d, -v.sigma_t[c]), hn::Mul(rho, dt)));
@@ -252,12 +271,95 @@ HWY_INLINE void MarchVector(D d, const MarchVolume& v, const simd::PhaseParams& 
   }
 }
 
+#if HWY_TARGET != HWY_SCALAR
+// MarchVector where every light is folded in toward the eye and none stays in the steps: the
+// density and L_in from the folded cells alone (MarchVolume::folded, C + 1 floats a cell), one
+// stencil on the ghosted grid, each (y, z) corner's two x cells read as 64-bit pairs (a cell's
+// channels two at a time), u stepped from the vector's start.
+template <int C, class D>
+HWY_INLINE void MarchFoldedVector(D d, const MarchVolume& v, const RayPacket& rays, size_t first, size_t last, float* HWY_RESTRICT radiance_out,
+                                  float* HWY_RESTRICT transmittance_out) {
+  using V = hn::Vec<D>;
+  const hn::RebindToSigned<D> di;
+  using VI = hn::Vec<decltype(di)>;
+  const size_t lanes = hn::Lanes(d);
+  HWY_ALIGN float buffer[9][hn::MaxLanes(d)];
+  LoadRays(rays, first, last, lanes, buffer);
+  const V zero = hn::Zero(d), one = hn::Set(d, 1.0f), half = hn::Set(d, 0.5f);
+  const V t0 = hn::Load(d, buffer[6]), dt = hn::Load(d, buffer[7]), steps = hn::Load(d, buffer[8]);
+  // u(s) = u_start + s du: the point in cells (0 at the first cell's centre) at step s's midpoint.
+  V u_start[3], du[3];
+  for (int e = 0; e < 3; ++e) {
+    const V o = hn::Load(d, buffer[e]), dir = hn::Load(d, buffer[3 + e]), inv_h = hn::Set(d, 1.0f / v.h[e]);
+    u_start[e] = hn::Sub(hn::Mul(hn::Sub(hn::MulAdd(hn::MulAdd(half, dt, t0), dir, o), hn::Set(d, v.lo[e])), inv_h), half);
+    du[e] = hn::Mul(hn::Mul(dt, dir), inv_h);
+  }
+  constexpr int kFloats = C + 1, kPairs = kFloats / 2;  // a cell's floats: the channels, then the density
+  const int gx = v.n[0] + 2, gxy = gx * (v.n[1] + 2);
+  const bool grey_steps = v.sigma_t[1] == v.sigma_t[0] && v.sigma_t[2] == v.sigma_t[0];
+  V radiance[C], transmittance[C];
+  for (int c = 0; c < C; ++c) radiance[c] = zero, transmittance[c] = one;
+  float max_steps = 0.0f;
+  for (size_t m = 0; m < lanes; ++m) max_steps = std::max(max_steps, buffer[8][m]);
+  const VI last_cell[3] = {hn::Set(di, v.n[0]), hn::Set(di, v.n[1]), hn::Set(di, v.n[2])};
+  for (int s = 0; s < static_cast<int>(max_steps); ++s) {
+    auto active = hn::Lt(hn::Set(d, static_cast<float>(s)), steps);
+    // Cells floor(u) + 1 and + 2 of the ghosted grid per axis (clamped only for lanes past their steps).
+    V frac[3];
+    VI g[3];
+    for (int e = 0; e < 3; ++e) {
+      const V u = hn::MulAdd(hn::Set(d, static_cast<float>(s)), du[e], u_start[e]), fl = hn::Floor(u);
+      frac[e] = hn::Sub(u, fl);
+      g[e] = hn::Min(hn::Max(hn::Add(hn::ConvertTo(di, fl), hn::Set(di, 1)), hn::Zero(di)), last_cell[e]);
+    }
+    const VI base = hn::Mul(hn::Add(g[0], hn::Add(hn::Mul(g[1], hn::Set(di, gx)), hn::Mul(g[2], hn::Set(di, gxy)))), hn::Set(di, kFloats));
+    const V y0 = hn::Sub(one, frac[1]), z0 = hn::Sub(one, frac[2]), x0 = hn::Sub(one, frac[0]);
+    const V yz[4] = {hn::Mul(y0, z0), hn::Mul(frac[1], z0), hn::Mul(y0, frac[2]), hn::Mul(frac[1], frac[2])};
+    V value[kFloats];  // trilinear: the channels, then the density
+    for (int k = 0; k < kFloats; ++k) value[k] = zero;
+    for (int e = 0; e < 4; ++e) {
+      const PairOffsets<D> at = PairOffsetsOf(d, hn::Add(base, hn::Set(di, ((e & 1) * gx + (e >> 1) * gxy) * kFloats)));
+      const V w0 = hn::Mul(yz[e], x0), w1 = hn::Mul(yz[e], frac[0]);
+      for (int k = 0; k < kPairs; ++k) {
+        V a, b, a1, b1;  // floats 2k and 2k + 1 of cells x and x + 1
+        GatherPairsAt(d, v.folded + 2 * k, at, a, b);
+        GatherPairsAt(d, v.folded + kFloats + 2 * k, at, a1, b1);
+        value[2 * k] = hn::MulAdd(w1, a1, hn::MulAdd(w0, a, value[2 * k]));
+        value[2 * k + 1] = hn::MulAdd(w1, b1, hn::MulAdd(w0, b, value[2 * k + 1]));
+      }
+    }
+    const V rho = value[C];
+    active = hn::And(active, hn::Gt(rho, zero));
+    if (hn::AllFalse(d, active)) continue;
+    V step_transmittance_0 = one;
+    for (int c = 0; c < C; ++c) {
+      const V step_transmittance = c > 0 && grey_steps ? step_transmittance_0 : hn::Exp(d, hn::Mul(hn::Set(d, -v.sigma_t[c]), hn::Mul(rho, dt)));
+      if (c == 0) step_transmittance_0 = step_transmittance;
+      const V scattered = hn::Mul(hn::Mul(transmittance[c], hn::Set(d, v.albedo[c])), hn::Mul(hn::Sub(one, step_transmittance), hn::Max(value[c], zero)));
+      radiance[c] = hn::Add(radiance[c], hn::IfThenElseZero(active, scattered));
+      transmittance[c] = hn::IfThenElse(active, hn::Mul(transmittance[c], step_transmittance), transmittance[c]);
+    }
+  }
+  for (int c = 0; c < C; ++c) {
+    hn::Store(radiance[c], d, radiance_out + c * lanes);
+    hn::Store(transmittance[c], d, transmittance_out + c * lanes);
+  }
+}
+#endif
+
 template <int C>
 HWY_INLINE void MarchAll(const MarchVolume& v, const simd::PhaseParams& phase, const RayPacket& rays) {
   const hn::ScalableTag<float> d;
   const size_t lanes = hn::Lanes(d);
   HWY_ALIGN float radiance[3 * hn::MaxLanes(d)], transmittance[3 * hn::MaxLanes(d)];
+#if HWY_TARGET != HWY_SCALAR
+  const bool folded = v.folded && v.light_count == 0 && !v.source;
+#endif
   for (size_t first = 0; first < rays.count; first += lanes) {
+#if HWY_TARGET != HWY_SCALAR
+    if (folded) MarchFoldedVector<C>(d, v, rays, first, rays.count - 1, radiance, transmittance);
+    else
+#endif
     MarchVector<C>(d, v, phase, rays, first, rays.count - 1, radiance, transmittance);
     const size_t n = std::min(lanes, rays.count - first);
     for (int c = 0; c < C; ++c) {

@@ -32,9 +32,10 @@ class PropagationSolution final : public GridSolution {
         march_(fields.march),
         depth_(fields.depth),
         resolution_(fields.resolution),
-        cutoff_(fields.cutoff) {
+        cutoff_(fields.cutoff),
+        auto_step_(fields.auto_step),
+        packed_(std::move(fields.packed)) {
     stats = std::move(fields.stats);
-    packed_ = pack_lights(scene_, volume_, depths_, depth_.threads);
   }
 
   RenderResult render(const View& view, const RenderOptions& options) const override {
@@ -65,6 +66,10 @@ class PropagationSolution final : public GridSolution {
     update_depths(scene, change.medium.has_value(), depth_, report);
     report.stats["propagate_seconds"] = watch.lap();
     packed_ = pack_lights(scene, volume_, depths_, options.threads);
+    if (auto_step_) {
+      march_.step_cells = step_cells_ = auto_step_cells(scene, volume_, depths_, packed_, options.threads);
+      report.stats["step_cells"] = step_cells_;
+    }
     scene_ = scene;
     return report;
   }
@@ -74,6 +79,7 @@ class PropagationSolution final : public GridSolution {
   DepthOptions depth_;
   int resolution_;
   double cutoff_;
+  bool auto_step_;  // setting step 0: chosen again after an update
   PackedLights packed_;  // the depths and the surfaces' shadows as the marcher reads them, made once per prepare or update
 };
 
@@ -94,6 +100,7 @@ PropagationFields propagation_fields(const Scene& scene, const RenderOptions& op
   depth.sweep_layers = static_cast<int>(settings.integer("sweep_layers"));
   depth.threads = options.threads;
   const double step_cells = settings.number("step");
+  if (step_cells > 0.0 && step_cells < 0.01) throw Error("method.step", to_text(step_cells), "0 (chosen for the medium) or a step in [0.01, 4] cells");
   const double cutoff = settings.number("cutoff");
   const bool surface_light = settings.integer("surface_light") != 0;
   settings.reject_unknown();
@@ -101,18 +108,24 @@ PropagationFields propagation_fields(const Scene& scene, const RenderOptions& op
   check_lights(scene.lights);
   Stopwatch watch;
   VolumeReport report;
-  PropagationFields fields{make_extinction_volume(scene, resolution, cutoff, options.threads, &report), {}, MarchSettings{step_cells, false, surface_light}, {}};
+  PropagationFields fields{make_extinction_volume(scene, resolution, cutoff, options.threads, &report), {}, MarchSettings{step_cells, false, surface_light}, {}, {}};
   const double inject_seconds = watch.lap();
   DepthStats depth_stats;
   check_depth_memory(fields.volume.density, scene.lights, options.max_memory);
   fields.depths = optical_depths(fields.volume.density, scene.lights, depth, &depth_stats);
+  const double propagate_seconds = watch.lap();
+  fields.packed = pack_lights(scene, fields.volume, fields.depths, options.threads);
+  fields.auto_step = step_cells == 0.0;
+  if (fields.auto_step) fields.march.step_cells = auto_step_cells(scene, fields.volume, fields.depths, fields.packed, options.threads);
   fields.stats = {{"cells", fields.volume.density.resolution()},
+                  {"step_cells", fields.march.step_cells},
                   {"optical_depth", name(depth.scheme)},
                   {"sweep_layers", depth.sweep_layers},
                   {"paper_iterations", depth.scheme == DepthScheme::paper ? depth_stats.iterations : 0},
                   {"truncation_bound", report.truncation_bound},
                   {"inject_seconds", inject_seconds},
-                  {"propagate_seconds", watch.seconds()}};
+                  {"propagate_seconds", propagate_seconds},
+                  {"step_seconds", watch.seconds()}};
   fields.resolution = resolution, fields.cutoff = cutoff, fields.depth = depth;
   return fields;
 }
@@ -127,7 +140,8 @@ MethodInfo propagation_info() {
   info.settings = {SettingInfo::integer("resolution", 64, 2, 1024, "cells along the longest side of the medium's bounds (RBF and constant)"),
                    SettingInfo::choice("optical_depth", name(DepthOptions{}.scheme), names_of<DepthScheme>(kDepthSchemes), "how the depth to each light is computed"),
                    SettingInfo::integer("sweep_layers", 4, 1, 64, "sweep: cell layers each short characteristic walks exactly"),
-                   SettingInfo::number("step", 0.5, 0.01, 4.0, "ray-march step in cells"),
+                   SettingInfo::number("step", 0.0, 0.0, 4.0,
+                                       "ray-march step in cells (0: chosen for the medium and lights, the longest of 0.5, 1, 2, 3 and 4 cells within 5e-4 of 0.5 cells' march over 256 chords; stats: step_cells)"),
                    SettingInfo::number("cutoff", 0.0, 0.0, 1e30, "RBF injection cutoff (0: 1e-4 of the largest weight)"),
                    SettingInfo::integer("surface_light", 0, 0, 1, "1: surfaces also receive the single-scattered light (64 directions, about 4x the render; not in the GL display)")};
   for (int resolution : {16, 32, 64, 96})

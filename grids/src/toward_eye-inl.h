@@ -57,17 +57,17 @@ HWY_INLINE void TowardEyeCells(D d, const MarchVolume& v, const simd::PhaseParam
   for (int c = 0; c < C; ++c) hn::StoreU(in[c], d, raw + static_cast<size_t>(c) * row_stride + static_cast<size_t>(x0));
 }
 
-// Planes [z0, z1) of the ghosted grid (n + 2 cells a side) into out (planes of its cells per
-// channel), through `window`: three raw planes (C channels of rows of `row_stride` floats, the
-// row's first and last cells continued linearly one float to each side, so that the second
-// difference across the ends is 0).
+// Planes [z0, z1) of the ghosted grid (n + 2 cells a side) into out (cells of C + 1 floats, the
+// channels then the density), through `window`: three raw planes (C channels of rows of
+// `row_stride` floats, the row's first and last cells continued linearly one float to each side,
+// so that the second difference across the ends is 0), then a row for the density.
 template <int C>
 HWY_INLINE void TowardEyeAll(const MarchVolume& v, const simd::PhaseParams& phase, const float* eye, const MarchLight* lights, int count, int z0,
                              int z1, float* HWY_RESTRICT out, float* HWY_RESTRICT window, size_t row_stride) {
   const hn::ScalableTag<float> d;
   const int nx = v.n[0] + 2, ny = v.n[1] + 2, nz = v.n[2] + 2;
   const size_t lanes = hn::Lanes(d), plane = static_cast<size_t>(ny) * C * row_stride;
-  const size_t cells = static_cast<size_t>(nx) * static_cast<size_t>(ny) * static_cast<size_t>(nz);
+  float* density_row = window + 3 * plane;
   const auto raw_plane = [&](int z) { return window + static_cast<size_t>(z % 3) * plane; };
   // raw row (y, channel c) of plane z: [c * row_stride + 1 ...] within row y's block
   const auto row = [&](int z, int y, int c) { return raw_plane(z) + (static_cast<size_t>(y) * C + static_cast<size_t>(c)) * row_stride; };
@@ -87,33 +87,36 @@ HWY_INLINE void TowardEyeAll(const MarchVolume& v, const simd::PhaseParams& phas
   const hn::Vec<decltype(d)> twelfth = hn::Set(d, 1.0f / 12.0f), two = hn::Set(d, 2.0f), zero = hn::Zero(d);
   for (int z = z0; z < z1; ++z) {
     if (z + 1 <= last) fill(z + 1);
-    for (int y = 0; y < ny; ++y)
-      for (int c = 0; c < C; ++c) {
-        const float* r = row(z, y, c) + 1;
-        const float* below = y > 0 ? row(z, y - 1, c) + 1 : nullptr;
-        const float* above = y + 1 < ny ? row(z, y + 1, c) + 1 : nullptr;
-        const float* front = z > 0 ? row(z - 1, y, c) + 1 : nullptr;
-        const float* back = z + 1 < nz ? row(z + 1, y, c) + 1 : nullptr;
-        float* o = out + static_cast<size_t>(c) * cells + (static_cast<size_t>(z) * ny + static_cast<size_t>(y)) * nx;
+    for (int y = 0; y < ny; ++y) {
+      // The density's row, each ghost the cell's beside it (the march's clamped read).
+      const int cy = std::clamp(y - 1, 0, v.n[1] - 1), cz = std::clamp(z - 1, 0, v.n[2] - 1);
+      const float* from = v.density + (static_cast<size_t>(cz) * static_cast<size_t>(v.n[1]) + static_cast<size_t>(cy)) * static_cast<size_t>(v.n[0]);
+      float* rho = density_row;
+      rho[0] = from[0], rho[nx - 1] = from[v.n[0] - 1];
+      std::copy(from, from + v.n[0], rho + 1);
+      float* o = out + (static_cast<size_t>(z) * ny + static_cast<size_t>(y)) * nx * (C + 1);
+      for (int x = 0; x < nx; x += static_cast<int>(lanes)) {
         // f - (f_-x + f_+x + ... - 2 f per axis) / 12: the mean error of linear interpolation over a
         // cell, h^2 f'' / 12, taken back (an axis without both neighbours adds no term).
-        for (int x = 0; x < nx; x += static_cast<int>(lanes)) {
-          const auto f = hn::LoadU(d, r + x);
-          const auto f2 = hn::Mul(two, f);
+        hn::Vec<decltype(d)> value[C + 1];
+        for (int c = 0; c < C; ++c) {
+          const float* r = row(z, y, c) + 1;
+          const auto f = hn::LoadU(d, r + x), f2 = hn::Mul(two, f);
           auto second = hn::Sub(hn::Add(hn::LoadU(d, r + x - 1), hn::LoadU(d, r + x + 1)), f2);
-          if (below && above) second = hn::Add(second, hn::Sub(hn::Add(hn::LoadU(d, below + x), hn::LoadU(d, above + x)), f2));
-          if (front && back) second = hn::Add(second, hn::Sub(hn::Add(hn::LoadU(d, front + x), hn::LoadU(d, back + x)), f2));
-          const auto value = hn::Max(hn::NegMulAdd(twelfth, second, f), zero);
-          const size_t n = std::min(lanes, static_cast<size_t>(nx - x));
-          if (n == lanes) {
-            hn::StoreU(value, d, o + x);
-          } else {
-            HWY_ALIGN float tail[hn::MaxLanes(d)];
-            hn::Store(value, d, tail);
-            std::copy(tail, tail + n, o + x);
-          }
+          if (y > 0 && y + 1 < ny) second = hn::Add(second, hn::Sub(hn::Add(hn::LoadU(d, row(z, y - 1, c) + 1 + x), hn::LoadU(d, row(z, y + 1, c) + 1 + x)), f2));
+          if (z > 0 && z + 1 < nz) second = hn::Add(second, hn::Sub(hn::Add(hn::LoadU(d, row(z - 1, y, c) + 1 + x), hn::LoadU(d, row(z + 1, y, c) + 1 + x)), f2));
+          value[c] = hn::Max(hn::NegMulAdd(twelfth, second, f), zero);
         }
+        value[C] = hn::LoadU(d, rho + x);
+        // Cells of C + 1 floats: the channels, then the density.
+        const size_t n = std::min(lanes, static_cast<size_t>(nx - x));
+        HWY_ALIGN float tail[(C + 1) * hn::MaxLanes(d)];
+        float* to = n == lanes ? o + static_cast<size_t>(x) * (C + 1) : tail;
+        if constexpr (C == 1) hn::StoreInterleaved2(value[0], value[1], d, to);
+        else hn::StoreInterleaved4(value[0], value[1], value[2], value[3], d, to);
+        if (n < lanes) std::copy(tail, tail + n * (C + 1), o + static_cast<size_t>(x) * (C + 1));
       }
+    }
   }
 }
 

@@ -28,14 +28,15 @@ void check(const MarchLight* lights, int count) {
 
 }  // namespace
 
-void march_toward_eye(const MarchVolume& v, const PhaseFunction& phase, const float eye[3], const MarchLight* lights, int count, float* out, int threads) {
+void march_toward_eye(const MarchVolume& v, const PhaseFunction& phase, const float eye[3], const MarchLight* lights, int count, float* out,
+                      int threads) {
   simd::PhaseParams p;
   if (!simd::params_for(phase, p)) throw Error("phase", phase.name(), "an analytic phase function for the SIMD marcher");
   check(lights, count);
   // The ghosted grid's rows (n + 2 cells), a pad to each side and a vector (of any target, 256
   // bytes at most) past the end.
   const size_t row_stride = static_cast<size_t>(v.n[0]) + 4 + 64;
-  const size_t window = 3 * static_cast<size_t>(v.n[1] + 2) * static_cast<size_t>(v.channels) * row_stride;
+  const size_t window = (3 * static_cast<size_t>(v.n[1] + 2) * static_cast<size_t>(v.channels) + 1) * row_stride;
   // Chunks of planes, each recomputing one raw plane to either side; enough of them for the threads.
   const long long grain = std::max(2, (v.n[2] + 2) / (4 * std::max(threads, 1)));
   parallel_for(v.n[2] + 2, threads, grain, [&](long long z0, long long z1) {
@@ -79,19 +80,25 @@ void march_toward_eye_reference(const MarchVolume& v, const PhaseFunction& phase
                 weight * static_cast<double>(light.intensity[c]) * std::exp(-static_cast<double>(v.sigma_t[c]) * static_cast<double>(v.depth_scale[c]) * depth);
         }
       }
-  out.assign(raw.size(), 0.0);
-  for (int c = 0; c < channels; ++c)
-    for (int z = 0; z < nz; ++z)
-      for (int y = 0; y < ny; ++y)
-        for (int x = 0; x < nx; ++x) {
+  const size_t floats = static_cast<size_t>(channels) + 1;  // a cell's: the channels, then the density
+  out.assign(cells * floats, 0.0);
+  for (int z = 0; z < nz; ++z)
+    for (int y = 0; y < ny; ++y)
+      for (int x = 0; x < nx; ++x) {
+        const size_t i = index(x, y, z);
+        for (int c = 0; c < channels; ++c) {
           const double* f = raw.data() + static_cast<size_t>(c) * cells;
-          const size_t i = index(x, y, z);
           double second = 0.0;
           if (x > 0 && x + 1 < nx) second += f[index(x - 1, y, z)] + f[index(x + 1, y, z)] - 2.0 * f[i];
           if (y > 0 && y + 1 < ny) second += f[index(x, y - 1, z)] + f[index(x, y + 1, z)] - 2.0 * f[i];
           if (z > 0 && z + 1 < nz) second += f[index(x, y, z - 1)] + f[index(x, y, z + 1)] - 2.0 * f[i];
-          out[static_cast<size_t>(c) * cells + i] = std::max(0.0, f[i] - second / 12.0);
+          out[i * floats + static_cast<size_t>(c)] = std::max(0.0, f[i] - second / 12.0);
         }
+        const auto clamped = [&](int j, int e) { return std::clamp(j - 1, 0, v.n[e] - 1); };
+        const size_t cell = (static_cast<size_t>(clamped(z, 2)) * static_cast<size_t>(v.n[1]) + static_cast<size_t>(clamped(y, 1))) * static_cast<size_t>(v.n[0]) +
+                            static_cast<size_t>(clamped(x, 0));
+        out[i * floats + static_cast<size_t>(channels)] = static_cast<double>(v.density[cell]);
+      }
 }
 
 }  // namespace haze::grids

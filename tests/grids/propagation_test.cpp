@@ -129,6 +129,34 @@ TEST(Propagation, StagesKeptApartGiveTheFullRendersResult) {
   EXPECT_EQ(render(from_file, "propagation").radiance.data(), render(scene, "propagation", options).radiance.data());
 }
 
+// Setting step 0 chooses the march's step (auto_step_cells): the frame benchmark's smooth RBF
+// cloud (lights outside it) takes a longer step than 0.5 cells and its image stays within the
+// probes' 5e-4 of 0.5 cells'; the test cloud with a light inside it and a grid of cell-sized white
+// noise keep 0.5 cells.
+TEST(Propagation, ChosenStepStaysWithinItsToleranceOfHalfCells) {
+  register_methods();
+  Scene scene = Scene::load(std::string(HAZE_SOURCE_DIR) + "/bench/frame/cloud_propagation.json");
+  scene.camera.width_px = 96, scene.camera.height_px = 54;
+  RenderOptions chosen, half;
+  chosen.settings = {{"resolution", 64}};
+  half.settings = {{"resolution", 64}, {"step", 0.5}};
+  const RenderResult a = render(scene, "propagation", chosen), b = render(scene, "propagation", half);
+  const double step = a.stats["step_cells"].get<double>(), error = relative_rmse(a.radiance, b.radiance);
+  std::printf("chosen step %.1f cells: %.1e relative RMS from 0.5 cells'\n", step, error);
+  EXPECT_GT(step, 0.5);
+  EXPECT_LT(error, 5e-4);
+  EXPECT_EQ(b.stats["step_cells"].get<double>(), 0.5);
+
+  scene = cloud_scene(16, 12);  // a light inside the cloud
+  EXPECT_EQ(render(scene, "propagation", chosen).stats["step_cells"].get<double>(), 0.5);
+  std::vector<float> noise(24 * 24 * 24);
+  for (size_t i = 0; i < noise.size(); ++i) noise[i] = static_cast<float>((i * 2654435761u) % 1000) / 500.0f;
+  scene.medium->density = GridDensity{{24, 24, 24}, noise};
+  scene.medium->bounds = Aabb{Vec3(-0.6), Vec3(0.6)};
+  scene.lights = {DirectionalLight{glm::normalize(Vec3(0.3, -1.0, 0.2)), Rgb(1.0)}};
+  EXPECT_EQ(render(scene, "propagation", chosen).stats["step_cells"].get<double>(), 0.5);
+}
+
 TEST(Propagation, BadSettingsAndLightsAreRejected) {
   register_methods();
   Scene scene = cloud_scene(8, 8);
@@ -144,7 +172,7 @@ TEST(Propagation, BadSettingsAndLightsAreRejected) {
   };
   EXPECT_EQ(field_of({{"optical_depth", "fast"}}), "method.optical_depth");
   EXPECT_EQ(field_of({{"resolution", 0}}), "method.resolution");
-  EXPECT_EQ(field_of({{"step", 0}}), "method.step");
+  EXPECT_EQ(field_of({{"step", 0.005}}), "method.step");  // 0 chooses the step; 0.01 is the finest
   scene.lights.push_back(SkyLight{});
   EXPECT_EQ(field_of({}), "lights[2].type");
 }

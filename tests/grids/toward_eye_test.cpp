@@ -77,7 +77,7 @@ TEST_P(TowardEyeTargets, MatchesTheFloat64Reference) {
     const double eye64[3] = {0.3, 0.4, 3.2};
     const auto n = k.volume.density.resolution();
     const size_t cells = static_cast<size_t>(n[0] + 2) * static_cast<size_t>(n[1] + 2) * static_cast<size_t>(n[2] + 2);  // with the ghosts
-    std::vector<float> simd(cells * static_cast<size_t>(k.v.channels), -1.0f);
+    std::vector<float> simd(cells * static_cast<size_t>(k.v.channels + 1), -1.0f);  // and the density
     march_toward_eye(k.v, k.volume.phase, eye, k.lights.data(), 2, simd.data(), 2);
     std::vector<double> reference;
     march_toward_eye_reference(k.v, k.volume.phase, eye64, k.lights.data(), 2, reference);
@@ -95,7 +95,7 @@ TEST(TowardEye, SpotsAreLeftToTheMarch) {
   KernelView k(scene, 8);
   MarchLight spot;
   spot.type = MarchLight::spot;
-  std::vector<float> out(10 * 10 * 10 * 3);
+  std::vector<float> out(10 * 10 * 10 * 4);
   const float eye[3] = {0.0f, 0.0f, 3.0f};
   try {
     march_toward_eye(k.v, k.volume.phase, eye, &spot, 1, out.data(), 1);
@@ -108,7 +108,7 @@ TEST(TowardEye, SpotsAreLeftToTheMarch) {
 // The frame benchmark's cloud (bench/frame/cloud_propagation.json: 128^3 cells, four coloured
 // point lights 4 to 21 cells outside the bounds, all folded in) at 240 x 135: the layers with the
 // lights folded in toward the eye against every light's depth at every step, relative RMS of L_in
-// over the image (T does not change). Measured 3.0e-4, held to 4e-4. A bright light added 4.5
+// over the image (T the same but for float rounding). Measured 3.0e-4, held to 4e-4. A bright light added 4.5
 // cells above the cloud's top, where the density is 12% of its largest, stays in the steps (2.3e-4,
 // held to 4e-4); 8.5 cells above, it is folded in (5.1e-4, held to 1e-3).
 TEST(TowardEye, LayersWithinTheStepsOnTheFrameCloud) {
@@ -128,13 +128,39 @@ TEST(TowardEye, LayersWithinTheStepsOnTheFrameCloud) {
     settings.toward_eye = false;
     ASSERT_TRUE(march_layers(scene, volume, depths, settings, options, View{scene.camera},
                              {ImageSpan{steps.data(), w, h}, ImageSpan{t_steps.data(), w, h}, ImageSpan{}}));
-    double d2 = 0.0, r2 = 0.0;
-    for (size_t i = 0; i < folded.size(); ++i) d2 += std::pow(folded[i] - steps[i], 2.0), r2 += std::pow(steps[i], 2.0);
-    const double rms = std::sqrt(d2 / r2);
-    std::printf("toward the eye against the steps, a light %.1f cells above: L_in %.2e relative RMS\n", above, rms);
-    EXPECT_EQ(t_folded, t_steps);
+    const auto relative_rms = [](const std::vector<float>& got, const std::vector<float>& want) {
+      double d2 = 0.0, r2 = 0.0;
+      for (size_t i = 0; i < got.size(); ++i) d2 += std::pow(got[i] - want[i], 2.0), r2 += std::pow(want[i], 2.0);
+      return std::sqrt(d2 / r2);
+    };
+    const double rms = relative_rms(folded, steps), t_rms = relative_rms(t_folded, t_steps);
+    std::printf("toward the eye against the steps, a light %.1f cells above: L_in %.2e relative RMS, T %.1e\n", above, rms, t_rms);
+    EXPECT_LT(t_rms, 1e-6) << above;  // the same steps (float rounding apart)
     EXPECT_LT(rms, above == 8.0 ? 1e-3 : 4e-4) << above;
   }
+}
+
+// The frame benchmark's per-pixel layers as a frame takes them (the step auto_step_cells chooses,
+// the lights folded in) against the 0.5-cell march with every light in the steps (the images
+// before either; issue 51 holds them to 1e-3): measured 3.5e-4 relative RMS of L_in at 240 x 135.
+TEST(TowardEye, FrameLayersWithinTheIssuesBoundOfTheHalfCellSteps) {
+  Scene scene = Scene::load(std::string(HAZE_SOURCE_DIR) + "/bench/frame/cloud_propagation.json");
+  scene.camera.width_px = 240, scene.camera.height_px = 135;
+  const ExtinctionVolume volume = make_extinction_volume(scene, 128);
+  const std::vector<DenseGrid> depths = optical_depths(volume.density, scene.lights);
+  const PackedLights packed = pack_lights(scene, volume, depths, 0);
+  const int w = 240, h = 135;
+  std::vector<float> frame(3 * w * h), before(3 * w * h), t(3 * w * h);
+  MarchSettings settings;
+  settings.step_cells = auto_step_cells(scene, volume, depths, packed, 0);
+  ASSERT_TRUE(march_layers(scene, volume, depths, settings, {}, View{scene.camera}, {ImageSpan{frame.data(), w, h}, ImageSpan{t.data(), w, h}, ImageSpan{}}, &packed));
+  settings.step_cells = 0.5, settings.toward_eye = false;
+  ASSERT_TRUE(march_layers(scene, volume, depths, settings, {}, View{scene.camera}, {ImageSpan{before.data(), w, h}, ImageSpan{t.data(), w, h}, ImageSpan{}}, &packed));
+  double d2 = 0.0, r2 = 0.0;
+  for (size_t i = 0; i < frame.size(); ++i) d2 += std::pow(frame[i] - before[i], 2.0), r2 += std::pow(before[i], 2.0);
+  const double rms = std::sqrt(d2 / r2);
+  std::printf("the frame's layers against 0.5 cells with the lights in the steps: L_in %.2e relative RMS\n", rms);
+  EXPECT_LT(rms, 1e-3);
 }
 
 }  // namespace

@@ -40,18 +40,20 @@ struct MarchVolume {
   float sigma_t[3] = {1, 1, 1}, albedo[3] = {1, 1, 1};
   int channels = 3;  // 1 where sigma_t, albedo and every light are grey: channel 0 only
   // A radiance per cell added to L_in, trilinear like the density (planes of cells,
-  // [c * cells + cell], one channel for all or three; null: none): lights folded in toward one
-  // eye (march_toward_eye), or dom's scattered light from the moments; and the lights' depths
-  // attenuated by sigma_t times depth_scale (dom's delta-M scaled steps).
+  // [c * cells + cell], one channel for all or three; null: none): dom's scattered light from the
+  // moments, with the lights' depths attenuated by sigma_t times depth_scale (its delta-M scaled
+  // steps).
   const float* source = nullptr;
   int source_channels = 1;
   float depth_scale[3] = {1, 1, 1};
   // The depths and the source keep their slope into the outer half cells, clamped at 0 (dom's
   // gather), instead of the edge cells' values.
   bool outer = false;
-  // The source on the grid with one ghost cell around it (n + 2 cells a side; march_toward_eye's),
-  // read between the centres of the cells and the ghosts beside them in the outer half cells.
-  bool source_ghosts = false;
+  // The lights folded in toward an eye (march_toward_eye: cells of channels + 1 floats, the
+  // channels' L_in and the density, on the grid with one ghost cell around the volume's), added to
+  // L_in where given and read between the centres of the cells and the ghosts beside them in the
+  // outer half cells; with no light left in the steps, the density is read from it too.
+  const float* folded = nullptr;
 };
 
 struct RayPacket {
@@ -70,7 +72,8 @@ struct RayPacket {
 // the cell beside it, as the march's clamped reads have them; MarchVolume::source_ghosts),
 // prefiltered for trilinear reads: each cell less 1/12 of its second differences along the axes
 // (linear interpolation's mean error over a cell, h^2 f'' / 12, taken back), at least 0. Into
-// out[c * cells + cell], c < volume.channels, cells (n + 2)^3 of them, on the threads; each
+// out[cell * (channels + 1) + c], c < volume.channels, then the cell's density at c = channels
+// (a ghost's the cell's beside it; MarchVolume::folded), (n + 2)^3 cells, on the threads; each
 // worker's scratch (three planes) kept, so that a frame allocates nothing once it has grown.
 void march_toward_eye(const MarchVolume& volume, const PhaseFunction& phase, const float eye[3], const MarchLight* lights, int count, float* out,
                       int threads);
