@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <optional>
 
 namespace haze::grids {
@@ -276,6 +277,41 @@ void march_row_layers(const Marcher& m, const MarchVolume& v, const View& view, 
   }
 }
 
+// Row y's layers (march_layers) for a camera whose rays leave one eye, in a scene without surfaces
+// of Haze's own and no surface layer asked for: the rays made and clipped in float32 lanes
+// (march_row_packet), the kernel, the spans. Buffers per thread, kept.
+void march_row_layers_from(const Marcher& m, const MarchVolume& v, const View& view, const Vec3& eye, int y, LayerSpans out) {
+  const auto width = static_cast<size_t>(view.camera.width_px), padded = width + 64;  // whole vectors of any target
+  thread_local std::vector<float> packed, result, depth;
+  packed.resize(9 * padded), result.resize(6 * padded);
+  Vec3 a, b;
+  view.camera.row_frame(y + 0.5, a, b);
+  const Aabb& box = m.volume.density.bounds();
+  RowFrame frame{};
+  for (int e = 0; e < 3; ++e) {
+    frame.eye[e] = static_cast<float>(eye[e]), frame.a[e] = static_cast<float>(a[e]), frame.b[e] = static_cast<float>(b[e]);
+    frame.lo[e] = static_cast<float>(box.lo[e]), frame.hi[e] = static_cast<float>(box.hi[e]);
+  }
+  frame.step = static_cast<float>(m.step);
+  if (!view.depth.empty()) {
+    depth.assign(padded, std::numeric_limits<float>::infinity());
+    std::copy_n(view.depth.begin() + static_cast<std::ptrdiff_t>(static_cast<size_t>(y) * width), width, depth.begin());
+    frame.depth = depth.data();
+  }
+  const auto row = [&](std::vector<float>& buffer, size_t r) { return buffer.data() + r * padded; };
+  march_row_packet(frame, row(packed, 0), row(packed, 1), row(packed, 2), row(packed, 3), row(packed, 4), row(packed, 5), row(packed, 6), row(packed, 7),
+                   row(packed, 8), width);
+  march_rays(v, m.volume.phase, RayPacket{row(packed, 0), row(packed, 1), row(packed, 2), row(packed, 3), row(packed, 4), row(packed, 5), row(packed, 6),
+                                          row(packed, 7), row(packed, 8), width, {row(result, 0), row(result, 1), row(result, 2)},
+                                          {row(result, 3), row(result, 4), row(result, 5)}});
+  const size_t grey = v.channels == 1 ? 0 : 1;  // channel c's row: c times this
+  for (size_t x = 0; x < width; ++x) {
+    float* l = out.inscatter.pixel(static_cast<int>(x), y);
+    float* t = out.transmittance.pixel(static_cast<int>(x), y);
+    for (size_t c = 0; c < 3; ++c) l[c] = row(result, c * grey)[x], t[c] = row(result, 3 + c * grey)[x];
+  }
+}
+
 // Row y's stretches between consecutive distances, one packet, chained per ray (march_distances).
 // A stretch from distance d steps no finer than pitch d, the spacing of the view's rays there (a
 // froxel column's width: the froxels resolve no more across), unless a point or spot light lies
@@ -522,8 +558,13 @@ bool march_layers(const Scene& scene, const ExtinctionVolume& volume, const std:
       simd_view.lights = lights.data(), simd_view.light_count = static_cast<int>(lights.size());
     }
   }
+  Vec3 eye, a, b;
+  const bool from_eye = view.camera.eye(eye) && view.camera.row_frame(0.5, a, b) && scene.surfaces.empty() && !out.surface.data;
   const auto rows = [&](long long y0, long long y1) {
-    for (auto y = static_cast<int>(y0); y < y1; ++y) march_row_layers(marcher, simd_view, view, y, out);
+    for (auto y = static_cast<int>(y0); y < y1; ++y) {
+      if (from_eye) march_row_layers_from(marcher, simd_view, view, eye, y, out);
+      else march_row_layers(marcher, simd_view, view, y, out);
+    }
   };
   // A body of one reference: std::function keeps it without allocating.
   parallel_for(view.camera.height_px, options.threads, 1, [&rows](long long y0, long long y1) { rows(y0, y1); });

@@ -347,6 +347,41 @@ HWY_INLINE void MarchFoldedVector(D d, const MarchVolume& v, const RayPacket& ra
 }
 #endif
 
+// march_row_packet's lanes: pixels [x0, x0 + lanes) (the caller pads the rows to whole vectors).
+HWY_NOINLINE void RowPacket(const RowFrame& r, float* HWY_RESTRICT ox, float* HWY_RESTRICT oy, float* HWY_RESTRICT oz, float* HWY_RESTRICT dx,
+                            float* HWY_RESTRICT dy, float* HWY_RESTRICT dz, float* HWY_RESTRICT t0, float* HWY_RESTRICT dt, float* HWY_RESTRICT steps,
+                            size_t count) {
+  const hn::ScalableTag<float> d;
+  using V = hn::Vec<decltype(d)>;
+  const size_t lanes = hn::Lanes(d);
+  float* HWY_RESTRICT origin[3] = {ox, oy, oz};
+  float* HWY_RESTRICT direction[3] = {dx, dy, dz};
+  const V zero = hn::Zero(d), step = hn::Set(d, r.step), tiny = hn::Set(d, 1e-30f);
+  for (size_t x0 = 0; x0 < count; x0 += lanes) {
+    const V px = hn::Add(hn::ConvertTo(d, hn::Iota(hn::RebindToSigned<decltype(d)>(), static_cast<int>(x0))), hn::Set(d, 0.5f));
+    V w[3];
+    for (int e = 0; e < 3; ++e) w[e] = hn::MulAdd(hn::Set(d, r.b[e]), px, hn::Set(d, r.a[e]));
+    const V inv_length = hn::Div(hn::Set(d, 1.0f), hn::Sqrt(hn::MulAdd(w[0], w[0], hn::MulAdd(w[1], w[1], hn::Mul(w[2], w[2])))));
+    // The slabs (a zero component taken as 1e-30 of its sign: its planes at +-inf, never NaN).
+    V near = zero, far = hn::Set(d, 3.0e38f);
+    for (int e = 0; e < 3; ++e) {
+      w[e] = hn::Mul(w[e], inv_length);
+      const V safe = hn::IfThenElse(hn::Lt(hn::Abs(w[e]), tiny), hn::CopySign(tiny, w[e]), w[e]);
+      const V inv = hn::Div(hn::Set(d, 1.0f), safe);
+      const V a = hn::Mul(hn::Sub(hn::Set(d, r.lo[e]), hn::Set(d, r.eye[e])), inv), b = hn::Mul(hn::Sub(hn::Set(d, r.hi[e]), hn::Set(d, r.eye[e])), inv);
+      near = hn::Max(near, hn::Min(a, b)), far = hn::Min(far, hn::Max(a, b));
+      hn::StoreU(w[e], d, direction[e] + x0);
+      hn::StoreU(hn::Set(d, r.eye[e]), d, origin[e] + x0);
+    }
+    if (r.depth) far = hn::Min(far, hn::LoadU(d, r.depth + x0));
+    const auto inside = hn::Gt(far, near);
+    const V n = hn::IfThenElseZero(inside, hn::Max(hn::Ceil(hn::Div(hn::Sub(far, near), step)), hn::Set(d, 1.0f)));
+    hn::StoreU(hn::IfThenElseZero(inside, near), d, t0 + x0);
+    hn::StoreU(hn::IfThenElseZero(inside, hn::Div(hn::Sub(far, near), hn::Max(n, hn::Set(d, 1.0f)))), d, dt + x0);
+    hn::StoreU(n, d, steps + x0);
+  }
+}
+
 template <int C>
 HWY_INLINE void MarchAll(const MarchVolume& v, const simd::PhaseParams& phase, const RayPacket& rays) {
   const hn::ScalableTag<float> d;

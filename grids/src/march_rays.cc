@@ -13,6 +13,12 @@
 namespace haze::grids {
 
 HWY_EXPORT(MarchRays);
+HWY_EXPORT(RowPacket);
+
+void march_row_packet(const RowFrame& row, float* ox, float* oy, float* oz, float* dx, float* dy, float* dz, float* t0, float* dt, float* steps,
+                      size_t count) {
+  HWY_DYNAMIC_DISPATCH(RowPacket)(row, ox, oy, oz, dx, dy, dz, t0, dt, steps, count);
+}
 
 bool march_supported(const PhaseFunction& phase) {
   simd::PhaseParams p;

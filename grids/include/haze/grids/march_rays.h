@@ -81,6 +81,19 @@ void march_toward_eye(const MarchVolume& volume, const PhaseFunction& phase, con
 void march_toward_eye_reference(const MarchVolume& volume, const PhaseFunction& phase, const double eye[3], const MarchLight* lights, int count,
                                 std::vector<double>& out);
 
+// One image row of rays from one eye, pixel x's direction normalize(a + b (x + 0.5)) (Camera::
+// row_frame), clipped to the box [lo, hi] and to the host's depth (null: none), in steps of
+// `step`: packet.ox .. packet.steps for pixels [0, count) (steps 0 where the ray misses the box),
+// in float32 lanes. The SIMD kernels' own rows, without a float64 ray per pixel.
+struct RowFrame {
+  float eye[3], a[3], b[3];
+  float lo[3], hi[3];
+  float step;
+  const float* depth;  // the row's, or null
+};
+void march_row_packet(const RowFrame& row, float* ox, float* oy, float* oz, float* dx, float* dy, float* dz, float* t0, float* dt, float* steps,
+                      size_t count);
+
 // False for phase functions the kernel cannot evaluate (tabulated): use the float64 marcher.
 bool march_supported(const PhaseFunction& phase);
 void march_rays(const MarchVolume& volume, const PhaseFunction& phase, const RayPacket& rays);
