@@ -275,7 +275,8 @@ HWY_INLINE void MarchVector(D d, const MarchVolume& v, const simd::PhaseParams& 
 // MarchVector where every light is folded in toward the eye and none stays in the steps: the
 // density and L_in from the folded cells alone (MarchVolume::folded, C + 1 floats a cell), one
 // stencil on the ghosted grid, each (y, z) corner's two x cells read as 64-bit pairs (a cell's
-// channels two at a time), u stepped from the vector's start.
+// channels two at a time), u stepped from the vector's start; the vector ends where every lane's
+// transmittance is below 1e-4.
 template <int C, class D>
 HWY_INLINE void MarchFoldedVector(D d, const MarchVolume& v, const RayPacket& rays, size_t first, size_t last, float* HWY_RESTRICT radiance_out,
                                   float* HWY_RESTRICT transmittance_out) {
@@ -295,6 +296,7 @@ HWY_INLINE void MarchFoldedVector(D d, const MarchVolume& v, const RayPacket& ra
     du[e] = hn::Mul(hn::Mul(dt, dir), inv_h);
   }
   constexpr int kFloats = C + 1, kPairs = kFloats / 2;  // a cell's floats: the channels, then the density
+  constexpr float kSpent = 1e-4f;
   const int gx = v.n[0] + 2, gxy = gx * (v.n[1] + 2);
   const bool grey_steps = v.sigma_t[1] == v.sigma_t[0] && v.sigma_t[2] == v.sigma_t[0];
   V radiance[C], transmittance[C];
@@ -331,6 +333,11 @@ HWY_INLINE void MarchFoldedVector(D d, const MarchVolume& v, const RayPacket& ra
     const V rho = value[C];
     active = hn::And(active, hn::Gt(rho, zero));
     if (hn::AllFalse(d, active)) continue;
+    // Every lane's light spent (T below kSpent in every channel): what the rest would add is at
+    // most kSpent of its light unattenuated.
+    V most = transmittance[0];
+    for (int c = 1; c < C; ++c) most = hn::Max(most, transmittance[c]);
+    if (hn::AllTrue(d, hn::Lt(most, hn::Set(d, kSpent)))) break;
     V step_transmittance_0 = one;
     for (int c = 0; c < C; ++c) {
       const V step_transmittance = c > 0 && grey_steps ? step_transmittance_0 : hn::Exp(d, hn::Mul(hn::Set(d, -v.sigma_t[c]), hn::Mul(rho, dt)));
