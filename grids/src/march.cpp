@@ -305,10 +305,16 @@ void march_row_layers_from(const Marcher& m, const MarchVolume& v, const View& v
                                           row(packed, 7), row(packed, 8), width, {row(result, 0), row(result, 1), row(result, 2)},
                                           {row(result, 3), row(result, 4), row(result, 5)}});
   const size_t grey = v.channels == 1 ? 0 : 1;  // channel c's row: c times this
-  for (size_t x = 0; x < width; ++x) {
-    float* l = out.inscatter.pixel(static_cast<int>(x), y);
-    float* t = out.transmittance.pixel(static_cast<int>(x), y);
-    for (size_t c = 0; c < 3; ++c) l[c] = row(result, c * grey)[x], t[c] = row(result, 3 + c * grey)[x];
+  for (const auto& [span, first] : {std::pair{out.inscatter, size_t(0)}, std::pair{out.transmittance, size_t(3)}}) {
+    const float *r = row(result, first), *g = row(result, first + grey), *b = row(result, first + 2 * grey);
+    if (span.channels == 3) {
+      march_interleave_rgb(r, g, b, width, span.pixel(0, y));
+    } else {  // RGBA: the fourth float left as it is
+      for (size_t x = 0; x < width; ++x) {
+        float* p = span.pixel(static_cast<int>(x), y);
+        p[0] = r[x], p[1] = g[x], p[2] = b[x];
+      }
+    }
   }
 }
 

@@ -389,6 +389,15 @@ HWY_NOINLINE void RowPacket(const RowFrame& r, float* HWY_RESTRICT ox, float* HW
   }
 }
 
+HWY_NOINLINE void InterleaveRgb(const float* HWY_RESTRICT r, const float* HWY_RESTRICT g, const float* HWY_RESTRICT b, size_t count,
+                                float* HWY_RESTRICT out) {
+  const hn::ScalableTag<float> d;
+  const size_t lanes = hn::Lanes(d);
+  size_t x = 0;
+  for (; x + lanes <= count; x += lanes) hn::StoreInterleaved3(hn::LoadU(d, r + x), hn::LoadU(d, g + x), hn::LoadU(d, b + x), d, out + 3 * x);
+  for (; x < count; ++x) out[3 * x] = r[x], out[3 * x + 1] = g[x], out[3 * x + 2] = b[x];
+}
+
 template <int C>
 HWY_INLINE void MarchAll(const MarchVolume& v, const simd::PhaseParams& phase, const RayPacket& rays) {
   const hn::ScalableTag<float> d;

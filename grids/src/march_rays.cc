@@ -14,6 +14,11 @@ namespace haze::grids {
 
 HWY_EXPORT(MarchRays);
 HWY_EXPORT(RowPacket);
+HWY_EXPORT(InterleaveRgb);
+
+void march_interleave_rgb(const float* r, const float* g, const float* b, size_t count, float* out) {
+  HWY_DYNAMIC_DISPATCH(InterleaveRgb)(r, g, b, count, out);
+}
 
 void march_row_packet(const RowFrame& row, float* ox, float* oy, float* oz, float* dx, float* dy, float* dz, float* t0, float* dt, float* steps,
                       size_t count) {

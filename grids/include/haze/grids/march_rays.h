@@ -94,6 +94,9 @@ struct RowFrame {
 void march_row_packet(const RowFrame& row, float* ox, float* oy, float* oz, float* dx, float* dy, float* dz, float* t0, float* dt, float* steps,
                       size_t count);
 
+// Three rows of `count` floats into RGB pixels, out[3 x + c] (the kernels' rows into a caller's span).
+void march_interleave_rgb(const float* r, const float* g, const float* b, size_t count, float* out);
+
 // False for phase functions the kernel cannot evaluate (tabulated): use the float64 marcher.
 bool march_supported(const PhaseFunction& phase);
 void march_rays(const MarchVolume& volume, const PhaseFunction& phase, const RayPacket& rays);
