@@ -277,6 +277,28 @@ void march_row_layers(const Marcher& m, const MarchVolume& v, const View& view, 
   }
 }
 
+// MarchSettings::toward_eye: the directional lights and the point lights not near dense cells
+// folded into `folded` toward `eye` (march_toward_eye) and taken out of `lights`, which v's
+// steps keep; nothing where no light folds.
+void fold_toward_eye(const Marcher& m, const Vec3& eye, std::vector<MarchLight>& lights, MarchVolume& v, std::vector<float>& folded, int threads) {
+  thread_local std::vector<MarchLight> far;  // kept, as the caller's
+  far.clear();
+  size_t kept = 0;
+  for (const MarchLight& l : lights) {
+    const bool stays = l.type == MarchLight::spot || (l.type == MarchLight::point && near_dense_cells(m.volume.density, m.packed.density_max, l));
+    if (stays) lights[kept++] = l;
+    else far.push_back(l);
+  }
+  lights.resize(kept);
+  if (far.empty()) return;
+  const auto n = m.volume.density.resolution();
+  folded.resize(static_cast<size_t>(n[0] + 2) * static_cast<size_t>(n[1] + 2) * static_cast<size_t>(n[2] + 2) * static_cast<size_t>(v.channels + 1));
+  const float at[3] = {static_cast<float>(eye.x), static_cast<float>(eye.y), static_cast<float>(eye.z)};
+  march_toward_eye(v, m.volume.phase, at, far.data(), static_cast<int>(far.size()), folded.data(), threads);
+  v.folded = folded.data();
+  v.lights = lights.data(), v.light_count = static_cast<int>(lights.size());
+}
+
 // Row y's layers (march_layers) for a camera whose rays leave one eye, in a scene without surfaces
 // of Haze's own and no surface layer asked for: the rays made and clipped in float32 lanes
 // (march_row_packet), the kernel, the spans. Buffers per thread, kept.
@@ -541,31 +563,11 @@ bool march_layers(const Scene& scene, const ExtinctionVolume& volume, const std:
   lights.clear();
   MarchVolume simd_view;
   if (settings.scalar || marcher.gather || !simd_volume(marcher, lights, simd_view)) return false;
-  if (Vec3 eye; settings.toward_eye && view.camera.eye(eye)) {
-    thread_local std::vector<MarchLight> far;
-    thread_local std::vector<float> source;  // kept as `lights`
-    far.clear();
-    const auto n = volume.density.resolution();
-    // Spots and the point lights near dense cells stay in the steps.
-    const auto stays = [&](const MarchLight& l) {
-      return l.type == MarchLight::spot || (l.type == MarchLight::point && near_dense_cells(volume.density, marcher.packed.density_max, l));
-    };
-    size_t kept = 0;
-    for (const MarchLight& l : lights) {
-      if (stays(l)) lights[kept++] = l;
-      else far.push_back(l);
-    }
-    lights.resize(kept);
-    if (!far.empty()) {
-      source.resize(static_cast<size_t>(n[0] + 2) * static_cast<size_t>(n[1] + 2) * static_cast<size_t>(n[2] + 2) * static_cast<size_t>(simd_view.channels + 1));
-      const float at[3] = {static_cast<float>(eye.x), static_cast<float>(eye.y), static_cast<float>(eye.z)};
-      march_toward_eye(simd_view, volume.phase, at, far.data(), static_cast<int>(far.size()), source.data(), options.threads);
-      simd_view.folded = source.data();
-      simd_view.lights = lights.data(), simd_view.light_count = static_cast<int>(lights.size());
-    }
-  }
   Vec3 eye, a, b;
-  const bool from_eye = view.camera.eye(eye) && view.camera.row_frame(0.5, a, b) && scene.surfaces.empty() && !out.surface.data;
+  const bool one_eye = view.camera.eye(eye);
+  thread_local std::vector<float> folded;  // kept as `lights`
+  if (one_eye && settings.toward_eye) fold_toward_eye(marcher, eye, lights, simd_view, folded, options.threads);
+  const bool from_eye = one_eye && view.camera.row_frame(0.5, a, b) && scene.surfaces.empty() && !out.surface.data;
   const auto rows = [&](long long y0, long long y1) {
     for (auto y = static_cast<int>(y0); y < y1; ++y) {
       if (from_eye) march_row_layers_from(marcher, simd_view, view, eye, y, out);
