@@ -280,7 +280,7 @@ void march_row_layers(const Marcher& m, const MarchVolume& v, const View& view, 
 // MarchSettings::toward_eye: the directional lights and the point lights not near dense cells
 // folded into `folded` toward `eye` (march_toward_eye) and taken out of `lights`, which v's
 // steps keep; nothing where no light folds.
-void fold_toward_eye(const Marcher& m, const Vec3& eye, std::vector<MarchLight>& lights, MarchVolume& v, std::vector<float>& folded, int threads) {
+void fold_toward_eye(const Marcher& m, const Vec3& eye, std::vector<MarchLight>& lights, MarchVolume& v, std::vector<uint32_t>& folded, int threads) {
   thread_local std::vector<MarchLight> far;  // kept, as the caller's
   far.clear();
   size_t kept = 0;
@@ -292,7 +292,24 @@ void fold_toward_eye(const Marcher& m, const Vec3& eye, std::vector<MarchLight>&
   lights.resize(kept);
   if (far.empty()) return;
   const auto n = m.volume.density.resolution();
-  folded.resize(static_cast<size_t>(n[0] + 2) * static_cast<size_t>(n[1] + 2) * static_cast<size_t>(n[2] + 2) * static_cast<size_t>(v.channels + 1));
+  folded.resize(static_cast<size_t>(n[0] + 2) * static_cast<size_t>(n[1] + 2) * static_cast<size_t>(n[2] + 2) * static_cast<size_t>(v.channels + 1) / 2);
+  // The float16 values' scales: a quarter of their range (the prefilter may double a peak) for the
+  // largest each can take, sum_l I_l max p E_l (E_l at most 1 / r^2 from the ghosted grid's box,
+  // r at least half a cell), and the largest density.
+  const Vec3 h = m.volume.density.cell_size();
+  const Aabb box{m.volume.density.bounds().lo - h, m.volume.density.bounds().hi + h};
+  const double peak = std::max(m.volume.phase.eval(1.0), m.volume.phase.eval(-1.0)), near = 0.5 * std::min({h.x, h.y, h.z});
+  double bound[3] = {0.0, 0.0, 0.0};
+  for (const MarchLight& l : far) {
+    double falloff = 1.0;
+    if (l.type == MarchLight::point) {
+      const Vec3 p(static_cast<double>(l.position[0]), static_cast<double>(l.position[1]), static_cast<double>(l.position[2]));
+      falloff = 1.0 / std::pow(std::max(glm::length(p - glm::clamp(p, box.lo, box.hi)), near), 2.0);
+    }
+    for (int c = 0; c < 3; ++c) bound[c] += static_cast<double>(l.intensity[c]) * peak * falloff;
+  }
+  for (int c = 0; c < 3; ++c) v.folded_scale[c] = bound[c] > 0.0 ? static_cast<float>(bound[c] / 16384.0) : 1.0f;
+  v.folded_scale[3] = m.packed.density_max > 0.0f ? m.packed.density_max / 16384.0f : 1.0f;
   const float at[3] = {static_cast<float>(eye.x), static_cast<float>(eye.y), static_cast<float>(eye.z)};
   march_toward_eye(v, m.volume.phase, at, far.data(), static_cast<int>(far.size()), folded.data(), threads);
   v.folded = folded.data();
@@ -565,7 +582,7 @@ bool march_layers(const Scene& scene, const ExtinctionVolume& volume, const std:
   if (settings.scalar || marcher.gather || !simd_volume(marcher, lights, simd_view)) return false;
   Vec3 eye, a, b;
   const bool one_eye = view.camera.eye(eye);
-  thread_local std::vector<float> folded;  // kept as `lights`
+  thread_local std::vector<uint32_t> folded;  // kept as `lights`
   if (one_eye && settings.toward_eye) fold_toward_eye(marcher, eye, lights, simd_view, folded, options.threads);
   const bool from_eye = one_eye && view.camera.row_frame(0.5, a, b) && scene.surfaces.empty() && !out.surface.data;
   const auto rows = [&](long long y0, long long y1) {

@@ -51,6 +51,18 @@ HWY_INLINE void GatherPairs(D d, const float* HWY_RESTRICT base, VI offset, hn::
 }
 #endif
 
+// A 32-bit word's low (kHigh 0) or high float16 half, 0 or normal as march_toward_eye writes them,
+// as a float32 2^-112 times its value (its bits moved into a float32's exponent and mantissa):
+// weights times kHalfUnit make products of normal floats.
+constexpr float kHalfUnit = 5.192296858534828e33f;  // 2^112
+template <int kHigh, class D>
+HWY_INLINE hn::Vec<D> HalfBits(D d, hn::Vec<hn::RebindToUnsigned<D>> word) {
+  const hn::RebindToUnsigned<D> du;
+  return hn::BitCast(d, kHigh ? hn::And(hn::ShiftRight<3>(word), hn::Set(du, 0x0FFFE000u)) : hn::ShiftLeft<13>(hn::And(word, hn::Set(du, 0x7FFFu))));
+}
+#if HWY_TARGET != HWY_SCALAR
+#endif
+
 // The packet's rays first .. first + lanes into buffer's rows (origin, direction, t0, dt, steps;
 // lanes past `last` repeat the last ray).
 template <size_t N>
@@ -245,16 +257,20 @@ HWY_INLINE void MarchVector(D d, const MarchVolume& v, const simd::PhaseParams& 
     // at the density's weights (clamped only for lanes past their steps: u is in [-0.5, n - 0.5]
     // inside the bounds).
     if (v.folded) {
-      const int gx = v.n[0] + 2, gxy = gx * (v.n[1] + 2), floats = C + 1;
+      const hn::RebindToUnsigned<D> du;
+      constexpr int kWords = (C + 1) / 2;
+      const int gx = v.n[0] + 2, gxy = gx * (v.n[1] + 2);
       VI g[3];
       for (int e = 0; e < 3; ++e) g[e] = hn::Min(hn::Max(hn::Add(hn::ConvertTo(di, hn::Floor(u[e])), hn::Set(di, 1)), hn::Zero(di)), hn::Set(di, v.n[e]));
-      const VI base = hn::Mul(hn::Add(g[0], hn::Add(hn::Mul(g[1], hn::Set(di, gx)), hn::Mul(g[2], hn::Set(di, gxy)))), hn::Set(di, floats));
+      const VI base = hn::Mul(hn::Add(g[0], hn::Add(hn::Mul(g[1], hn::Set(di, gx)), hn::Mul(g[2], hn::Set(di, gxy)))), hn::Set(di, kWords));
       for (int c = 0; c < C; ++c) {
         V folded = zero;
-        for (int m = 0; m < 8; ++m)
-          folded = hn::MulAdd(weight[m], hn::GatherIndex(d, v.folded + c, hn::Add(base, hn::Set(di, ((m & 1) + ((m >> 1) & 1) * gx + ((m >> 2) & 1) * gxy) * floats))),
-                              folded);
-        in[c] = hn::Add(in[c], hn::Max(folded, zero));
+        for (int m = 0; m < 8; ++m) {
+          const VI at = hn::Add(base, hn::Set(di, ((m & 1) + ((m >> 1) & 1) * gx + ((m >> 2) & 1) * gxy) * kWords + c / 2));
+          const auto word = hn::GatherIndex(du, v.folded, at);
+          folded = hn::MulAdd(hn::Mul(weight[m], hn::Set(d, kHalfUnit)), c % 2 ? HalfBits<1>(d, word) : HalfBits<0>(d, word), folded);
+        }
+        in[c] = hn::Add(in[c], hn::Max(hn::Mul(folded, hn::Set(d, v.folded_scale[c])), zero));
       }
     }
     for (int c = 0; c < C; ++c) {
@@ -273,9 +289,9 @@ HWY_INLINE void MarchVector(D d, const MarchVolume& v, const simd::PhaseParams& 
 
 #if HWY_TARGET != HWY_SCALAR
 // MarchVector where every light is folded in toward the eye and none stays in the steps: the
-// density and L_in from the folded cells alone (MarchVolume::folded, C + 1 floats a cell), one
-// stencil on the ghosted grid, each (y, z) corner's two x cells read as 64-bit pairs (a cell's
-// channels two at a time), u stepped from the vector's start; the vector ends where every lane's
+// density and L_in from the folded cells alone (MarchVolume::folded: a cell's C + 1 float16
+// values in one 64-bit word, or 32 where grey), one stencil on the ghosted grid, each (y, z)
+// corner's two x cells read as 64-bit gathers, u stepped from the vector's start; the vector ends where every lane's
 // transmittance is below 1e-4.
 template <int C, class D>
 HWY_INLINE void MarchFoldedVector(D d, const MarchVolume& v, const RayPacket& rays, size_t first, size_t last, float* HWY_RESTRICT radiance_out,
@@ -295,7 +311,7 @@ HWY_INLINE void MarchFoldedVector(D d, const MarchVolume& v, const RayPacket& ra
     u_start[e] = hn::Sub(hn::Mul(hn::Sub(hn::MulAdd(hn::MulAdd(half, dt, t0), dir, o), hn::Set(d, v.lo[e])), inv_h), half);
     du[e] = hn::Mul(hn::Mul(dt, dir), inv_h);
   }
-  constexpr int kFloats = C + 1, kPairs = kFloats / 2;  // a cell's floats: the channels, then the density
+  constexpr int kWords = (C + 1) / 2;  // a cell's: its C + 1 float16 values, the channels then the density
   constexpr float kSpent = 1e-4f;
   const int gx = v.n[0] + 2, gxy = gx * (v.n[1] + 2);
   const bool grey_steps = v.sigma_t[1] == v.sigma_t[0] && v.sigma_t[2] == v.sigma_t[0];
@@ -314,22 +330,34 @@ HWY_INLINE void MarchFoldedVector(D d, const MarchVolume& v, const RayPacket& ra
       frac[e] = hn::Sub(u, fl);
       g[e] = hn::Min(hn::Max(hn::Add(hn::ConvertTo(di, fl), hn::Set(di, 1)), hn::Zero(di)), last_cell[e]);
     }
-    const VI base = hn::Mul(hn::Add(g[0], hn::Add(hn::Mul(g[1], hn::Set(di, gx)), hn::Mul(g[2], hn::Set(di, gxy)))), hn::Set(di, kFloats));
+    const VI base = hn::Mul(hn::Add(g[0], hn::Add(hn::Mul(g[1], hn::Set(di, gx)), hn::Mul(g[2], hn::Set(di, gxy)))), hn::Set(di, kWords));
     const V y0 = hn::Sub(one, frac[1]), z0 = hn::Sub(one, frac[2]), x0 = hn::Sub(one, frac[0]);
     const V yz[4] = {hn::Mul(y0, z0), hn::Mul(frac[1], z0), hn::Mul(y0, frac[2]), hn::Mul(frac[1], frac[2])};
-    V value[kFloats];  // trilinear: the channels, then the density
-    for (int k = 0; k < kFloats; ++k) value[k] = zero;
+    const hn::RebindToUnsigned<D> du;
+    V value[C + 1];  // trilinear, times 2^-112: the channels, then the density
+    for (int k = 0; k <= C; ++k) value[k] = zero;
     for (int e = 0; e < 4; ++e) {
-      const PairOffsets<D> at = PairOffsetsOf(d, hn::Add(base, hn::Set(di, ((e & 1) * gx + (e >> 1) * gxy) * kFloats)));
-      const V w0 = hn::Mul(yz[e], x0), w1 = hn::Mul(yz[e], frac[0]);
-      for (int k = 0; k < kPairs; ++k) {
-        V a, b, a1, b1;  // floats 2k and 2k + 1 of cells x and x + 1
-        GatherPairsAt(d, v.folded + 2 * k, at, a, b);
-        GatherPairsAt(d, v.folded + kFloats + 2 * k, at, a1, b1);
-        value[2 * k] = hn::MulAdd(w1, a1, hn::MulAdd(w0, a, value[2 * k]));
-        value[2 * k + 1] = hn::MulAdd(w1, b1, hn::MulAdd(w0, b, value[2 * k + 1]));
+      const PairOffsets<D> at = PairOffsetsOf(d, hn::Add(base, hn::Set(di, ((e & 1) * gx + (e >> 1) * gxy) * kWords)));
+      const V w0 = hn::Mul(yz[e], hn::Mul(x0, hn::Set(d, kHalfUnit))), w1 = hn::Mul(yz[e], hn::Mul(frac[0], hn::Set(d, kHalfUnit)));
+      const float* words = reinterpret_cast<const float*>(v.folded);  // read as 8-byte lanes, bits kept
+      V a, b, a1, b1;
+      if constexpr (kWords == 1) {  // cells x and x + 1 side by side: [channel 0 | density] each
+        GatherPairsAt(d, words, at, a, a1);
+        b = a, b1 = a1;
+      } else {  // a cell's two words: [channel 0 | channel 1], [channel 2 | density]
+        GatherPairsAt(d, words, at, a, b);
+        GatherPairsAt(d, words + 2, at, a1, b1);
       }
+      const auto wa = hn::BitCast(du, a), wb = hn::BitCast(du, b), wa1 = hn::BitCast(du, a1), wb1 = hn::BitCast(du, b1);
+      value[0] = hn::MulAdd(w1, HalfBits<0>(d, wa1), hn::MulAdd(w0, HalfBits<0>(d, wa), value[0]));
+      if constexpr (C == 3) {
+        value[1] = hn::MulAdd(w1, HalfBits<1>(d, wa1), hn::MulAdd(w0, HalfBits<1>(d, wa), value[1]));
+        value[2] = hn::MulAdd(w1, HalfBits<0>(d, wb1), hn::MulAdd(w0, HalfBits<0>(d, wb), value[2]));
+      }
+      value[C] = hn::MulAdd(w1, HalfBits<1>(d, wb1), hn::MulAdd(w0, HalfBits<1>(d, wb), value[C]));
     }
+    for (int k = 0; k < C; ++k) value[k] = hn::Mul(value[k], hn::Set(d, v.folded_scale[k]));
+    value[C] = hn::Mul(value[C], hn::Set(d, v.folded_scale[3]));
     const V rho = value[C];
     active = hn::And(active, hn::Gt(rho, zero));
     if (hn::AllFalse(d, active)) continue;

@@ -57,13 +57,23 @@ HWY_INLINE void TowardEyeCells(D d, const MarchVolume& v, const simd::PhaseParam
   for (int c = 0; c < C; ++c) hn::StoreU(in[c], d, raw + static_cast<size_t>(c) * row_stride + static_cast<size_t>(x0));
 }
 
-// Planes [z0, z1) of the ghosted grid (n + 2 cells a side) into out (cells of C + 1 floats, the
-// channels then the density), through `window`: three raw planes (C channels of rows of
+// x (at least 0) as float16 bits in the low half of each 32-bit lane: at most 65504, and 0 below
+// 2^-14 (no subnormals: the march decodes by moving the bits into a float32's).
+template <class D>
+HWY_INLINE hn::Vec<hn::RebindToUnsigned<D>> Half(D d, hn::Vec<D> x) {
+  const hn::Rebind<hwy::float16_t, D> df16;
+  const hn::Rebind<uint16_t, D> du16;
+  const hn::Vec<D> kept = hn::IfThenZeroElse(hn::Lt(x, hn::Set(d, 6.103515625e-5f)), hn::Min(x, hn::Set(d, 65504.0f)));
+  return hn::PromoteTo(hn::RebindToUnsigned<D>(), hn::BitCast(du16, hn::DemoteTo(df16, kept)));
+}
+
+// Planes [z0, z1) of the ghosted grid (n + 2 cells a side) into out (cells of C + 1 float16
+// values, the channels then the density: MarchVolume::folded), through `window`: three raw planes (C channels of rows of
 // `row_stride` floats, the row's first and last cells continued linearly one float to each side,
 // so that the second difference across the ends is 0), then a row for the density.
 template <int C>
 HWY_INLINE void TowardEyeAll(const MarchVolume& v, const simd::PhaseParams& phase, const float* eye, const MarchLight* lights, int count, int z0,
-                             int z1, float* HWY_RESTRICT out, float* HWY_RESTRICT window, size_t row_stride) {
+                             int z1, uint32_t* HWY_RESTRICT out, float* HWY_RESTRICT window, size_t row_stride) {
   const hn::ScalableTag<float> d;
   const int nx = v.n[0] + 2, ny = v.n[1] + 2, nz = v.n[2] + 2;
   const size_t lanes = hn::Lanes(d), plane = static_cast<size_t>(ny) * C * row_stride;
@@ -85,6 +95,10 @@ HWY_INLINE void TowardEyeAll(const MarchVolume& v, const simd::PhaseParams& phas
   const int first = std::max(z0 - 1, 0), last = std::min(z1, nz - 1);
   for (int z = first; z <= last && z < z0 + 1; ++z) fill(z);  // the planes before z0's neighbour above
   const hn::Vec<decltype(d)> twelfth = hn::Set(d, 1.0f / 12.0f), two = hn::Set(d, 2.0f), zero = hn::Zero(d);
+  const hn::RebindToUnsigned<decltype(d)> du;
+  constexpr int kWords = (C + 1) / 2;  // a cell's: channels 0 and 1 (or channel 0 and the density), channel 2 and the density
+  float inv_scale[4];
+  for (int k = 0; k < 4; ++k) inv_scale[k] = 1.0f / v.folded_scale[C == 1 && k == 1 ? 3 : k];
   for (int z = z0; z < z1; ++z) {
     if (z + 1 <= last) fill(z + 1);
     for (int y = 0; y < ny; ++y) {
@@ -94,7 +108,7 @@ HWY_INLINE void TowardEyeAll(const MarchVolume& v, const simd::PhaseParams& phas
       float* rho = density_row;
       rho[0] = from[0], rho[nx - 1] = from[v.n[0] - 1];
       std::copy(from, from + v.n[0], rho + 1);
-      float* o = out + (static_cast<size_t>(z) * ny + static_cast<size_t>(y)) * nx * (C + 1);
+      uint32_t* o = out + (static_cast<size_t>(z) * ny + static_cast<size_t>(y)) * nx * kWords;
       for (int x = 0; x < nx; x += static_cast<int>(lanes)) {
         // f - (f_-x + f_+x + ... - 2 f per axis) / 12: the mean error of linear interpolation over a
         // cell, h^2 f'' / 12, taken back (an axis without both neighbours adds no term).
@@ -108,20 +122,25 @@ HWY_INLINE void TowardEyeAll(const MarchVolume& v, const simd::PhaseParams& phas
           value[c] = hn::Max(hn::NegMulAdd(twelfth, second, f), zero);
         }
         value[C] = hn::LoadU(d, rho + x);
-        // Cells of C + 1 floats: the channels, then the density.
+        // Cells of C + 1 float16 values over their scales, two to a 32-bit word (the channels, then
+        // the density).
+        hn::Vec<decltype(du)> word[kWords];
+        for (int k = 0; k < kWords; ++k)
+          word[k] = hn::Or(Half(d, hn::Mul(value[2 * k], hn::Set(d, inv_scale[2 * k]))),
+                           hn::ShiftLeft<16>(Half(d, hn::Mul(value[2 * k + 1], hn::Set(d, inv_scale[2 * k + 1])))));
         const size_t n = std::min(lanes, static_cast<size_t>(nx - x));
-        HWY_ALIGN float tail[(C + 1) * hn::MaxLanes(d)];
-        float* to = n == lanes ? o + static_cast<size_t>(x) * (C + 1) : tail;
-        if constexpr (C == 1) hn::StoreInterleaved2(value[0], value[1], d, to);
-        else hn::StoreInterleaved4(value[0], value[1], value[2], value[3], d, to);
-        if (n < lanes) std::copy(tail, tail + n * (C + 1), o + static_cast<size_t>(x) * (C + 1));
+        HWY_ALIGN uint32_t tail[kWords * hn::MaxLanes(d)];
+        uint32_t* to = n == lanes ? o + static_cast<size_t>(x) * kWords : tail;
+        if constexpr (kWords == 1) hn::StoreU(word[0], du, to);
+        else hn::StoreInterleaved2(word[0], word[1], du, to);
+        if (n < lanes) std::copy(tail, tail + n * kWords, o + static_cast<size_t>(x) * kWords);
       }
     }
   }
 }
 
 HWY_NOINLINE void TowardEye(const MarchVolume& v, const simd::PhaseParams& phase, const float* eye, const MarchLight* lights, int count, int z0, int z1,
-                            float* out, float* window, size_t row_stride) {
+                            uint32_t* out, float* window, size_t row_stride) {
   if (v.channels == 1) {
     TowardEyeAll<1>(v, phase, eye, lights, count, z0, z1, out, window, row_stride);
   } else {

@@ -28,7 +28,7 @@ void check(const MarchLight* lights, int count) {
 
 }  // namespace
 
-void march_toward_eye(const MarchVolume& v, const PhaseFunction& phase, const float eye[3], const MarchLight* lights, int count, float* out,
+void march_toward_eye(const MarchVolume& v, const PhaseFunction& phase, const float eye[3], const MarchLight* lights, int count, uint32_t* out,
                       int threads) {
   simd::PhaseParams p;
   if (!simd::params_for(phase, p)) throw Error("phase", phase.name(), "an analytic phase function for the SIMD marcher");

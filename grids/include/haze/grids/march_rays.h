@@ -12,6 +12,7 @@
 #include <haze/core/phase.h>
 
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
 #pragma GCC visibility push(default)  // the public API: exported from shared builds
@@ -49,11 +50,13 @@ struct MarchVolume {
   // The depths and the source keep their slope into the outer half cells, clamped at 0 (dom's
   // gather), instead of the edge cells' values.
   bool outer = false;
-  // The lights folded in toward an eye (march_toward_eye: cells of channels + 1 floats, the
-  // channels' L_in and the density, on the grid with one ghost cell around the volume's), added to
-  // L_in where given and read between the centres of the cells and the ghosts beside them in the
-  // outer half cells; with no light left in the steps, the density is read from it too.
-  const float* folded = nullptr;
+  // The lights folded in toward an eye (march_toward_eye: cells of channels + 1 float16 values,
+  // the channels' L_in and the density, each over its folded_scale, two to a 32-bit word, on the
+  // grid with one ghost cell around the volume's), added to L_in where given and read between the
+  // centres of the cells and the ghosts beside them in the outer half cells; with no light left in
+  // the steps, the density is read from it too. folded_scale: channels 0 to 2, then the density.
+  const uint32_t* folded = nullptr;
+  float folded_scale[4] = {1, 1, 1, 1};
 };
 
 struct RayPacket {
@@ -72,12 +75,14 @@ struct RayPacket {
 // the cell beside it, as the march's clamped reads have them; MarchVolume::source_ghosts),
 // prefiltered for trilinear reads: each cell less 1/12 of its second differences along the axes
 // (linear interpolation's mean error over a cell, h^2 f'' / 12, taken back), at least 0. Into
-// out[cell * (channels + 1) + c], c < volume.channels, then the cell's density at c = channels
-// (a ghost's the cell's beside it; MarchVolume::folded), (n + 2)^3 cells, on the threads; each
-// worker's scratch (three planes) kept, so that a frame allocates nothing once it has grown.
-void march_toward_eye(const MarchVolume& volume, const PhaseFunction& phase, const float eye[3], const MarchLight* lights, int count, float* out,
+// out (MarchVolume::folded's layout over volume.folded_scale: (channels + 1) / 2 words a cell,
+// the channels then the cell's density, a ghost's the cell's beside it; (n + 2)^3 cells; float16
+// values, 2^-11 relative, 0 below 2^-14 of their scale), on the threads; each worker's scratch
+// (three planes) kept, so that a frame allocates nothing once it has grown.
+void march_toward_eye(const MarchVolume& volume, const PhaseFunction& phase, const float eye[3], const MarchLight* lights, int count, uint32_t* out,
                       int threads);
-// Its float64 reference, one cell at a time (phase.eval, std::exp): the same layout.
+// Its float64 reference, one cell at a time (phase.eval, std::exp): out[cell * (channels + 1) + c],
+// the values themselves (no scale, no float16).
 void march_toward_eye_reference(const MarchVolume& volume, const PhaseFunction& phase, const double eye[3], const MarchLight* lights, int count,
                                 std::vector<double>& out);
 

@@ -77,11 +77,11 @@ struct MarchSettings {
   // march_layers (a frame's per-pixel layers) from one eye: the directional lights, and the point
   // lights with no cell within kFarCells cells of them denser than kFarDensity of the volume's
   // largest, folded into a radiance per cell toward the eye (march_toward_eye, made each frame),
-  // read trilinearly with the density instead of every light's depth at every step; spots and
-  // the other point lights stay in the steps (near a light the folded radiance's curvature is
-  // more than its prefilter takes back: 1.5e-3 of the image for a light 4.5 cells above a cloud's
-  // top). Within 4e-4 relative RMS of the steps' layers on the frame benchmark's cloud
-  // (tests/grids/toward_eye_test.cpp).
+  // read trilinearly with the density from float16 records instead of every light's depth at
+  // every step; spots and the other point lights stay in the steps (near a light the folded
+  // radiance's curvature is more than its prefilter takes back: 1.5e-3 of the image for a light
+  // 4.5 cells above a cloud's top). Within 4e-4 relative RMS of the steps' layers on the frame
+  // benchmark's cloud (tests/grids/toward_eye_test.cpp).
   bool toward_eye = true;
   static constexpr int kFarCells = 8;
   static constexpr float kFarDensity = 0.01f;
