@@ -5,8 +5,10 @@
 // Per ray, steps s < steps of length dt from t0, at the midpoints x:
 //   rho   = trilinear density, depth_l = trilinear optical depth to light l (cell-centred, clamped),
 //   L_in  = sum_l p(to_light_l . dir) E_l(x) V_l e^(-sigma_t depth_l)   (V_l trilinear visibility, or 1)
-//           + source(x)                                                  (trilinear, where given),
+//           + source(x) + folded(x)                                      (trilinear, where given),
 //   L    += T albedo (1 - e^(-sigma_t rho dt)) L_in,   T *= e^(-sigma_t rho dt)   (per channel).
+// The row's rays themselves from one eye (march_row_packet), and the lights folded in toward it
+// per cell (march_toward_eye), are here too.
 #pragma once
 
 #include <haze/core/phase.h>
@@ -72,7 +74,7 @@ struct RayPacket {
 //   S(cell) = sum_l p(to_light_l . w) E_l V_l e^(-sigma_t depth_scale depth_l),
 // for `count` point or directional lights (a spot's cone edge is left to the march; haze::Error),
 // on the grid with one ghost cell around the volume's (a ghost's depths and visibility those of
-// the cell beside it, as the march's clamped reads have them; MarchVolume::source_ghosts),
+// the cell beside it, as the march's clamped reads have them; MarchVolume::folded),
 // prefiltered for trilinear reads: each cell less 1/12 of its second differences along the axes
 // (linear interpolation's mean error over a cell, h^2 f'' / 12, taken back), at least 0. Into
 // out (MarchVolume::folded's layout over volume.folded_scale: (channels + 1) / 2 words a cell,
