@@ -216,6 +216,14 @@ bool simd_volume(const Marcher& m, std::vector<MarchLight>& lights, MarchVolume&
   return true;
 }
 
+// The kernel's packet over row-major buffers of `stride` floats a row: the nine inputs (origin,
+// direction, t0, dt, steps) in `in`'s rows, L_in then T per channel in `out`'s; `count` rays.
+RayPacket packet_of(std::vector<float>& in, std::vector<float>& out, size_t stride, size_t count) {
+  const auto row = [stride](std::vector<float>& buffer, size_t r) { return buffer.data() + r * stride; };
+  return {row(in, 0), row(in, 1), row(in, 2), row(in, 3), row(in, 4), row(in, 5), row(in, 6), row(in, 7), row(in, 8), count,
+          {row(out, 0), row(out, 1), row(out, 2)}, {row(out, 3), row(out, 4), row(out, 5)}};
+}
+
 // Row y's rays to their hits (a surface or the view's depth) through the SIMD kernel, into each
 // thread's kept buffers: L_in in result's rows 0 to 2 and T in rows 3 to 5 (rows of width floats;
 // row 0 and 3 alone when grey).
@@ -237,10 +245,7 @@ const RowMarch& march_row_rays(const Marcher& m, const MarchVolume& v, const Vie
                               r.rays[x].direction.z, s.t0, s.dt, static_cast<double>(s.count)};
     for (size_t a = 0; a < 9; ++a) r.in[a * width + x] = static_cast<float>(values[a]);
   }
-  auto row = [&](std::vector<float>& buffer, size_t a) { return buffer.data() + a * width; };
-  RayPacket packet{row(r.in, 0), row(r.in, 1), row(r.in, 2), row(r.in, 3), row(r.in, 4), row(r.in, 5), row(r.in, 6), row(r.in, 7), row(r.in, 8), width,
-                   {row(r.result, 0), row(r.result, 1), row(r.result, 2)}, {row(r.result, 3), row(r.result, 4), row(r.result, 5)}};
-  march_rays(v, m.volume.phase, packet);
+  march_rays(v, m.volume.phase, packet_of(r.in, r.result, width, width));
   return r;
 }
 
@@ -337,15 +342,12 @@ void march_row_layers_from(const Marcher& m, const MarchVolume& v, const View& v
     std::copy_n(view.depth.begin() + static_cast<std::ptrdiff_t>(static_cast<size_t>(y) * width), width, depth.begin());
     frame.depth = depth.data();
   }
-  const auto row = [&](std::vector<float>& buffer, size_t r) { return buffer.data() + r * padded; };
-  march_row_packet(frame, row(packed, 0), row(packed, 1), row(packed, 2), row(packed, 3), row(packed, 4), row(packed, 5), row(packed, 6), row(packed, 7),
-                   row(packed, 8), width);
-  march_rays(v, m.volume.phase, RayPacket{row(packed, 0), row(packed, 1), row(packed, 2), row(packed, 3), row(packed, 4), row(packed, 5), row(packed, 6),
-                                          row(packed, 7), row(packed, 8), width, {row(result, 0), row(result, 1), row(result, 2)},
-                                          {row(result, 3), row(result, 4), row(result, 5)}});
+  march_row_packet(frame, packed.data(), padded, width);
+  march_rays(v, m.volume.phase, packet_of(packed, result, padded, width));
+  const auto row = [&](size_t r) { return result.data() + r * padded; };
   const size_t grey = v.channels == 1 ? 0 : 1;  // channel c's row: c times this
   for (const auto& [span, first] : {std::pair{out.inscatter, size_t(0)}, std::pair{out.transmittance, size_t(3)}}) {
-    const float *r = row(result, first), *g = row(result, first + grey), *b = row(result, first + 2 * grey);
+    const float *r = row(first), *g = row(first + grey), *b = row(first + 2 * grey);
     if (span.channels == 3) {
       march_interleave_rgb(r, g, b, width, span.pixel(0, y));
     } else {  // RGBA: the fourth float left as it is
@@ -434,10 +436,8 @@ void march_row_distances(const Marcher& m, const MarchVolume& v, const View& vie
       for (size_t e = 0; e < 9; ++e) packed[e * count + i] = static_cast<float>(segment[e]);
       ++i;
     }
-  auto row = [&](std::vector<float>& buffer, size_t a) { return buffer.data() + a * count; };
-  RayPacket packet{row(packed, 0), row(packed, 1), row(packed, 2), row(packed, 3), row(packed, 4), row(packed, 5), row(packed, 6), row(packed, 7),
-                         row(packed, 8), count, {row(result, 0), row(result, 1), row(result, 2)}, {row(result, 3), row(result, 4), row(result, 5)}};
-  if (count > 0) march_rays(v, m.volume.phase, packet);
+  if (count > 0) march_rays(v, m.volume.phase, packet_of(packed, result, count, count));
+  const auto row = [&](std::vector<float>& buffer, size_t a) { return buffer.data() + a * count; };
   // Chained front to back: L(d_k) = L(d_k-1) + T(d_k-1) L_k, T(d_k) = T(d_k-1) T_k.
   l.assign(width, Vec3f(0.0f)), t.assign(width, Vec3f(1.0f));
   const size_t per_slice = width * static_cast<size_t>(camera.height_px), first = static_cast<size_t>(y) * width;
@@ -514,9 +514,7 @@ double auto_step_cells(const Scene& scene, const ExtinctionVolume& volume, const
                                 t0[i], (t1[i] - t0[i]) / steps, static_cast<double>(steps)};
       for (size_t e = 0; e < 9; ++e) in[e * count + i] = static_cast<float>(values[e]);
     }
-    const auto row = [&](std::vector<float>& buffer, size_t r) { return buffer.data() + r * count; };
-    march_rays(v, volume.phase, RayPacket{row(in, 0), row(in, 1), row(in, 2), row(in, 3), row(in, 4), row(in, 5), row(in, 6), row(in, 7), row(in, 8), count,
-                                          {row(out, 0), row(out, 1), row(out, 2)}, {row(out, 3), row(out, 4), row(out, 5)}});
+    march_rays(v, volume.phase, packet_of(in, out, count, count));
     return out;
   };
   const std::vector<float> finest = march(kFinestAutoStep);

@@ -291,8 +291,8 @@ HWY_INLINE void MarchVector(D d, const MarchVolume& v, const simd::PhaseParams& 
 // MarchVector where every light is folded in toward the eye and none stays in the steps: the
 // density and L_in from the folded cells alone (MarchVolume::folded: a cell's C + 1 float16
 // values in one 64-bit word, or 32 where grey), one stencil on the ghosted grid, each (y, z)
-// corner's two x cells read as 64-bit gathers, u stepped from the vector's start; the vector ends where every lane's
-// transmittance is below 1e-4.
+// corner's two x cells read as 64-bit gathers, u stepped from the vector's start; the vector
+// ends where every lane's transmittance is below 1e-4.
 template <int C, class D>
 HWY_INLINE void MarchFoldedVector(D d, const MarchVolume& v, const RayPacket& rays, size_t first, size_t last, float* HWY_RESTRICT radiance_out,
                                   float* HWY_RESTRICT transmittance_out) {
@@ -383,14 +383,15 @@ HWY_INLINE void MarchFoldedVector(D d, const MarchVolume& v, const RayPacket& ra
 #endif
 
 // march_row_packet's lanes: pixels [x0, x0 + lanes) (the caller pads the rows to whole vectors).
-HWY_NOINLINE void RowPacket(const RowFrame& r, float* HWY_RESTRICT ox, float* HWY_RESTRICT oy, float* HWY_RESTRICT oz, float* HWY_RESTRICT dx,
-                            float* HWY_RESTRICT dy, float* HWY_RESTRICT dz, float* HWY_RESTRICT t0, float* HWY_RESTRICT dt, float* HWY_RESTRICT steps,
-                            size_t count) {
+HWY_NOINLINE void RowPacket(const RowFrame& r, float* HWY_RESTRICT rows, size_t stride, size_t count) {
   const hn::ScalableTag<float> d;
   using V = hn::Vec<decltype(d)>;
   const size_t lanes = hn::Lanes(d);
-  float* HWY_RESTRICT origin[3] = {ox, oy, oz};
-  float* HWY_RESTRICT direction[3] = {dx, dy, dz};
+  float* HWY_RESTRICT origin[3] = {rows, rows + stride, rows + 2 * stride};
+  float* HWY_RESTRICT direction[3] = {rows + 3 * stride, rows + 4 * stride, rows + 5 * stride};
+  float* HWY_RESTRICT t0 = rows + 6 * stride;
+  float* HWY_RESTRICT dt = rows + 7 * stride;
+  float* HWY_RESTRICT steps = rows + 8 * stride;
   const V zero = hn::Zero(d), step = hn::Set(d, r.step), tiny = hn::Set(d, 1e-30f);
   for (size_t x0 = 0; x0 < count; x0 += lanes) {
     const V px = hn::Add(hn::ConvertTo(d, hn::Iota(hn::RebindToSigned<decltype(d)>(), static_cast<int>(x0))), hn::Set(d, 0.5f));

@@ -20,9 +20,8 @@ void march_interleave_rgb(const float* r, const float* g, const float* b, size_t
   HWY_DYNAMIC_DISPATCH(InterleaveRgb)(r, g, b, count, out);
 }
 
-void march_row_packet(const RowFrame& row, float* ox, float* oy, float* oz, float* dx, float* dy, float* dz, float* t0, float* dt, float* steps,
-                      size_t count) {
-  HWY_DYNAMIC_DISPATCH(RowPacket)(row, ox, oy, oz, dx, dy, dz, t0, dt, steps, count);
+void march_row_packet(const RowFrame& row, float* rows, size_t stride, size_t count) {
+  HWY_DYNAMIC_DISPATCH(RowPacket)(row, rows, stride, count);
 }
 
 bool march_supported(const PhaseFunction& phase) {

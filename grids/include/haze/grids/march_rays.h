@@ -90,16 +90,16 @@ void march_toward_eye_reference(const MarchVolume& volume, const PhaseFunction& 
 
 // One image row of rays from one eye, pixel x's direction normalize(a + b (x + 0.5)) (Camera::
 // row_frame), clipped to the box [lo, hi] and to the host's depth (null: none), in steps of
-// `step`: packet.ox .. packet.steps for pixels [0, count) (steps 0 where the ray misses the box),
-// in float32 lanes. The SIMD kernels' own rows, without a float64 ray per pixel.
+// `step`: into rows[r * stride + x] for pixels x < count, rows r = ox, oy, oz, dx, dy, dz, t0, dt,
+// steps (steps 0 where the ray misses the box; rows padded to whole vectors), in float32 lanes.
+// The SIMD kernel's own packet rows, without a float64 ray per pixel.
 struct RowFrame {
   float eye[3], a[3], b[3];
   float lo[3], hi[3];
   float step;
   const float* depth;  // the row's, or null
 };
-void march_row_packet(const RowFrame& row, float* ox, float* oy, float* oz, float* dx, float* dy, float* dz, float* t0, float* dt, float* steps,
-                      size_t count);
+void march_row_packet(const RowFrame& row, float* rows, size_t stride, size_t count);
 
 // Three rows of `count` floats into RGB pixels, out[3 x + c] (the kernels' rows into a caller's span).
 void march_interleave_rgb(const float* r, const float* g, const float* b, size_t count, float* out);
