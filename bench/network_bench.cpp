@@ -8,9 +8,11 @@
 // - Update: the next frame after a fraction of the particles moved (diameters given, as a
 //   simulation hands them over): update_network against solve_network over the new positions,
 //   both without iterating (the networks, the depth map and the direct light only).
+// - Render: a 512 x 512 image of the cloud (two suns and a sky, as the paper's figure 5), the
+//   splat (the paper's renderer) against the exact march.
 // Run: build/release/bench/haze_bench_network --benchmark_repetitions=3 --benchmark_report_aggregates_only=true
 // Counters: grind, seconds per particle (Field, LightMap), per particle and direction (Build), per particle,
-// direction and channel (Iteration), printed with SI prefixes (n: nanoseconds).
+// direction and channel (Iteration), per pixel (Render), printed with SI prefixes (n: nanoseconds).
 #include <haze/core/rng.h>
 #include <haze/particles/network.h>
 
@@ -137,8 +139,28 @@ void BM_Update(benchmark::State& state) {
   state.counters["direct%"] = 100.0 * static_cast<double>(u.direct) / n;
 }
 
+// Args: particles, pixels on a side, 1: splat, 0: march.
+void BM_Render(benchmark::State& state) {
+  const Cloud cloud(state.range(0));
+  const ParticleField field(cloud.view);
+  const std::vector<Light> lights{DirectionalLight{glm::normalize(Vec3(0.6, -0.7, -0.3)), Rgb(1.0)},
+                                  DirectionalLight{glm::normalize(Vec3(-0.5, 0.6, -0.4)), Rgb(0.6)}, SkyLight{Rgb(0.1, 0.15, 0.25)}};
+  NetworkSettings settings;
+  const NetworkSolution s = solve_network(field, lights, settings);
+  Scene scene;
+  scene.lights = lights;
+  scene.camera.position = Vec3(0.0, 0.5, 3.2), scene.camera.look_at = Vec3(0.0);
+  scene.camera.fov_y_deg = 45.0;
+  scene.camera.width_px = scene.camera.height_px = static_cast<int>(state.range(1));
+  const NetworkRender render = state.range(2) ? NetworkRender::splat : NetworkRender::march;
+  for (auto _ : state) benchmark::DoNotOptimize(render_network(scene, field, s, {}, render).data());
+  state.counters["grind"] = benchmark::Counter(static_cast<double>(state.range(1) * state.range(1)),
+                                                  benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+}
+
 }  // namespace
 
+BENCHMARK(BM_Render)->Args({1024, 512, 1})->Args({512, 512, 1})->Args({1024, 128, 0})->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_Field)->Arg(1024)->Arg(10000)->Arg(100000)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_Build)
     ->Args({1024, 128})

@@ -1,11 +1,14 @@
 // Internal: the pieces of the network that a full build (network.cpp) and an update of moved
-// particles (network_update.cpp) share.
+// particles (network_update.cpp) share, and what the renderer (network_render.cpp) hands its splat
+// (network_splat.cpp).
 #pragma once
 
 #include <haze/particles/network.h>
 
 #include <array>
 #include <cmath>
+#include <functional>
+#include <span>
 #include <utility>
 #include <vector>
 
@@ -63,5 +66,67 @@ void iterate(NetworkSolution& s, const NetworkSettings& settings);
 
 // What update_network compares the next frame against.
 void remember(NetworkSolution& s, const ParticleField& field, const std::vector<const Light*>& delta);
+
+// Camera::generate_ray inverted: the pixel position and footprint radius (pixels) of a sphere.
+struct FilmProjection {
+  const Camera& cam;
+  Vec3 forward = glm::normalize(cam.look_at - cam.position);
+  Vec3 right = glm::normalize(glm::cross(forward, cam.up));
+  Vec3 up = glm::cross(right, forward);
+  double aspect = static_cast<double>(cam.width_px) / cam.height_px;
+  double tan_half = std::tan(0.5 * cam.fov_y_deg * kPi / 180.0);
+
+  // False when the sphere of radius `extent` around x lies wholly behind a pinhole camera. A
+  // host's camera (matrices) is not binned: every particle covers the whole image.
+  bool operator()(const Vec3& x, double extent, double& px, double& py, double& radius) const {
+    if (cam.type == Camera::Type::matrices) {
+      px = 0.5 * cam.width_px, py = 0.5 * cam.height_px, radius = 2.0 * (cam.width_px + cam.height_px);
+      return true;
+    }
+    const Vec3 d = x - cam.position;
+    double scale;  // film units per world unit at x
+    if (cam.type == Camera::Type::orthographic) {
+      scale = 2.0 / cam.height;
+    } else {
+      const double z = glm::dot(d, forward);
+      if (z <= extent) {  // touching or behind the eye: cover the whole image
+        if (z < -extent) return false;
+        px = 0.5 * cam.width_px, py = 0.5 * cam.height_px, radius = 2.0 * (cam.width_px + cam.height_px);
+        return true;
+      }
+      scale = 1.0 / ((z - extent) * tan_half);
+    }
+    const double sx = glm::dot(d, right) * scale, sy = glm::dot(d, up) * scale;
+    px = (sx / aspect + 1.0) * 0.5 * cam.width_px;
+    py = (1.0 - sy) * 0.5 * cam.height_px;
+    radius = extent * scale * 0.5 * cam.height_px + 1.0;
+    return true;
+  }
+};
+
+
+// The splat's lattice: a node per this many of the narrowest footprint's width h in pixels (where
+// the image is interpolated between nodes; docs/NETWORKS.md gives the error).
+inline constexpr double kSplatNodesPerWidth = 3.0;
+
+// What render_network hands its splat.
+struct SplatInputs {
+  const Camera& camera;
+  const ParticleField& field;
+  const NetworkSolution& solution;
+  std::span<const Rgb> scattered;  // each particle's scattered light toward the eye (albedo J, emission)
+  std::function<Rgb(const Vec3& x, const Vec3& w)> direct;  // the single-scattered direct light toward w at x
+  double nearest;                  // LightDepthMap::arrival's
+  Rgb background;                  // behind the particles where nothing ends a ray
+  std::function<Vec3(const Vec3& x)> toward_eye;
+  // Per pixel: where its ray ends (its t_end: Haze's own surface or the host's depth, else inf) and
+  // the light leaving that end; empty where nothing ends any ray.
+  std::function<Rgb(int x, int y, const Ray& ray, double& t_end)> end_of;
+};
+
+// The splat of `front_to_back` (the particles by distance from the eye) into `result`, per pixel;
+// or, without ends, over a lattice of kSplatNodesPerWidth nodes to the narrowest footprint's width,
+// interpolated bilinearly.
+void splat_network(const SplatInputs& in, std::span<const uint32_t> front_to_back, RenderResult& result, const RenderOptions& options);
 
 }  // namespace haze::particles::network_internal

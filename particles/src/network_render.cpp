@@ -2,13 +2,20 @@
 #include <haze/core/error.h>
 #include <haze/core/stopwatch.h>
 #include <haze/particles/network.h>
+#include <haze/particles/splat.h>
 
 #include "erf_table.h"
+#include "network_internal.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 namespace haze::particles {
+
+using network_internal::FilmProjection;
+using network_internal::SplatInputs;
+using network_internal::splat_network;
 
 // The method's name, written once: the registry, its settings and its errors read it here.
 constexpr const char* kNetworkName = "network";
@@ -19,43 +26,6 @@ constexpr int kTile = 16;
 constexpr int kSurfaceDirections = 64;  // over the sphere: a surface point's hemisphere gets about half
 // The span of the phase matrix's raw row sums past which the network warns (docs/NETWORKS.md).
 constexpr double kRowSumRange[2] = {0.8, 1.25};
-
-// Camera::generate_ray inverted: the pixel position and footprint radius (pixels) of a sphere.
-struct Projection {
-  const Camera& cam;
-  Vec3 forward = glm::normalize(cam.look_at - cam.position);
-  Vec3 right = glm::normalize(glm::cross(forward, cam.up));
-  Vec3 up = glm::cross(right, forward);
-  double aspect = static_cast<double>(cam.width_px) / cam.height_px;
-  double tan_half = std::tan(0.5 * cam.fov_y_deg * kPi / 180.0);
-
-  // False when the sphere of radius `extent` around x lies wholly behind a pinhole camera. A
-  // host's camera (matrices) is not binned: every particle covers the whole image.
-  bool operator()(const Vec3& x, double extent, double& px, double& py, double& radius) const {
-    if (cam.type == Camera::Type::matrices) {
-      px = 0.5 * cam.width_px, py = 0.5 * cam.height_px, radius = 2.0 * (cam.width_px + cam.height_px);
-      return true;
-    }
-    const Vec3 d = x - cam.position;
-    double scale;  // film units per world unit at x
-    if (cam.type == Camera::Type::orthographic) {
-      scale = 2.0 / cam.height;
-    } else {
-      const double z = glm::dot(d, forward);
-      if (z <= extent) {  // touching or behind the eye: cover the whole image
-        if (z < -extent) return false;
-        px = 0.5 * cam.width_px, py = 0.5 * cam.height_px, radius = 2.0 * (cam.width_px + cam.height_px);
-        return true;
-      }
-      scale = 1.0 / ((z - extent) * tan_half);
-    }
-    const double sx = glm::dot(d, right) * scale, sy = glm::dot(d, up) * scale;
-    px = (sx / aspect + 1.0) * 0.5 * cam.width_px;
-    py = (1.0 - sy) * 0.5 * cam.height_px;
-    radius = extent * scale * 0.5 * cam.height_px + 1.0;
-    return true;
-  }
-};
 
 // A particle's Gaussian along a ray: rho(t) = amplitude / (sqrt(pi) h) exp(-(t - centre)^2 / h^2).
 struct Along {
@@ -115,14 +85,16 @@ Rgb march(std::vector<Along>& along, const Rgb& sigma_t, const std::vector<Rgb>&
   return radiance;
 }
 
+
 }  // namespace
 
-Image render_network(const Scene& scene, const ParticleField& field, const NetworkSolution& solution, const RenderOptions& options) {
-  return render_network(scene, field, solution, options, View{scene.camera}).radiance;
+Image render_network(const Scene& scene, const ParticleField& field, const NetworkSolution& solution, const RenderOptions& options,
+                     NetworkRender render) {
+  return render_network(scene, field, solution, options, View{scene.camera}, render).radiance;
 }
 
 RenderResult render_network(const Scene& scene, const ParticleField& field, const NetworkSolution& solution, const RenderOptions& options,
-                            const View& view) {
+                            const View& view, NetworkRender render) {
   const Camera& cam = view.camera;
   if (cam.type == Camera::Type::rays)
     throw Error("view.camera", "per-pixel rays", "a camera with one eye (pinhole, orthographic or matrices) for method network, whose "
@@ -131,6 +103,8 @@ RenderResult render_network(const Scene& scene, const ParticleField& field, cons
   const bool parallel = cam.type == Camera::Type::orthographic || (cam.type == Camera::Type::matrices && cam.projection[2][3] == 0.0);
   const Vec3 backward = cam.type == Camera::Type::matrices ? glm::normalize(Vec3(cam.view_inverse * glm::dvec4(0.0, 0.0, 1.0, 0.0)))
                                                            : glm::normalize(cam.position - cam.look_at);
+  Vec3 eye(0.0);
+  cam.eye(eye);  // false for parallel rays
   const MaterialDesc& material = field.particles().material;
   Rgb background = scene.background;
   size_t delta = 0;  // point, spot and directional lights
@@ -153,7 +127,7 @@ RenderResult render_network(const Scene& scene, const ParticleField& field, cons
   parallel_for(static_cast<long long>(n), options.threads, 64, [&](long long p0, long long p1) {
     for (auto p = static_cast<size_t>(p0); p < static_cast<size_t>(p1); ++p) {
       const Vec3 x = field.position(p);
-      const Vec3 w = parallel ? backward : glm::normalize(cam.position - x);
+      const Vec3 w = parallel ? backward : glm::normalize(eye - x);
       const Eigen::VectorXd row = solution.matrix->row(w);
       Rgb j(0.0);
       for (int c = 0; c < 3; ++c)
@@ -237,46 +211,69 @@ RenderResult render_network(const Scene& scene, const ParticleField& field, cons
     return s;
   };
 
-  // Particles binned to 16 x 16 tiles by their footprints (march() orders each ray's).
+  // Particles binned to 16 x 16 tiles by their footprints, each tile's front to back (by the
+  // distance to the eye, or along the view for parallel rays): the splat's order (march() orders
+  // each ray's itself).
   const int tiles_x = (cam.width_px + kTile - 1) / kTile, tiles_y = (cam.height_px + kTile - 1) / kTile;
-  std::vector<std::vector<int>> tiles(static_cast<size_t>(tiles_x) * static_cast<size_t>(tiles_y));
-  const Projection project{cam};
-  for (size_t p = 0; p < n; ++p) {
-    if (field.weight(p) <= 0.0) continue;
+  std::vector<std::vector<uint32_t>> tiles(static_cast<size_t>(tiles_x) * static_cast<size_t>(tiles_y));
+  std::vector<std::pair<double, uint32_t>> by_depth;
+  by_depth.reserve(n);
+  for (size_t p = 0; p < n; ++p)
+    if (field.weight(p) > 0.0) by_depth.emplace_back(parallel ? -glm::dot(field.position(p), backward) : glm::length(field.position(p) - eye), static_cast<uint32_t>(p));
+  std::sort(by_depth.begin(), by_depth.end());
+  const FilmProjection project{cam};
+  for (const auto& [depth, index] : by_depth) {
     double px, py, radius;
-    if (!project(field.position(p), kCut * field.h(p), px, py, radius)) continue;
+    if (!project(field.position(index), kCut * field.h(index), px, py, radius)) continue;
     const int x0 = std::max(0, static_cast<int>(std::floor((px - radius) / kTile))), x1 = std::min(tiles_x - 1, static_cast<int>(std::floor((px + radius) / kTile)));
     const int y0 = std::max(0, static_cast<int>(std::floor((py - radius) / kTile))), y1 = std::min(tiles_y - 1, static_cast<int>(std::floor((py + radius) / kTile)));
     for (int ty = y0; ty <= y1; ++ty)
-      for (int tx = x0; tx <= x1; ++tx) tiles[static_cast<size_t>(ty * tiles_x + tx)].push_back(static_cast<int>(p));
+      for (int tx = x0; tx <= x1; ++tx) tiles[static_cast<size_t>(ty * tiles_x + tx)].push_back(index);
   }
   RenderResult result = RenderResult::for_view(view);
+  // Where pixel (x, y)'s ray ends, and what leaves that end toward the camera.
+  const auto end_of = [&](int x, int y, const Ray& ray, double& t_hit, std::vector<Along>& gathered) {
+    t_hit = kInfinity;
+    Vec3 normal;
+    const Surface* surface = nearest_surface(scene.surfaces, ray, view.max_distance(x, y), t_hit, normal);
+    return surface ? surface_light(*surface, ray.at(t_hit), normal, -ray.direction, gathered)
+           : std::isinf(t_hit) ? background : Rgb(0.0);  // none behind a host's depth
+  };
+  if (render == NetworkRender::splat) {
+    SplatInputs in{cam, field, solution, scattered, direct, nearest, background, [&](const Vec3& x) { return parallel ? backward : glm::normalize(eye - x); }, {}};
+    if (!scene.surfaces.empty() || !view.depth.empty())
+      in.end_of = [&](int x, int y, const Ray& ray, double& t_end) {
+        thread_local std::vector<Along> gathered;
+        return end_of(x, y, ray, t_end, gathered);
+      };
+    std::vector<uint32_t> order(by_depth.size());
+    std::transform(by_depth.begin(), by_depth.end(), order.begin(), [](const auto& e) { return e.second; });
+    splat_network(in, order, result, options);
+    return result;
+  }
   ProgressTracker progress(options.progress, static_cast<long long>(tiles.size()));
   parallel_for(static_cast<long long>(tiles.size()), options.threads, 1, [&](long long t0, long long t1) {
     for (auto t = t0; t < t1 && !progress.cancelled(); ++t) {
-      const std::vector<int>& list = tiles[static_cast<size_t>(t)];
+      const std::vector<uint32_t>& list = tiles[static_cast<size_t>(t)];
       const int tx = static_cast<int>(t % tiles_x), ty = static_cast<int>(t / tiles_x);
       std::vector<Along> along, gathered;
       for (int y = ty * kTile; y < std::min(cam.height_px, (ty + 1) * kTile); ++y)
         for (int x = tx * kTile; x < std::min(cam.width_px, (tx + 1) * kTile); ++x) {
           const Ray ray = cam.pixel_ray(x, y);
-          double t_hit = kInfinity;
-          Vec3 normal;
-          const Surface* surface = nearest_surface(scene.surfaces, ray, view.max_distance(x, y), t_hit, normal);
+          double t_hit;
+          const Rgb leaving = end_of(x, y, ray, t_hit, gathered);
           along.clear();
-          for (const int index : list) {
-            const auto p = static_cast<size_t>(index);
+          for (const uint32_t index : list) {
+            const size_t p = index;
             const Vec3 o = field.position(p) - ray.origin;
             const double h = field.h(p), tc = glm::dot(o, ray.direction), perp2 = glm::dot(o, o) - tc * tc;
             if (perp2 >= kCut * kCut * h * h || tc < -kCut * h || tc - kCut * h >= t_hit) continue;
-            along.push_back({tc, h, field.weight(p) * std::exp(-perp2 / (h * h)) * std::sqrt(kPi) * h, index});
+            along.push_back({tc, h, field.weight(p) * std::exp(-perp2 / (h * h)) * std::sqrt(kPi) * h, static_cast<int>(index)});
           }
           Rgb transmittance(1.0);
           const Rgb radiance = march(
               along, material.sigma_t, scattered, [&](double t) { return direct(ray.origin + t * ray.direction, -ray.direction); }, transmittance,
               t_hit);
-          const Rgb leaving = surface ? surface_light(*surface, ray.at(t_hit), normal, -ray.direction, gathered)
-                              : std::isinf(t_hit) ? background : Rgb(0.0);  // none behind a host's depth
           result.set(x, y, {radiance, transmittance, leaving});
         }
       progress.advance();
@@ -291,8 +288,9 @@ namespace {
 // Prepared: the particle set, its field and the networks with the converged I.
 class NetworkMethodSolution final : public MethodSolution {
  public:
-  NetworkMethodSolution(const Scene& scene, ParticleSet set, int neighbours, const NetworkSettings& settings, const Emission& emission)
-      : scene_(scene), neighbours_(neighbours), settings_(settings) {
+  NetworkMethodSolution(const Scene& scene, ParticleSet set, int neighbours, const NetworkSettings& settings, NetworkRender render,
+                        const Emission& emission)
+      : scene_(scene), neighbours_(neighbours), settings_(settings), render_(render) {
     set_ = std::make_unique<ParticleSet>(std::move(set));
     field_ = std::make_unique<ParticleField>(set_->view(), neighbours_);
     solution_ = solve_network(*field_, scene_.lights, settings_, nullptr, scene_.surfaces, emission);
@@ -303,7 +301,7 @@ class NetworkMethodSolution final : public MethodSolution {
   RenderResult render(const View& view, const RenderOptions& options) const override {
     const Stopwatch watch;
     const Scene seen = view_scene(scene_, view.camera);
-    RenderResult result = render_network(seen, *field_, solution_, options, view);
+    RenderResult result = render_network(seen, *field_, solution_, options, view, render_);
     result.stats["render_seconds"] = watch.seconds();
     return result;
   }
@@ -372,6 +370,7 @@ class NetworkMethodSolution final : public MethodSolution {
   std::unique_ptr<ParticleSet> set_;
   std::unique_ptr<ParticleField> field_;  // views *set_
   NetworkSettings settings_;
+  NetworkRender render_;
   NetworkSolution solution_;
 };
 
@@ -388,6 +387,7 @@ class NetworkMethod final : public Method {
     if (network.terms > network.directions)
       throw Error("method.terms", to_text(network.terms), "at most method.directions (" + to_text(network.directions) + ")");
     const int neighbours = static_cast<int>(settings.integer("neighbours"));
+    const NetworkRender render = settings.choice("render") == "march" ? NetworkRender::march : NetworkRender::splat;
     network.threads = options.threads;
     network.max_memory = options.max_memory;
     settings.reject_unknown();
@@ -396,7 +396,7 @@ class NetworkMethod final : public Method {
     if (!particles)
       throw Error("particles", scene.medium ? "a `medium` instead" : "missing", "a particles block: method network renders particle sets only");
     network.progress = options.progress;
-    return std::make_unique<NetworkMethodSolution>(scene, particles->set(), neighbours, network, scene.medium->emission);
+    return std::make_unique<NetworkMethodSolution>(scene, particles->set(), neighbours, network, render, scene.medium->emission);
   }
 };
 
@@ -415,7 +415,8 @@ MethodInfo network_info() {
                    SettingInfo::integer("iterations", n.max_iterations, 0, 100000, "network iterations at most (0: single scattering)"),
                    SettingInfo::number("tolerance", n.tolerance, 1e-9, 1.0, "stop when an iteration changes I by less (relative L2)"),
                    SettingInfo::integer("terms", 0, 0, 4096, "eigenpairs of the phase matrix (0: those with |lambda| >= 0.01; D: full)"),
-                   SettingInfo::integer("neighbours", 8, 1, 64, "k of the k-th neighbour that sizes particles without diameters")};
+                   SettingInfo::integer("neighbours", 8, 1, 64, "k of the k-th neighbour that sizes particles without diameters"),
+                   SettingInfo::choice("render", "splat", {"splat", "march"}, "camera rays: the particles splatted front to back (the paper's), or the exact march through their Gaussians")};
   for (int directions : {32, 64, 128}) info.trade_sweep.push_back({{"directions", directions}});
   // Trade suite, particle_cloud: 5.5% at any D in 0.45 s.
   info.offer = [](const SceneFeatures& f, double tolerance) {

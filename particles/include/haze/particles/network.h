@@ -8,8 +8,8 @@
 // tracer solve the same medium; each iteration sweeps every direction's columns in upstream order
 // (light crosses the volume in one iteration, not one particle per iteration); direct light is
 // attenuated by the continuous density (light_depth.h), not binary visibility, and evaluated along
-// camera rays, not only at particle centres; splats are exact line integrals of
-// each particle's Gaussian along each pixel's ray.
+// camera rays by the exact march (NetworkRender), not only at particle centres; a splat's
+// opacity along each pixel's ray is the exact line integral of the particle's Gaussian.
 #pragma once
 
 #include <haze/core/directions.h>
@@ -147,16 +147,24 @@ double iterate_network(NetworkSolution& solution, int threads);
 NetworkSolution update_network(NetworkSolution previous, const ParticleField& field, const std::vector<Light>& lights,
                                const NetworkSettings& settings);
 
-// Camera rays through the particles' Gaussians, front to back: each particle scatters
-// albedo sum_d c_d(w) I[p, d] toward the eye in proportion to its Gaussian's optical depth along
-// the ray, and every step adds the single-scattered direct light at its middle from the depth maps
-// with the exact phase function; then the background (plus any sky) through what is left.
-// Surfaces are not drawn.
-Image render_network(const Scene& scene, const ParticleField& field, const NetworkSolution& solution, const RenderOptions& options = {});
+// How camera rays gather the particles' light (render_network):
+// - splat, the paper's (seed 001 section 3.4): each particle's radiance toward the eye (its
+//   scattered light and the direct light at its centre) composited front to back in the order of
+//   the particles' distances from the eye, with its opacity along each ray (splat.h);
+// - march: the formal solution through the overlapping Gaussians, front to back in steps of at most
+//   half the narrowest active width (each step's optical depth exact, its source the particles'
+//   radiance weighted by their share of it), the single-scattered direct light from the depth maps
+//   at every step's middle with the exact phase function.
+// Both add the background (plus any sky) through what is left; surfaces are lit as the method's
+// handles say. docs/NETWORKS.md gives both errors and costs.
+enum class NetworkRender { splat, march };
+
+Image render_network(const Scene& scene, const ParticleField& field, const NetworkSolution& solution, const RenderOptions& options = {},
+                     NetworkRender render = NetworkRender::splat);
 // The same for `view`: its camera (one eye: per-pixel rays are refused), its depth ending the
 // rays, and with view.layers L_in, T and C per pixel.
 RenderResult render_network(const Scene& scene, const ParticleField& field, const NetworkSolution& solution, const RenderOptions& options,
-                            const View& view);
+                            const View& view, NetworkRender render = NetworkRender::splat);
 
 // Method "network": its settings, what it handles and its auto rule.
 MethodInfo network_info();
