@@ -10,6 +10,9 @@
 //   both without iterating (the networks, the depth map and the direct light only).
 // - Render: a 512 x 512 image of the cloud (two suns and a sky, as the paper's figure 5), the
 //   splat (the paper's renderer) against the exact march.
+// - Frame: the paper's frame (section 4: "one iteration in each frame, and when the light sources
+//   move, we take the solution of the previous light position as the initial value"): both suns
+//   turned by a degree, update_network with one iteration, and the splat at 512 x 512.
 // Run: build/release/bench/haze_bench_network --benchmark_repetitions=3 --benchmark_report_aggregates_only=true
 // Counters: grind, seconds per particle (Field, LightMap), per particle and direction (Build), per particle,
 // direction and channel (Iteration), per pixel (Render), printed with SI prefixes (n: nanoseconds).
@@ -139,27 +142,57 @@ void BM_Update(benchmark::State& state) {
   state.counters["direct%"] = 100.0 * static_cast<double>(u.direct) / n;
 }
 
-// Args: particles, pixels on a side, 1: splat, 0: march.
-void BM_Render(benchmark::State& state) {
-  const Cloud cloud(state.range(0));
-  const ParticleField field(cloud.view);
-  const std::vector<Light> lights{DirectionalLight{glm::normalize(Vec3(0.6, -0.7, -0.3)), Rgb(1.0)},
-                                  DirectionalLight{glm::normalize(Vec3(-0.5, 0.6, -0.4)), Rgb(0.6)}, SkyLight{Rgb(0.1, 0.15, 0.25)}};
-  NetworkSettings settings;
-  const NetworkSolution s = solve_network(field, lights, settings);
+// Seed 001's figure 5: two suns (left-up and bottom-right) and a sky; turned by `degrees` about y.
+std::vector<Light> two_suns(double degrees) {
+  const double a = degrees * kPi / 180.0;
+  const auto turned = [&](const Vec3& v) { return glm::normalize(Vec3(std::cos(a) * v.x + std::sin(a) * v.z, v.y, -std::sin(a) * v.x + std::cos(a) * v.z)); };
+  return {DirectionalLight{turned(Vec3(0.6, -0.7, -0.3)), Rgb(1.0)}, DirectionalLight{turned(Vec3(-0.5, 0.6, -0.4)), Rgb(0.6)},
+          SkyLight{Rgb(0.1, 0.15, 0.25)}};
+}
+Scene framing(const std::vector<Light>& lights, int size) {
   Scene scene;
   scene.lights = lights;
   scene.camera.position = Vec3(0.0, 0.5, 3.2), scene.camera.look_at = Vec3(0.0);
   scene.camera.fov_y_deg = 45.0;
-  scene.camera.width_px = scene.camera.height_px = static_cast<int>(state.range(1));
+  scene.camera.width_px = scene.camera.height_px = size;
+  return scene;
+}
+
+// Args: particles, pixels on a side, 1: splat, 0: march.
+void BM_Render(benchmark::State& state) {
+  const Cloud cloud(state.range(0));
+  const ParticleField field(cloud.view);
+  const std::vector<Light> lights = two_suns(0.0);
+  NetworkSettings settings;
+  const NetworkSolution s = solve_network(field, lights, settings);
+  const Scene scene = framing(lights, static_cast<int>(state.range(1)));
   const NetworkRender render = state.range(2) ? NetworkRender::splat : NetworkRender::march;
   for (auto _ : state) benchmark::DoNotOptimize(render_network(scene, field, s, {}, render).data());
   state.counters["grind"] = benchmark::Counter(static_cast<double>(state.range(1) * state.range(1)),
                                                   benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
 }
 
+// Args: particles, pixels on a side.
+void BM_Frame(benchmark::State& state) {
+  const Cloud cloud(state.range(0));
+  const ParticleField field(cloud.view);
+  NetworkSettings settings;
+  NetworkSolution s = solve_network(field, two_suns(0.0), settings);
+  settings.max_iterations = 1;
+  double degrees = 0.0;
+  for (auto _ : state) {
+    degrees += 1.0;
+    const std::vector<Light> lights = two_suns(degrees);
+    s = update_network(std::move(s), field, lights, settings);
+    Scene scene = framing(lights, static_cast<int>(state.range(1)));
+    scene.camera.position = Vec3(3.2 * std::sin(degrees * kPi / 180.0), 0.5, 3.2 * std::cos(degrees * kPi / 180.0));
+    benchmark::DoNotOptimize(render_network(scene, field, s).data());
+  }
+}
+
 }  // namespace
 
+BENCHMARK(BM_Frame)->Args({1024, 512})->Args({512, 512})->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_Render)->Args({1024, 512, 1})->Args({512, 512, 1})->Args({1024, 128, 0})->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_Field)->Arg(1024)->Arg(10000)->Arg(100000)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_Build)

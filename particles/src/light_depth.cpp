@@ -170,6 +170,49 @@ bool LightDepthMap::arrival(const Vec3& x, const Rgb& sigma_t, double nearest, L
   return true;
 }
 
+// splat() for a directional light's parallel texel rays: the particle's depth t along them is the
+// same for every texel, so the depth nodes' erf terms are taken once, and exp(-perp^2 / h^2) is the
+// product of one factor per texel column and one per row.
+void LightDepthMap::splat_parallel(Face& f, const Vec3& x, double h, double w, int i0, int i1, int j0, int j1, float* tail) const {
+  const Vec3 local = x - origin_;
+  const double t = glm::dot(local, f.axis) + extent_, a = glm::dot(local, f.t1), b = glm::dot(local, f.t2);
+  if (t < -kCut * h || i0 > i1 || j0 > j1) return;
+  const ErfTable& erf = ErfTable::instance();
+  const auto k_count = static_cast<size_t>(nodes_);
+  const auto k0 = static_cast<size_t>(std::max(0.0, std::ceil((t - kCut * h - s0_) / ds_)));
+  const auto k1 = static_cast<size_t>(std::max(0.0, std::min(static_cast<double>(k_count) - 1.0, std::floor((t + kCut * h - s0_) / ds_)) + 1.0));  // past the last
+  const double before = erf(t / h);
+  thread_local std::vector<double> node, across, down;
+  std::vector<double>& nodes = node;
+  std::vector<double>& column = across;
+  std::vector<double>& row = down;
+  nodes.clear(), column.clear(), row.clear();
+  for (size_t k = k0; k < k1; ++k) nodes.push_back(erf((s0_ + static_cast<double>(k) * ds_ - t) / h) + before);
+  const double texel = 2.0 * extent_ / resolution_;
+  for (int i = i0; i <= i1; ++i) column.push_back((-extent_ + (i + 0.5) * texel - a) / h);
+  for (int j = j0; j <= j1; ++j) row.push_back((-extent_ + (j + 0.5) * texel - b) / h);
+  const double scale = w * h * 0.5 * std::sqrt(kPi);
+  const auto m = static_cast<size_t>(resolution_);
+  for (int j = j0; j <= j1; ++j) {
+    const double v = row[static_cast<size_t>(j - j0)];
+    for (int i = i0; i <= i1; ++i) {
+      const double u = column[static_cast<size_t>(i - i0)];
+      if (u * u + v * v >= kCut * kCut) continue;
+      const double amplitude = scale * std::exp(-(u * u + v * v));
+      const size_t texel_index = static_cast<size_t>(j) * m + static_cast<size_t>(i), base = texel_index * k_count;
+      for (size_t k = k0; k < k1; ++k) f.depth[base + k] += static_cast<float>(amplitude * nodes[k - k0]);
+      const auto whole = static_cast<float>(amplitude * (1.0 + before));
+      const size_t after = std::max(k0, k1);
+      if (tail) {
+        if (after < k_count) tail[base + after] += whole;
+      } else {
+        for (size_t k = after; k < k_count; ++k) f.depth[base + k] += whole;
+        f.touched[texel_index] = 1;
+      }
+    }
+  }
+}
+
 // Each particle adds, to every texel ray passing within 3 h of it, the integral of its Gaussian
 // from the ray's origin to each depth node: A (erf((s_k - t) / h) + erf(t / h)) with t the
 // particle's depth along the ray and A = w_p exp(-perp^2 / h^2) h sqrt(pi) / 2. Nodes past t + 3 h
@@ -219,7 +262,12 @@ void LightDepthMap::splat(Face& f, std::span<const Gaussian> gaussians, bool run
       const Footprint& fp = footprint[p];
       if (fp.i0 > fp.i1 || fp.j1 < r0 || fp.j0 >= r1) continue;
       const auto [x, h, w] = gaussians[p];
-      for (int j = std::max(fp.j0, static_cast<int>(r0)); j <= std::min(fp.j1, static_cast<int>(r1) - 1); ++j)
+      const int j_lo = std::max(fp.j0, static_cast<int>(r0)), j_hi = std::min(fp.j1, static_cast<int>(r1) - 1);
+      if (directional_) {
+        splat_parallel(f, x, h, w, fp.i0, fp.i1, j_lo, j_hi, running ? tail.data() : nullptr);
+        continue;
+      }
+      for (int j = j_lo; j <= j_hi; ++j)
         for (int i = fp.i0; i <= fp.i1; ++i) {
           Vec3 o, d;
           texel_ray(f, i, j, o, d);

@@ -73,6 +73,9 @@ class LightDepthMap {
   // Adds the Gaussians' line integrals to the face's nodes; `running` sums the part past each
   // Gaussian with one prefix sum over every texel (a whole map), else node by node (a few).
   void splat(Face& f, std::span<const Gaussian> gaussians, bool running, int threads);
+  // One Gaussian's part of splat() for a directional light, to the texels [i0, i1] x [j0, j1]; the
+  // whole Gaussian past its last node into `tail` (running), else into every node past it.
+  void splat_parallel(Face& f, const Vec3& x, double h, double w, int i0, int i1, int j0, int j1, float* tail) const;
 };
 
 }  // namespace haze::particles
