@@ -515,8 +515,8 @@ Command add_bench(CLI::App& app) {
   sub->add_option("--tolerances", a->tolerances, "The tolerances method auto is run at")->capture_default_str();
   sub->add_option("--scene", a->only, "Only these scenes of the suite (by file stem); the others' rows stay");
   sub->add_flag("--report-only", a->report_only, "Rewrite TRADEOFFS.md from the rows in --out, rendering nothing");
-  const Command frame = add_bench_frame(*bench);
-  return {bench, [a, frame] { return frame.sub->parsed() ? frame.run() : run(*a); }};
+  const Command frame = add_bench_frame(*bench), seeds = add_bench_seeds(*bench);
+  return {bench, [a, frame, seeds] { return frame.sub->parsed() ? frame.run() : seeds.sub->parsed() ? seeds.run() : run(*a); }};
 }
 
 }  // namespace haze::app

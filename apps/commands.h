@@ -28,6 +28,8 @@ Command add_tables(CLI::App& app);
 Command add_bench(CLI::App& app);
 // `haze bench frame` under `bench` (cmd_bench_frame.cpp).
 Command add_bench_frame(CLI::App& bench);
+// `haze bench seeds` under `bench` (cmd_bench_seeds.cpp).
+Command add_bench_seeds(CLI::App& bench);
 Command add_methods(CLI::App& app);
 // Every registered method and its settings, for help texts.
 std::string methods_help();
