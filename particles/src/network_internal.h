@@ -124,9 +124,12 @@ struct SplatInputs {
   std::function<Rgb(int x, int y, const Ray& ray, double& t_end)> end_of;
 };
 
-// The splat of `front_to_back` (the particles by distance from the eye) into `result`, per pixel;
+// Where a render hands each pixel's layers (x, y), threaded.
+using PixelSink = std::function<void(int, int, const PixelLayers&)>;
+
+// The splat of `front_to_back` (the particles by distance from the eye) into `sink`, per pixel;
 // or, without ends, over a lattice of kSplatNodesPerWidth nodes to the narrowest footprint's width,
-// interpolated bilinearly.
-void splat_network(const SplatInputs& in, std::span<const uint32_t> front_to_back, RenderResult& result, const RenderOptions& options);
+// interpolated bilinearly. Returns the lattice's step in pixels.
+int splat_network(const SplatInputs& in, std::span<const uint32_t> front_to_back, const PixelSink& sink, const RenderOptions& options);
 
 }  // namespace haze::particles::network_internal

@@ -14,6 +14,7 @@
 namespace haze::particles {
 
 using network_internal::FilmProjection;
+using network_internal::PixelSink;
 using network_internal::SplatInputs;
 using network_internal::splat_network;
 
@@ -88,13 +89,11 @@ Rgb march(std::vector<Along>& along, const Rgb& sigma_t, const std::vector<Rgb>&
 
 }  // namespace
 
-Image render_network(const Scene& scene, const ParticleField& field, const NetworkSolution& solution, const RenderOptions& options,
-                     NetworkRender render) {
-  return render_network(scene, field, solution, options, View{scene.camera}, render).radiance;
-}
+namespace {
 
-RenderResult render_network(const Scene& scene, const ParticleField& field, const NetworkSolution& solution, const RenderOptions& options,
-                            const View& view, NetworkRender render) {
+// render_network, each pixel's layers handed to `sink`; returns the render's stats.
+nlohmann::json render_into(const Scene& scene, const ParticleField& field, const NetworkSolution& solution, const RenderOptions& options,
+                           const View& view, NetworkRender render, const PixelSink& sink) {
   const Camera& cam = view.camera;
   if (cam.type == Camera::Type::rays)
     throw Error("view.camera", "per-pixel rays", "a camera with one eye (pinhole, orthographic or matrices) for method network, whose "
@@ -230,7 +229,6 @@ RenderResult render_network(const Scene& scene, const ParticleField& field, cons
     for (int ty = y0; ty <= y1; ++ty)
       for (int tx = x0; tx <= x1; ++tx) tiles[static_cast<size_t>(ty * tiles_x + tx)].push_back(index);
   }
-  RenderResult result = RenderResult::for_view(view);
   // Where pixel (x, y)'s ray ends, and what leaves that end toward the camera.
   const auto end_of = [&](int x, int y, const Ray& ray, double& t_hit, std::vector<Along>& gathered) {
     t_hit = kInfinity;
@@ -248,8 +246,7 @@ RenderResult render_network(const Scene& scene, const ParticleField& field, cons
       };
     std::vector<uint32_t> order(by_depth.size());
     std::transform(by_depth.begin(), by_depth.end(), order.begin(), [](const auto& e) { return e.second; });
-    splat_network(in, order, result, options);
-    return result;
+    return {{"splat_lattice", splat_network(in, order, sink, options)}};
   }
   ProgressTracker progress(options.progress, static_cast<long long>(tiles.size()));
   parallel_for(static_cast<long long>(tiles.size()), options.threads, 1, [&](long long t0, long long t1) {
@@ -274,12 +271,26 @@ RenderResult render_network(const Scene& scene, const ParticleField& field, cons
           const Rgb radiance = march(
               along, material.sigma_t, scattered, [&](double t) { return direct(ray.origin + t * ray.direction, -ray.direction); }, transmittance,
               t_hit);
-          result.set(x, y, {radiance, transmittance, leaving});
+          sink(x, y, {radiance, transmittance, leaving});
         }
       progress.advance();
     }
   });
   progress.throw_if_cancelled();
+  return nlohmann::json::object();
+}
+
+}  // namespace
+
+Image render_network(const Scene& scene, const ParticleField& field, const NetworkSolution& solution, const RenderOptions& options,
+                     NetworkRender render) {
+  return render_network(scene, field, solution, options, View{scene.camera}, render).radiance;
+}
+
+RenderResult render_network(const Scene& scene, const ParticleField& field, const NetworkSolution& solution, const RenderOptions& options,
+                            const View& view, NetworkRender render) {
+  RenderResult result = RenderResult::for_view(view);
+  result.stats = render_into(scene, field, solution, options, view, render, [&](int x, int y, const PixelLayers& p) { result.set(x, y, p); });
   return result;
 }
 
@@ -306,6 +317,20 @@ class NetworkMethodSolution final : public MethodSolution {
     return result;
   }
   bool renders_layers() const override { return true; }
+  // The splat's pixels straight into the caller's layers.
+  bool render_layers(const View& view, LayerSpans out, const RenderOptions& options) const override {
+    if (render_ != NetworkRender::splat) return false;
+    const Scene seen = view_scene(scene_, view.camera);
+    const auto put = [](const ImageSpan& span, int x, int y, const Rgb& v) {
+      float* p = span.pixel(x, y);
+      p[0] = static_cast<float>(v.r), p[1] = static_cast<float>(v.g), p[2] = static_cast<float>(v.b);
+    };
+    render_into(seen, *field_, solution_, options, view, render_, [&](int x, int y, const PixelLayers& p) {
+      put(out.inscatter, x, y, p.inscatter), put(out.transmittance, x, y, p.transmittance);
+      if (out.surface.data) put(out.surface, x, y, p.surface);
+    });
+    return true;
+  }
 
   // Moved particles (a new particle medium of the same count) and new lights: update_network,
   // which redoes only what the moved particles and lights reach, then iterates from the previous

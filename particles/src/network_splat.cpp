@@ -111,7 +111,7 @@ struct TileRays {
 
 }  // namespace
 
-void splat_network(const SplatInputs& in, std::span<const uint32_t> front_to_back, RenderResult& result, const RenderOptions& options) {
+int splat_network(const SplatInputs& in, std::span<const uint32_t> front_to_back, const PixelSink& sink, const RenderOptions& options) {
   const ParticleField& field = in.field;
   const MaterialDesc& material = field.particles().material;
   const Camera& cam = in.camera;
@@ -167,7 +167,6 @@ void splat_network(const SplatInputs& in, std::span<const uint32_t> front_to_bac
     if (std::isfinite(narrowest)) step = std::clamp(static_cast<int>(narrowest / kSplatNodesPerWidth), 1, std::max(cam.width_px, cam.height_px));
   }
   const Lattice lattice(step, cam.width_px, cam.height_px);
-  result.stats["splat_lattice"] = step;
   // Particles binned to tiles of nodes by their footprints, each tile's front to back.
   const int tiles_x = (lattice.nx + kTile - 1) / kTile, tiles_y = (lattice.ny + kTile - 1) / kTile;
   std::vector<std::vector<uint32_t>> tiles(static_cast<size_t>(tiles_x) * static_cast<size_t>(tiles_y));
@@ -209,7 +208,7 @@ void splat_network(const SplatInputs& in, std::span<const uint32_t> front_to_bac
           const size_t j = static_cast<size_t>((y - y0) * kTile + (x - x0));
           if (step == 1) {
             const Rgb leaving = in.end_of ? rays.leaving[j] : in.background;
-            result.set(x, y, {Rgb(rays.radiance[0][j], rays.radiance[1][j], rays.radiance[2][j]),
+            sink(x, y, {Rgb(rays.radiance[0][j], rays.radiance[1][j], rays.radiance[2][j]),
                               Rgb(rays.transmittance[0][j], rays.transmittance[1][j], rays.transmittance[2][j]), leaving});
           } else {
             const size_t node = static_cast<size_t>(y) * static_cast<size_t>(lattice.nx) + static_cast<size_t>(x);
@@ -220,7 +219,7 @@ void splat_network(const SplatInputs& in, std::span<const uint32_t> front_to_bac
     }
   });
   progress.throw_if_cancelled();
-  if (step == 1) return;
+  if (step == 1) return step;
   // Each pixel bilinear between its lattice's nodes.
   parallel_for(cam.height_px, options.threads, 16, [&](long long y0, long long y1) {
     for (auto y = static_cast<int>(y0); y < static_cast<int>(y1); ++y) {
@@ -238,10 +237,11 @@ void splat_network(const SplatInputs& in, std::span<const uint32_t> front_to_bac
                                        w[3] * static_cast<double>(v[c][b + 1]);
           return sum;
         };
-        result.set(x, y, {at(node_radiance), at(node_transmittance), in.background});
+        sink(x, y, {at(node_radiance), at(node_transmittance), in.background});
       }
     }
   });
+  return step;
 }
 
 }  // namespace haze::particles::network_internal

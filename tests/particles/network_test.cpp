@@ -101,6 +101,37 @@ TEST(NetworkRender, SplatAgreesWithTheMarch) {
   EXPECT_LT(rmse(*splat.transmittance, *march.transmittance), 1e-5);
 }
 
+// The splat's layers into a renderer's memory (render_layers: RGBA rows with padding, a host's
+// floor as depth, and none) are render's layers.
+TEST(NetworkRender, RenderLayersIntoCallerMemoryAreRendersLayers) {
+  register_methods();
+  Scene scene = Scene::load(std::string(HAZE_SOURCE_DIR) + "/examples/particle_cloud.json");
+  scene.camera.width_px = 48, scene.camera.height_px = 36;
+  const Solution solution = prepare(scene, "network");
+  std::vector<float> floor;
+  for (int y = 0; y < 36; ++y)
+    for (int x = 0; x < 48; ++x) {
+      const Ray ray = scene.camera.pixel_ray(x, y);
+      floor.push_back(ray.direction.y < 0.0 ? static_cast<float>((-0.6 - ray.origin.y) / ray.direction.y) : std::numeric_limits<float>::infinity());
+    }
+  for (const bool depth : {false, true}) {
+    const View view{scene.camera, depth ? std::span<const float>(floor) : std::span<const float>(), true};
+    const RenderResult want = solution.render(view);
+    const size_t stride = 4 * 48 + 3;
+    std::vector<float> l(stride * 36, -7.0f), t(3 * 48 * 36), c(3 * 48 * 36);
+    solution.render_layers(View{scene.camera, view.depth}, {ImageSpan{l.data(), 48, 36, 4, stride}, ImageSpan{t.data(), 48, 36}, ImageSpan{c.data(), 48, 36}});
+    for (int y = 0; y < 36; ++y)
+      for (int x = 0; x < 48; ++x) {
+        const float* li = &l[static_cast<size_t>(y) * stride + 4 * static_cast<size_t>(x)];
+        const size_t at = 3 * (static_cast<size_t>(y) * 48 + static_cast<size_t>(x));
+        ASSERT_LT(glm::length(Rgb(li[0], li[1], li[2]) - want.inscatter->at(x, y)), 1e-6) << "L_in at " << x << ", " << y << (depth ? " (depth)" : "");
+        ASSERT_EQ(li[3], -7.0f) << "alpha written";
+        ASSERT_LT(glm::length(Rgb(t[at], t[at + 1], t[at + 2]) - want.transmittance->at(x, y)), 1e-6) << "T at " << x << ", " << y;
+        ASSERT_LT(glm::length(Rgb(c[at], c[at + 1], c[at + 2]) - want.surface->at(x, y)), 1e-6) << "C at " << x << ", " << y;
+      }
+  }
+}
+
 // Where no ray ends early, the splat takes its rays on a lattice of kSplatNodesPerWidth nodes to
 // the narrowest footprint and interpolates the pixels between them: examples/particle_cloud.json
 // at 384 x 288 (a node every 2 pixels) and 1024 x 768 (every 5) against every pixel's own ray (a
