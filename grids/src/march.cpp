@@ -540,6 +540,17 @@ double auto_step_cells(const Scene& scene, const ExtinctionVolume& volume, const
   return chosen;
 }
 
+// The steps take `s`'s radiance per cell beside the lights', and its extinction and albedo.
+void take_scattered(const MarchScattered& s, MarchVolume& v) {
+  v.source = s.radiance, v.source_channels = s.channels, v.outer = true;
+  for (int c = 0; c < 3; ++c) {
+    const auto sigma_t = static_cast<float>(s.sigma_t[c]);
+    v.depth_scale[c] = sigma_t > 0.0f ? v.sigma_t[c] / sigma_t : 1.0f;
+    v.sigma_t[c] = sigma_t, v.albedo[c] = static_cast<float>(s.albedo[c]);
+  }
+  if (s.channels == 3 || !is_grey(s.sigma_t) || !is_grey(s.albedo)) v.channels = 3;
+}
+
 bool march_distances(const Scene& scene, const ExtinctionVolume& volume, const std::vector<DenseGrid>& depths, const MarchSettings& settings,
                      const RenderOptions& options, const View& view, std::span<const double> distances, DistanceLayers out,
                      const PackedLights* packed, const MarchScattered* scattered) {
@@ -551,15 +562,7 @@ bool march_distances(const Scene& scene, const ExtinctionVolume& volume, const s
   lights.clear();
   MarchVolume simd_view;
   if (settings.scalar || !simd_volume(marcher, lights, simd_view)) return false;
-  if (scattered) {
-    simd_view.source = scattered->radiance, simd_view.source_channels = scattered->channels, simd_view.outer = true;
-    for (int c = 0; c < 3; ++c) {
-      const auto sigma_t = static_cast<float>(scattered->sigma_t[c]);
-      simd_view.depth_scale[c] = sigma_t > 0.0f ? simd_view.sigma_t[c] / sigma_t : 1.0f;
-      simd_view.sigma_t[c] = sigma_t, simd_view.albedo[c] = static_cast<float>(scattered->albedo[c]);
-    }
-    if (scattered->channels == 3 || !is_grey(scattered->sigma_t) || !is_grey(scattered->albedo)) simd_view.channels = 3;
-  }
+  if (scattered) take_scattered(*scattered, simd_view);
   const Camera& camera = view.camera;
   const double pitch = camera.pixel_angle();  // a column's width per unit distance: no finer steps along it
   const auto rows = [&](long long y0, long long y1) {
@@ -571,7 +574,7 @@ bool march_distances(const Scene& scene, const ExtinctionVolume& volume, const s
 }
 
 bool march_layers(const Scene& scene, const ExtinctionVolume& volume, const std::vector<DenseGrid>& depths, const MarchSettings& settings,
-                  const RenderOptions& options, const View& view, LayerSpans out, const PackedLights* packed) {
+                  const RenderOptions& options, const View& view, LayerSpans out, const PackedLights* packed, const MarchScattered* scattered) {
   const Vec3 h = volume.density.cell_size();
   const Marcher marcher(scene, volume, depths, settings.step_cells * std::min({h.x, h.y, h.z}), options.threads, packed, settings.surface_gather);
   thread_local std::vector<MarchLight> lights;  // kept, as march_distances' (rows read it while this thread waits)
@@ -581,7 +584,8 @@ bool march_layers(const Scene& scene, const ExtinctionVolume& volume, const std:
   Vec3 eye, a, b;
   const bool one_eye = view.camera.eye(eye);
   thread_local std::vector<uint32_t> folded;  // kept as `lights`
-  if (one_eye && settings.toward_eye) fold_toward_eye(marcher, eye, lights, simd_view, folded, options.threads);
+  if (scattered) take_scattered(*scattered, simd_view);
+  else if (one_eye && settings.toward_eye) fold_toward_eye(marcher, eye, lights, simd_view, folded, options.threads);
   const bool from_eye = one_eye && view.camera.row_frame(0.5, a, b) && scene.surfaces.empty() && !out.surface.data;
   const auto rows = [&](long long y0, long long y1) {
     for (auto y = static_cast<int>(y0); y < y1; ++y) {

@@ -200,11 +200,15 @@ TEST(Layers, AutoPassesTheChosenMethodsLayers) {
 // (the tails in SIMD lanes, short stretches through render's float64 path) within 1e-3 relative
 // RMS and 2e-3 per pixel of its layers, in a box, in unbounded fog and in a coloured medium, over a
 // host's floor and the sky; RGBA rows with padding left as they were; propagation's march into the
-// spans (march_layers: the rows of its render, the same kernel) as its render's.
+// spans (march_layers: the rows of its render, the same kernel) as its render's; dom's gather as
+// its render's with a point light, and under a sun the marcher's kernel with the moments' light
+// toward the eye per cell (4.4e-4 relative RMS, 2.3e-3 at worst: held to 4e-3 there, as its
+// froxels are).
 TEST(Layers, RenderLayersIntoCallerMemoryMatchesRender) {
   grids::register_methods();
-  for (const std::string variant : {"box", "unbounded", "coloured", "propagation", "dom"}) {
+  for (const std::string variant : {"box", "unbounded", "coloured", "propagation", "dom", "dom sun"}) {
     Scene scene = testing::fog_box(48, 32, Vec3(0.1, -0.1, 0.4));
+    if (variant == "dom sun") scene.lights = {DirectionalLight{glm::normalize(Vec3(0.3, -1.0, 0.2)), Rgb(2.0)}};
     if (variant == "unbounded") scene.medium->bounds = Aabb{};
     if (variant == "coloured") scene.medium->albedo = Rgb(0.9, 0.7, 0.5);
     scene.background = Rgb(0.05, 0.1, 0.2);
@@ -216,8 +220,8 @@ TEST(Layers, RenderLayersIntoCallerMemoryMatchesRender) {
       }
     RenderOptions prepared;
     if (variant == "propagation") prepared.settings = {{"resolution", 16}};
-    if (variant == "dom") prepared.settings = {{"resolution", 12}, {"directions", 32}, {"terms", 9}};
-    const Solution solution = prepare(scene, variant == "propagation" || variant == "dom" ? variant : "analytic", prepared);
+    if (variant.starts_with("dom")) prepared.settings = {{"resolution", 12}, {"directions", 32}, {"terms", 9}};
+    const Solution solution = prepare(scene, variant == "propagation" ? variant : variant.starts_with("dom") ? "dom" : "analytic", prepared);
     const RenderResult exact = solution.render(View{scene.camera, depth, true});
     const size_t stride = 4 * 48 + 3;
     std::vector<float> l(stride * 32, -7.0f), t(3 * 48 * 32), c(3 * 48 * 32);
@@ -236,7 +240,7 @@ TEST(Layers, RenderLayersIntoCallerMemoryMatchesRender) {
       }
     std::printf("render_layers (%s) against render: L_in %.2e relative RMS, %.2e at worst\n", variant.c_str(), std::sqrt(d2 / r2), worst);
     EXPECT_LT(std::sqrt(d2 / r2), 1e-3) << variant;
-    EXPECT_LT(worst, 2e-3) << variant;
+    EXPECT_LT(worst, variant == "dom sun" ? 4e-3 : 2e-3) << variant;
     for (size_t y = 0; y < 32; ++y) EXPECT_EQ(l[y * stride + 4 * 48], -7.0f) << "row padding written";
   }
 }

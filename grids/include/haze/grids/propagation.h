@@ -131,9 +131,11 @@ bool march_distances(const Scene& scene, const ExtinctionVolume& volume, const s
 
 // The same as march_view's layers (View::layers) into the caller's spans (LayerSpans, what
 // Solution::render_layers takes), each thread's buffers kept: a frame allocates nothing once they
-// have grown. False where the SIMD kernel cannot take the scene, or with surface_gather.
+// have grown. False where the SIMD kernel cannot take the scene, or with surface_gather. With
+// `scattered` (dom's layers), as march_distances (the lights then stay in the steps).
 bool march_layers(const Scene& scene, const ExtinctionVolume& volume, const std::vector<DenseGrid>& depths, const MarchSettings& settings,
-                  const RenderOptions& options, const View& view, LayerSpans out, const PackedLights* packed = nullptr);
+                  const RenderOptions& options, const View& view, LayerSpans out, const PackedLights* packed = nullptr,
+                  const MarchScattered* scattered = nullptr);
 
 // Setting step 0, the march's step chosen for the medium and lights: the longest of kAutoSteps
 // cells whose march of kAutoStepProbes chords spread over the bounds (the SIMD kernel, every light
