@@ -40,6 +40,10 @@ Channel make_channel(const ExtinctionVolume& volume, const std::vector<Light>& l
 // in float32 or, divided by a per-cell scale (the cell's largest value), in float16.
 struct FirstCollision {
   std::vector<float> values;
+  // Or, where every light is directional and nothing emits (`separable` asked for): values[cell][d] =
+  // sum_l factor[cell * lights + l] rows[l * padded + d], each light's phase row in the padded order.
+  std::vector<float> rows, factor;
+  int lights = 0;
   std::vector<simd::Half> half;
   std::vector<float> scale;  // [cell], with `half`
   std::vector<float> slope;  // [cell * 3 + axis]: the source's change across the cell over its mean
@@ -79,9 +83,10 @@ class Transport {
   //   sum_lights p(w_light . w_d) E_light e^(-sigma_t depth) / sum_j p(w_light . w_j) w_j,
   // normalized so its quadrature over directions is exactly E e^(-sigma_t depth), times `scale`
   // (1 / (1 - f) under delta-M scaling, so that the scaled sigma_s gives back the true one).
-  // In float16 when `half`.
+  // In float16 when `half`; separable (FirstCollision::rows) when asked and every light is
+  // directional and nothing emits (not with `half`).
   FirstCollision first_collision(const ExtinctionVolume& volume, const std::vector<Light>& lights, const std::vector<DenseGrid>& depths,
-                                 int channel, double scale, bool half, int threads) const;
+                                 int channel, double scale, bool half, int threads, bool separable = false) const;
 
   // The paper's scheme: full radiance per cell and direction, every cell updated from its upwind
   // neighbours' previous values (Jacobi). Returns the moments; appends one change per iteration.

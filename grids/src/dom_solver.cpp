@@ -367,7 +367,7 @@ DomSolution solve_dom(const ExtinctionVolume& volume, const std::vector<Light>& 
     const dom::Faces* entering = boundary ? &faces[static_cast<size_t>(c)] : nullptr;
     const Stopwatch source_watch;
     dom::FirstCollision first = transport.first_collision(volume, delta_lights, delta_depths, c, 1.0 / (1.0 - out.delta_m_fraction),
-                                                          settings.storage == DomStorage::float16, settings.threads);
+                                                          settings.storage == DomStorage::float16, settings.threads, settings.scheme != DomScheme::paper);
     out.first_collision_seconds += source_watch.seconds();
     std::vector<float>& x = out.moments[static_cast<size_t>(c)];
     if (settings.scheme == DomScheme::paper) {

@@ -122,7 +122,8 @@ void DomSweepRow(const DomOctant& o, const DomRow& r) {
     const float* HWY_RESTRICT m_in = r.m_in && !empty ? r.m_in + c * n : nullptr;
     const float* HWY_RESTRICT first = r.first && !empty ? r.first + c * r.first_stride : nullptr;
     const simd::Half* HWY_RESTRICT first_half = !r.first && r.first_half && !empty ? r.first_half + c * r.first_stride : nullptr;
-    const bool linear = r.first_slope && (first || first_half) && o.diamond;
+    const float* HWY_RESTRICT factor = r.first_rows && !empty ? r.first_factor + c * static_cast<size_t>(r.first_lights) : nullptr;
+    const bool linear = r.first_slope && (first || first_half || factor) && o.diamond;
     V ts[3];
     for (int e = 0; e < 3; ++e)
       ts[e] = hn::Set(d, linear ? r.albedo * sigma_t_value * r.first_slope[c * 3 + static_cast<size_t>(e)] * o.sign[e] : 0.0f);
@@ -147,6 +148,12 @@ void DomSweepRow(const DomOctant& o, const DomRow& r) {
           for (size_t v = 0; v < count; ++v)
             s[v] = hn::Mul(hn::Set(d, r.first_scale[c]),
                            hn::PromoteTo(d, hn::LoadU(dh, reinterpret_cast<const hwy::float16_t*>(first_half + i + v * lanes))));
+        if (factor)
+          for (size_t l = 0; l < static_cast<size_t>(r.first_lights); ++l) {
+            const V f = hn::Set(d, factor[l]);
+            const float* HWY_RESTRICT row = r.first_rows + l * r.first_stride + i;
+            for (size_t v = 0; v < count; ++v) s[v] = hn::MulAdd(f, hn::LoadU(d, row + v * lanes), s[v]);
+          }
         const V fc[4] = {s[0], s[1], s[2], s[3]};  // the first-collision source alone
         if (m_in) {
           const float* HWY_RESTRICT lq = o.lq + i;

@@ -47,9 +47,12 @@ void dom_sweep_row_reference(const DomOctant& o, const DomRow& r) {
     auto directions = [&](bool bound) {
       bool negative = false;
       for (size_t d = 0; d < p; ++d) {
-        const float first = empty ? 0.0f
-                            : r.first ? r.first[c * r.first_stride + d]
-                            : r.first_half ? r.first_scale[c] * static_cast<float>(r.first_half[c * r.first_stride + d]) : 0.0f;
+        float first = empty ? 0.0f
+                      : r.first ? r.first[c * r.first_stride + d]
+                      : r.first_half ? r.first_scale[c] * static_cast<float>(r.first_half[c * r.first_stride + d]) : 0.0f;
+        if (r.first_rows && !empty)
+          for (size_t l = 0; l < static_cast<size_t>(r.first_lights); ++l)
+            first += r.first_factor[c * static_cast<size_t>(r.first_lights) + l] * r.first_rows[l * r.first_stride + d];
         float s = first;
         if (r.m_in && !empty)
           for (size_t k = 0; k < n; ++k) s += o.lq[k * p + d] * r.m_in[c * n + k];

@@ -194,7 +194,8 @@ void Transport::sweep(const Channel& ch, const FirstCollision* first, const floa
         DomRow row;
         row.step = o & 1 ? -1 : 1;
         row.density = ch.density, row.sigma_t_scale = ch.sigma_t_scale, row.albedo = ch.albedo;
-        if (first && first->half.empty()) row.first = first->values.data() + oc.offset;
+        if (first && !first->rows.empty()) row.first_rows = first->rows.data() + oc.offset, row.first_factor = first->factor.data(), row.first_lights = first->lights;
+        else if (first && first->half.empty()) row.first = first->values.data() + oc.offset;
         if (first && !first->half.empty()) row.first_half = first->half.data() + oc.offset, row.first_scale = first->scale.data();
         if (first && !first->slope.empty()) row.first_slope = first->slope.data();
         row.first_stride = padded_;
@@ -290,7 +291,8 @@ std::vector<Faces> Transport::faces(const DomBoundary& boundary, const DenseGrid
 }
 
 FirstCollision Transport::first_collision(const ExtinctionVolume& volume, const std::vector<Light>& lights,
-                                          const std::vector<DenseGrid>& depths, int channel, double scale_all, bool half, int threads) const {
+                                          const std::vector<DenseGrid>& depths, int channel, double scale_all, bool half, int threads,
+                                          bool separable) const {
   const DenseGrid& grid = volume.density;
   const auto d = static_cast<size_t>(d_);
   const Vec3 h = grid.cell_size();
@@ -329,8 +331,18 @@ FirstCollision Transport::first_collision(const ExtinctionVolume& volume, const 
       normalized_phase(-sun->direction, cosines, rows[l]);  // as arrival() gives to_light
     }
   FirstCollision first;
-  if (half) first.half.resize(cells_ * padded_), first.scale.resize(cells_);
-  else first.values.assign(cells_ * padded_, 0.0f);
+  separable = separable && !half && !emits && !lights.empty() &&
+              std::all_of(lights.begin(), lights.end(), [](const Light& l) { return std::holds_alternative<DirectionalLight>(l); });
+  if (separable) {
+    first.lights = static_cast<int>(lights.size());
+    first.rows.assign(lights.size() * padded_, 0.0f), first.factor.assign(cells_ * lights.size(), 0.0f);
+    for (size_t l = 0; l < lights.size(); ++l)
+      for (size_t t = 0; t < d; ++t) first.rows[l * padded_ + padded_index_[t]] = rows[l][t];
+  } else if (half) {
+    first.half.resize(cells_ * padded_), first.scale.resize(cells_);
+  } else {
+    first.values.assign(cells_ * padded_, 0.0f);
+  }
   first.slope.assign(3 * cells_, 0.0f);
   const auto nx = n_[0], ny = n_[1];
   parallel_for(n_[2], threads, 1, [&](long long k0, long long k1) {
@@ -345,7 +357,7 @@ FirstCollision Transport::first_collision(const ExtinctionVolume& volume, const 
             continue;
           }
           const Vec3 x = grid.cell_center(i, j, kg);
-          float* f = half ? cell.data() : first.values.data() + c * padded_;
+          float* f = separable ? nullptr : half ? cell.data() : first.values.data() + c * padded_;
           std::array<double, 3> slope{0.0, 0.0, 0.0};  // each light's change weighted by its share
           double total = 0.0;
           if (half) std::fill(cell.begin(), cell.end(), 0.0f);
@@ -364,9 +376,13 @@ FirstCollision Transport::first_collision(const ExtinctionVolume& volume, const 
             if (!(e > 0.0)) continue;
             for (size_t axis = 0; axis < 3; ++axis) slope[axis] += e * linear_change(u[axis]);
             total += e;
+            const auto scale = static_cast<float>(scale_all * e);
+            if (separable) {
+              first.factor[c * lights.size() + l] = scale;
+              continue;
+            }
             if (rows[l].empty()) normalized_phase(a.to_light, cosines, phase);
             const float* row = rows[l].empty() ? phase.data() : rows[l].data();
-            const auto scale = static_cast<float>(scale_all * e);
             for (size_t t = 0; t < d; ++t) f[padded_index_[t]] += scale * row[t];
           }
           // Emission: an isotropic source L_e of its own, entering the sweep's sigma_s S as

@@ -91,6 +91,55 @@ TEST_P(DomSweep, MatchesScalarReferenceOnEveryTarget) {
   EXPECT_GT(marked, 100);  // the fix-up's path is taken
 }
 
+// A separable first-collision source (DomRow::first_rows, suns only) is the source it stands for,
+// sum_l factor[cell][l] rows[l][d] given whole, on every target and in the reference (the diamond
+// with slopes and the step; 1e-5 relative: summation order).
+TEST_P(DomSweep, SeparableFirstCollisionIsTheSourceItStandsFor) {
+  Rng rng(5);
+  auto fill = [&](std::vector<float>& v, float lo, float hi) {
+    for (float& e : v) e = lo + (hi - lo) * static_cast<float>(rng.uniform());
+  };
+  for (const bool diamond : {false, true})
+    for (int lights : {1, 2, 3}) {
+      const int p = 24, n = 9, np = 16, count = 13, cells = 20;
+      const auto up = static_cast<size_t>(p);
+      std::vector<float> a(5 * up), lq(static_cast<size_t>(n) * up), q(up * static_cast<size_t>(np), 0.0f);
+      fill(a, 0.0f, 3.0f), fill(lq, -0.2f, 0.3f), fill(q, -0.5f, 0.5f);
+      for (size_t d = 0; d < up; ++d) a[3 * up + d] = a[d] + a[up + d] + a[2 * up + d], a[4 * up + d] = 0.0f;
+      const DomOctant octant{p, n, np, a.data(), lq.data(), q.data(), diamond, {1.0f, 1.0f, -1.0f}};
+      std::vector<float> density(cells), rows(static_cast<size_t>(lights) * up), factor(static_cast<size_t>(cells * lights)), m_in(static_cast<size_t>(cells * n));
+      std::vector<float> slope(3 * static_cast<size_t>(cells));
+      fill(density, 0.0f, 4.0f), fill(rows, 0.0f, 1.0f), fill(factor, 0.0f, 2.0f), fill(m_in, 0.0f, 2.0f), fill(slope, -2.0f, 2.0f);
+      std::vector<float> whole(static_cast<size_t>(cells) * up, 0.0f);
+      for (size_t c = 0; c < static_cast<size_t>(cells); ++c)
+        for (size_t d = 0; d < up; ++d)
+          for (size_t l = 0; l < static_cast<size_t>(lights); ++l) whole[c * up + d] += factor[c * static_cast<size_t>(lights) + l] * rows[l * up + d];
+      std::vector<float> state[4];
+      for (int which = 0; which < 4; ++which) {  // kernel and reference, whole and separable
+        state[which].resize(static_cast<size_t>(cells * n) + up + 2 * static_cast<size_t>(count) * up);
+        Rng same(9);
+        for (float& e : state[which]) e = static_cast<float>(same.uniform());
+        std::vector<float> scratch(4 * up + static_cast<size_t>(np));
+        DomRow row;
+        row.count = count, row.cell0 = 3, row.density = density.data(), row.sigma_t_scale = 1.7f, row.albedo = 0.9f;
+        row.first_stride = up, row.m_in = m_in.data(), row.first_slope = diamond ? slope.data() : nullptr;
+        if (which % 2 == 0) row.first = whole.data();
+        else row.first_rows = rows.data(), row.first_factor = factor.data(), row.first_lights = lights;
+        row.m_out = state[which].data();
+        row.x_run = row.m_out + cells * n;
+        row.y_row = row.x_run + up, row.z_row = row.y_row + static_cast<size_t>(count) * up;
+        row.scratch = scratch.data();
+        (which < 2 ? dom_sweep_row : dom_sweep_row_reference)(octant, row);
+      }
+      for (int which = 1; which < 4; ++which) {
+        const float peak = *std::max_element(state[0].begin(), state[0].end());
+        for (size_t i = 0; i < state[0].size(); ++i)
+          ASSERT_NEAR(state[which][i], state[0][i], 1e-5f * std::abs(state[0][i]) + 1e-6f * peak)
+              << (diamond ? "diamond" : "step") << ", " << lights << " lights, variant " << which << " at " << i << " target " << hwy::TargetName(GetParam());
+      }
+    }
+}
+
 // One cell and direction through the scalar reference: the radiance leaving through the faces
 // `out` and the cell's mean, for entering radiance `in`, a_e = |w_e| / h_e, extinction sigma_t,
 // albedo 1 and source s.

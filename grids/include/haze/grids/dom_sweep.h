@@ -84,6 +84,11 @@ struct DomRow {
   const simd::Half* first_half = nullptr;  // or the same in float16, times first_scale[cell]
   const float* first_scale = nullptr;
   size_t first_stride = 0;
+  // Or, for directional lights (the same phase row in every cell), the source separable:
+  // first[cell][d] = sum_l first_factor[cell * first_lights + l] first_rows[l * first_stride + d].
+  const float* first_rows = nullptr;
+  const float* first_factor = nullptr;
+  int first_lights = 0;
   // Or null: [cell * 3 + e], the first-collision source's change across the cell along axis e over
   // its mean (the diamond scheme takes the source as linear over the cell; see above).
   const float* first_slope = nullptr;
