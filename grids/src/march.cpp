@@ -321,6 +321,31 @@ void fold_toward_eye(const Marcher& m, const Vec3& eye, std::vector<MarchLight>&
   v.lights = lights.data(), v.light_count = static_cast<int>(lights.size());
 }
 
+// Three rows of `width` floats into row y of an RGB or RGBA span (RGBA's fourth float left as it is).
+void put_row(const float* r, const float* g, const float* b, size_t width, const ImageSpan& span, int y) {
+  if (span.channels == 3) {
+    march_interleave_rgb(r, g, b, width, span.pixel(0, y));
+    return;
+  }
+  for (size_t x = 0; x < width; ++x) {
+    float* p = span.pixel(static_cast<int>(x), y);
+    p[0] = r[x], p[1] = g[x], p[2] = b[x];
+  }
+}
+
+// The rays of a film row from `eye` along a + b (px + 0.5) (Camera::row_frame's a and b, shifted
+// and scaled for a row's part or a lattice), for march_row_packet.
+RowFrame row_frame_of(const Marcher& m, const Vec3& eye, const Vec3& a, const Vec3& b) {
+  const Aabb& box = m.volume.density.bounds();
+  RowFrame frame{};
+  for (int e = 0; e < 3; ++e) {
+    frame.eye[e] = static_cast<float>(eye[e]), frame.a[e] = static_cast<float>(a[e]), frame.b[e] = static_cast<float>(b[e]);
+    frame.lo[e] = static_cast<float>(box.lo[e]), frame.hi[e] = static_cast<float>(box.hi[e]);
+  }
+  frame.step = static_cast<float>(m.step);
+  return frame;
+}
+
 // Row y's layers (march_layers) for a camera whose rays leave one eye, in a scene without surfaces
 // of Haze's own and no surface layer asked for: the rays made and clipped in float32 lanes
 // (march_row_packet), the kernel, the spans. Buffers per thread, kept.
@@ -330,13 +355,7 @@ void march_row_layers_from(const Marcher& m, const MarchVolume& v, const View& v
   packed.resize(9 * padded), result.resize(6 * padded);
   Vec3 a, b;
   view.camera.row_frame(y + 0.5, a, b);
-  const Aabb& box = m.volume.density.bounds();
-  RowFrame frame{};
-  for (int e = 0; e < 3; ++e) {
-    frame.eye[e] = static_cast<float>(eye[e]), frame.a[e] = static_cast<float>(a[e]), frame.b[e] = static_cast<float>(b[e]);
-    frame.lo[e] = static_cast<float>(box.lo[e]), frame.hi[e] = static_cast<float>(box.hi[e]);
-  }
-  frame.step = static_cast<float>(m.step);
+  RowFrame frame = row_frame_of(m, eye, a, b);
   if (!view.depth.empty()) {
     depth.assign(padded, std::numeric_limits<float>::infinity());
     std::copy_n(view.depth.begin() + static_cast<std::ptrdiff_t>(static_cast<size_t>(y) * width), width, depth.begin());
@@ -346,17 +365,145 @@ void march_row_layers_from(const Marcher& m, const MarchVolume& v, const View& v
   march_rays(v, m.volume.phase, packet_of(packed, result, padded, width));
   const auto row = [&](size_t r) { return result.data() + r * padded; };
   const size_t grey = v.channels == 1 ? 0 : 1;  // channel c's row: c times this
-  for (const auto& [span, first] : {std::pair{out.inscatter, size_t(0)}, std::pair{out.transmittance, size_t(3)}}) {
-    const float *r = row(first), *g = row(first + grey), *b = row(first + 2 * grey);
-    if (span.channels == 3) {
-      march_interleave_rgb(r, g, b, width, span.pixel(0, y));
-    } else {  // RGBA: the fourth float left as it is
-      for (size_t x = 0; x < width; ++x) {
-        float* p = span.pixel(static_cast<int>(x), y);
-        p[0] = r[x], p[1] = g[x], p[2] = b[x];
+  for (const auto& [span, first] : {std::pair{out.inscatter, size_t(0)}, std::pair{out.transmittance, size_t(3)}})
+    put_row(row(first), row(first + grey), row(first + 2 * grey), width, span, y);
+}
+
+// march_layers' lattice step in pixels (MarchSettings::kLatticeNodesPerCell): from one eye without a
+// host's depth, a node per kLatticeNodesPerCell of the narrowest cell as the view's central pixels
+// see it at the volume's farthest corner; else 1. `peaks`: the film positions of the lights in the
+// steps (point lights near dense cells, spots: peaks narrower than a cell) in or near the view.
+int lattice_step(const Marcher& m, const MarchVolume& v, const View& view, const Vec3& eye, std::vector<std::array<double, 2>>& peaks) {
+  const Camera& camera = view.camera;
+  if (!view.depth.empty()) return 1;
+  const Aabb& box = m.volume.density.bounds();
+  double far = 0.0;
+  for (int c = 0; c < 8; ++c) far = std::max(far, glm::length(Vec3(c & 1 ? box.hi.x : box.lo.x, c & 2 ? box.hi.y : box.lo.y, c & 4 ? box.hi.z : box.lo.z) - eye));
+  const Vec3 h = m.volume.density.cell_size();
+  const double cell_pixels = std::min({h.x, h.y, h.z}) / (far * camera.pixel_angle());
+  const int step = std::min(static_cast<int>(cell_pixels / MarchSettings::kLatticeNodesPerCell), std::max(camera.width_px, camera.height_px));
+  if (step < 2) return 1;
+  peaks.clear();
+  for (int l = 0; l < v.light_count; ++l) {
+    const MarchLight& light = v.lights[l];
+    double px, py;
+    if (light.type == MarchLight::directional) continue;
+    if (!camera.film_position(Vec3(light.position[0], light.position[1], light.position[2]), px, py)) continue;  // behind the eye
+    const double margin = MarchSettings::kLatticePeakNodes * step;
+    if (px > -margin && px < camera.width_px + margin && py > -margin && py < camera.height_px + margin) peaks.push_back({px, py});
+  }
+  return step;
+}
+
+// march_layers on a lattice: the rays through film points (i s + 0.5, j s + 0.5), i < nx, j < ny,
+// reaching past the last pixel, each row a packet; then every pixel bilinear between its nodes.
+void march_lattice_layers(const Marcher& m, const MarchVolume& v, const View& view, const Vec3& eye, int s, std::span<const std::array<double, 2>> peaks,
+                          LayerSpans out, int threads) {
+  const Camera& camera = view.camera;
+  const auto nx = static_cast<size_t>((camera.width_px - 1) / s + 2), ny = static_cast<size_t>((camera.height_px - 1) / s + 2);
+  // The most nodes any step takes (2): the kept buffers grow once, not each time the step falls.
+  const auto most_x = static_cast<size_t>((camera.width_px - 1) / 2 + 2), most_y = static_cast<size_t>((camera.height_px - 1) / 2 + 2);
+  thread_local std::vector<float> kept;  // [6][ny][nx]: L_in, then T; this thread's, frame after frame
+  std::vector<float>& nodes = kept;
+  nodes.reserve(6 * most_x * most_y), nodes.resize(6 * nx * ny);
+  const size_t grey = v.channels == 1 ? 0 : 1;
+  const auto node_rows = [&](long long j0, long long j1) {
+    const size_t padded = nx + 64;
+    thread_local std::vector<float> packed, result;
+    packed.reserve(9 * (most_x + 64)), result.reserve(6 * (most_x + 64));
+    packed.resize(9 * padded), result.resize(6 * padded);
+    for (auto j = static_cast<size_t>(j0); j < static_cast<size_t>(j1); ++j) {
+      Vec3 a, b;
+      camera.row_frame(static_cast<double>(j) * s + 0.5, a, b);
+      a += 0.5 * b - 0.5 * s * b, b *= s;  // a + b (i + 0.5) = a_row + b_row (i s + 0.5)
+      RowFrame frame = row_frame_of(m, eye, a, b);
+      march_row_packet(frame, packed.data(), padded, nx);
+      march_rays(v, m.volume.phase, packet_of(packed, result, padded, nx));
+      for (size_t r = 0; r < 6; ++r) {
+        const float* from = result.data() + (r < 3 ? r * grey : 3 + (r - 3) * grey) * padded;
+        std::copy_n(from, nx, nodes.data() + (r * ny + j) * nx);
       }
     }
+  };
+  // Bodies of one reference: std::function keeps them without allocating.
+  parallel_for(static_cast<long long>(ny), threads, 1, [&node_rows](long long j0, long long j1) { node_rows(j0, j1); });
+  // Rough nodes: a second difference along x or y over kLatticeSpread (of T, or of L_in over its
+  // largest on the lattice): a silhouette of the volume, an edge of a light, which the bilinear
+  // interpolation would blur. A pixel next to one takes its own ray: the runs of such pixels in a
+  // row, each a packet.
+  thread_local std::vector<std::uint8_t> kept_rough;
+  std::vector<std::uint8_t>& rough = kept_rough;
+  rough.reserve(most_x * most_y), rough.assign(nx * ny, 0);
+  float peak = 0.0f;
+  for (size_t k = 0; k < 3 * nx * ny; ++k) peak = std::max(peak, nodes[k]);
+  const auto roughness = [&](long long j0, long long j1) {
+    for (auto j = static_cast<size_t>(j0); j < static_cast<size_t>(j1); ++j)
+      for (size_t i = 0; i < nx; ++i)
+        for (size_t r = 0; r < 6 && !rough[j * nx + i]; ++r) {
+          const float* at = nodes.data() + (r * ny + j) * nx + i;
+          const float limit = MarchSettings::kLatticeSpread * (r < 3 ? peak : 1.0f);
+          const bool across = i > 0 && i + 1 < nx && std::abs(at[-1] - 2.0f * at[0] + at[1]) > limit;
+          const bool down = j > 0 && j + 1 < ny && std::abs(at[-static_cast<std::ptrdiff_t>(nx)] - 2.0f * at[0] + at[nx]) > limit;
+          if (across || down) rough[j * nx + i] = 1;
+        }
+  };
+  parallel_for(static_cast<long long>(ny), threads, 8, [&roughness](long long j0, long long j1) { roughness(j0, j1); });
+  for (const auto& [px, py] : peaks) {  // around a light in the steps, every pixel its own ray
+    const int reach = MarchSettings::kLatticePeakNodes, ci = static_cast<int>(std::floor((px - 0.5) / s)), cj = static_cast<int>(std::floor((py - 0.5) / s));
+    for (int j = std::max(0, cj - reach); j <= std::min(static_cast<int>(ny) - 1, cj + reach + 1); ++j)
+      for (int i = std::max(0, ci - reach); i <= std::min(static_cast<int>(nx) - 1, ci + reach + 1); ++i) rough[static_cast<size_t>(j) * nx + static_cast<size_t>(i)] = 1;
   }
+  // Each pixel's column of nodes and its weight between them, the same in every row.
+  thread_local std::vector<size_t> kept_column;
+  thread_local std::vector<float> kept_fx;
+  std::vector<size_t>& column = kept_column;
+  std::vector<float>& fx = kept_fx;
+  column.resize(static_cast<size_t>(camera.width_px)), fx.resize(column.size());
+  for (int x = 0; x < camera.width_px; ++x)
+    column[static_cast<size_t>(x)] = static_cast<size_t>(x / s), fx[static_cast<size_t>(x)] = static_cast<float>(x % s) / static_cast<float>(s);
+  const auto pixel_rows = [&](long long y0, long long y1) {
+    const auto width = static_cast<size_t>(camera.width_px);
+    const size_t padded = width + 64;
+    thread_local std::vector<float> packed, result, blend, line;
+    blend.reserve(6 * most_x);
+    packed.resize(9 * padded), result.resize(6 * padded), blend.resize(6 * nx), line.resize(6 * padded);
+    for (auto y = static_cast<int>(y0); y < y1; ++y) {
+      const auto j = static_cast<size_t>(y / s);
+      const float fy = static_cast<float>(y % s) / static_cast<float>(s);
+      // Between the node rows, then along the row, each channel apart.
+      for (size_t r = 0; r < 6; ++r) {
+        const float* above = nodes.data() + (r * ny + j) * nx;
+        float* b = blend.data() + r * nx;
+        for (size_t i = 0; i < nx; ++i) b[i] = above[i] + fy * (above[i + nx] - above[i]);
+        float* l = line.data() + r * padded;
+        for (size_t x = 0; x < width; ++x) l[x] = b[column[x]] + fx[x] * (b[column[x] + 1] - b[column[x]]);
+      }
+      // Pixels next to a rough node, each its own ray: the runs of them, each a packet.
+      const std::uint8_t* near = rough.data() + j * nx;
+      const auto own = [&](size_t x) { const size_t i = column[x]; return (near[i] | near[i + 1] | near[i + nx] | near[i + nx + 1]) != 0; };
+      for (size_t x = 0; x < width;) {
+        if (!own(x)) {
+          ++x;
+          continue;
+        }
+        const size_t run = x;
+        while (x < width && own(x)) ++x;
+        Vec3 a, b;
+        camera.row_frame(y + 0.5, a, b);
+        a += static_cast<double>(run) * b;
+        RowFrame frame = row_frame_of(m, eye, a, b);
+        const size_t count = x - run;
+        march_row_packet(frame, packed.data(), padded, count);
+        march_rays(v, m.volume.phase, packet_of(packed, result, padded, count));
+        for (size_t r = 0; r < 6; ++r) std::copy_n(result.data() + (r < 3 ? r * grey : 3 + (r - 3) * grey) * padded, count, line.data() + r * padded + run);
+      }
+      for (const auto& [span, first] : {std::pair{out.inscatter, size_t(0)}, std::pair{out.transmittance, size_t(3)}}) {
+        const float* r = line.data() + first * padded;
+        put_row(r, r + padded, r + 2 * padded, width, span, y);
+      }
+    }
+  };
+  parallel_for(camera.height_px, threads, 8, [&pixel_rows](long long y0, long long y1) { pixel_rows(y0, y1); });
 }
 
 // Row y's stretches between consecutive distances, one packet, chained per ray (march_distances).
@@ -586,15 +733,32 @@ bool march_layers(const Scene& scene, const ExtinctionVolume& volume, const std:
   thread_local std::vector<uint32_t> folded;  // kept as `lights`
   if (scattered) take_scattered(*scattered, simd_view);
   else if (one_eye && settings.toward_eye) fold_toward_eye(marcher, eye, lights, simd_view, folded, options.threads);
-  const bool from_eye = one_eye && view.camera.row_frame(0.5, a, b) && scene.surfaces.empty() && !out.surface.data;
-  const auto rows = [&](long long y0, long long y1) {
-    for (auto y = static_cast<int>(y0); y < y1; ++y) {
-      if (from_eye) march_row_layers_from(marcher, simd_view, view, eye, y, out);
-      else march_row_layers(marcher, simd_view, view, y, out);
-    }
-  };
-  // A body of one reference: std::function keeps it without allocating.
-  parallel_for(view.camera.height_px, options.threads, 1, [&rows](long long y0, long long y1) { rows(y0, y1); });
+  // Without surfaces of Haze's own, C is the background where no host depth ends the ray.
+  const bool from_eye = one_eye && view.camera.row_frame(0.5, a, b) && scene.surfaces.empty();
+  thread_local std::vector<std::array<double, 2>> peaks;  // kept as `lights`
+  if (const int step = from_eye ? lattice_step(marcher, simd_view, view, eye, peaks) : 1; step > 1) {
+    march_lattice_layers(marcher, simd_view, view, eye, step, peaks, out, options.threads);
+  } else {
+    const auto rows = [&](long long y0, long long y1) {
+      for (auto y = static_cast<int>(y0); y < y1; ++y) {
+        if (from_eye) march_row_layers_from(marcher, simd_view, view, eye, y, out);
+        else march_row_layers(marcher, simd_view, view, y, out);
+      }
+    };
+    // A body of one reference: std::function keeps it without allocating.
+    parallel_for(view.camera.height_px, options.threads, 1, [&rows](long long y0, long long y1) { rows(y0, y1); });
+  }
+  if (from_eye && out.surface.data) {
+    const auto fill = [&](long long y0, long long y1) {
+      for (auto y = static_cast<int>(y0); y < y1; ++y)
+        for (int x = 0; x < view.camera.width_px; ++x) {
+          const Rgb c = std::isinf(view.max_distance(x, y)) ? scene.background : Rgb(0.0);
+          float* p = out.surface.pixel(x, y);
+          p[0] = static_cast<float>(c.r), p[1] = static_cast<float>(c.g), p[2] = static_cast<float>(c.b);
+        }
+    };
+    parallel_for(view.camera.height_px, options.threads, 16, [&fill](long long y0, long long y1) { fill(y0, y1); });
+  }
   return true;
 }
 

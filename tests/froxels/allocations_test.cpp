@@ -130,7 +130,7 @@ TEST(FrameAllocations, TheTemporalFroxelsAllocateNothingAfterTheFirstFrames) {
 }
 
 // The per-pixel layers into the caller's buffers (render_layers), the camera moving: analytic's
-// one pass, propagation's march and dom's gather allocate nothing once warm.
+// one pass, propagation's march (and its lattice) and dom's gather allocate nothing once warm.
 TEST(FrameAllocations, TheLayersIntoCallerMemoryAllocateNothing) {
   const Scene scene = testing::fog_box(64, 36, Vec3(0.1, -0.1, 0.4));
   std::vector<float> l(3 * 64 * 36), t(l.size()), c(l.size());
@@ -140,10 +140,19 @@ TEST(FrameAllocations, TheLayersIntoCallerMemoryAllocateNothing) {
     if (std::string(method) == "propagation") prepared.settings = {{"resolution", 16}};
     if (std::string(method) == "dom") prepared.settings = {{"resolution", 12}, {"directions", 32}, {"terms", 9}};
     const Solution solution = prepare(scene, method, prepared);
+    SCOPED_TRACE(method);
     expect_none_per_moving_frame(scene.camera, 0.05, [&](const Camera& camera, const RenderOptions& options) {
       solution.render_layers(View{camera, depth}, {ImageSpan{l.data(), 64, 36}, ImageSpan{t.data(), 64, 36}, ImageSpan{c.data(), 64, 36}}, options);
     });
   }
+  // Propagation's lattice (no host depth, a coarse grid close up: a node every few pixels).
+  Scene close = testing::fog_box(256, 144, Vec3(0.1, -0.1, 0.4));
+  std::vector<float> wide(3 * 256 * 144), wide_t(wide.size());
+  const Solution coarse = prepare(close, "propagation", RenderOptions{0, {{"resolution", 8}}, {}, {}});
+  SCOPED_TRACE("propagation's lattice");
+  expect_none_per_moving_frame(close.camera, 0.05, [&](const Camera& camera, const RenderOptions& options) {
+    coarse.render_layers(View{camera}, {ImageSpan{wide.data(), 256, 144}, ImageSpan{wide_t.data(), 256, 144}, ImageSpan{}}, options);
+  });
 }
 
 }  // namespace

@@ -175,9 +175,12 @@ TEST(TowardEye, LayersWithinTheStepsOnTheFrameCloud) {
       for (size_t i = 0; i < got.size(); ++i) d2 += std::pow(got[i] - want[i], 2.0), r2 += std::pow(want[i], 2.0);
       return std::sqrt(d2 / r2);
     };
-    if (above == 0.0) {  // the rows from the eye in float32 lanes (march_row_packet) against float64 rays: asking for the surface layer takes those
+    if (above == 0.0) {  // the rows from the eye in float32 lanes (march_row_packet) against float64 rays: a camera of the same rays given per pixel takes those
+      auto rays = std::make_shared<std::vector<Ray>>();
+      for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) rays->push_back(scene.camera.pixel_ray(x, y));
       std::vector<float> l64(3 * w * h), t64(3 * w * h), c64(3 * w * h);
-      ASSERT_TRUE(march_layers(scene, volume, depths, settings, options, View{scene.camera},
+      ASSERT_TRUE(march_layers(scene, volume, depths, settings, options, View{Camera::from_rays(rays, w, h)},
                                {ImageSpan{l64.data(), w, h}, ImageSpan{t64.data(), w, h}, ImageSpan{c64.data(), w, h}}));
       EXPECT_LT(relative_rms(steps, l64), 2e-5);
       EXPECT_LT(relative_rms(t_steps, t64), 1e-6);
@@ -210,6 +213,41 @@ TEST(TowardEye, FrameLayersWithinTheIssuesBoundOfTheHalfCellSteps) {
   const double rms = std::sqrt(d2 / r2);
   std::printf("the frame's layers against 0.5 cells with the lights in the steps: L_in %.2e relative RMS\n", rms);
   EXPECT_LT(rms, 1e-3);
+}
+
+// A coarse grid seen up close: march_layers takes its rays on a lattice (a node per third of the
+// narrowest cell as the view sees it) and interpolates the pixels, but next to rough nodes and
+// around a near point light in view: RBF fog at 15^3 and 20^3, 400 x 300, the light out of view
+// and in it, against every pixel's own ray (a host depth of +inf everywhere asks for those): L_in
+// within 2e-3 relative RMS, T within 1e-3 (measured: 8.5e-4 and 2.9e-4 at 20^3).
+TEST(TowardEye, LatticeLayersWithinTheirBoundOfEveryPixel) {
+  Scene scene = Scene::load(std::string(HAZE_SOURCE_DIR) + "/examples/smoke_rbf.json");
+  scene.lights = {PointLight{Vec3(1.4, 1.2, 1.0), Rgb(6.0)}};
+  scene.medium->bounds = Aabb{Vec3(-1.0), Vec3(1.0)};
+  const int w = 400, h = 300;
+  scene.camera.width_px = w, scene.camera.height_px = h;
+  for (const bool in_view : {false, true})
+    for (int n : {15, 20}) {
+      scene.lights = {PointLight{in_view ? Vec3(0.6, 0.5, 1.3) : Vec3(1.4, 1.2, 1.0), Rgb(6.0)}};
+      scene.camera.position = Vec3(-1.0, -0.6, 4.2);
+      const ExtinctionVolume volume = make_extinction_volume(scene, n);
+      const std::vector<DenseGrid> depths = optical_depths(volume.density, scene.lights);
+      std::vector<float> lattice(3 * w * h), pixels(3 * w * h), t_lattice(3 * w * h), t_pixels(3 * w * h);
+      const std::vector<float> none(static_cast<size_t>(w * h), std::numeric_limits<float>::infinity());
+      MarchSettings settings;
+      ASSERT_TRUE(march_layers(scene, volume, depths, settings, {}, View{scene.camera}, {ImageSpan{lattice.data(), w, h}, ImageSpan{t_lattice.data(), w, h}, ImageSpan{}}));
+      ASSERT_TRUE(march_layers(scene, volume, depths, settings, {}, View{scene.camera, none}, {ImageSpan{pixels.data(), w, h}, ImageSpan{t_pixels.data(), w, h}, ImageSpan{}}));
+      const auto relative_rms = [](const std::vector<float>& got, const std::vector<float>& want) {
+        double d2 = 0.0, r2 = 0.0;
+        for (size_t i = 0; i < got.size(); ++i) d2 += std::pow(got[i] - want[i], 2.0), r2 += std::pow(want[i], 2.0);
+        return std::sqrt(d2 / r2);
+      };
+      const double rms = relative_rms(lattice, pixels), t_rms = relative_rms(t_lattice, t_pixels);
+      std::printf("%d^3, the light %s: lattice against every pixel, L_in %.2e relative RMS, T %.2e\n", n, in_view ? "in view" : "out of view", rms, t_rms);
+      EXPECT_GT(rms, 0.0) << n << ": the lattice taken";
+      EXPECT_LT(rms, 2e-3) << n;
+      EXPECT_LT(t_rms, 1e-3) << n;
+    }
 }
 
 }  // namespace

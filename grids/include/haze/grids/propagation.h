@@ -85,6 +85,16 @@ struct MarchSettings {
   bool toward_eye = true;
   static constexpr int kFarCells = 8;
   static constexpr float kFarDensity = 0.01f;
+  // march_layers from one eye without a host's depth or surfaces: where a cell spans more than two
+  // such steps of pixels, the rays are marched on a lattice of this many nodes per cell as the
+  // view sees it and the pixels interpolated bilinearly, but for those next to a rough node (below)
+  // and those within kLatticePeakNodes nodes of a light in the steps (a near point light, a spot)
+  // in view, which take their own rays (tests/grids/toward_eye_test.cpp measures the error).
+  static constexpr double kLatticeNodesPerCell = 2.5;
+  static constexpr int kLatticePeakNodes = 4;
+  // A pixel next to a lattice node whose second difference along x or y exceeds this (in T, or in
+  // L_in over its largest) takes its own ray: the volume's silhouette, the edge of a light's cone.
+  static constexpr float kLatticeSpread = 0.01f;
 };
 
 // The per-light volumes as the marcher reads them, all lights of a cell together ([cell * lights +
