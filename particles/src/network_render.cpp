@@ -86,11 +86,6 @@ Rgb march(std::vector<Along>& along, const Rgb& sigma_t, const std::vector<Rgb>&
   return radiance;
 }
 
-
-}  // namespace
-
-namespace {
-
 // render_network, each pixel's layers handed to `sink`; returns the render's stats.
 nlohmann::json render_into(const Scene& scene, const ParticleField& field, const NetworkSolution& solution, const RenderOptions& options,
                            const View& view, NetworkRender render, const PixelSink& sink) {
@@ -210,25 +205,12 @@ nlohmann::json render_into(const Scene& scene, const ParticleField& field, const
     return s;
   };
 
-  // Particles binned to 16 x 16 tiles by their footprints, each tile's front to back (by the
-  // distance to the eye, or along the view for parallel rays): the splat's order (march() orders
-  // each ray's itself).
-  const int tiles_x = (cam.width_px + kTile - 1) / kTile, tiles_y = (cam.height_px + kTile - 1) / kTile;
-  std::vector<std::vector<uint32_t>> tiles(static_cast<size_t>(tiles_x) * static_cast<size_t>(tiles_y));
+  // The particles front to back: by the distance to the eye, or along the view for parallel rays.
   std::vector<std::pair<double, uint32_t>> by_depth;
   by_depth.reserve(n);
   for (size_t p = 0; p < n; ++p)
     if (field.weight(p) > 0.0) by_depth.emplace_back(parallel ? -glm::dot(field.position(p), backward) : glm::length(field.position(p) - eye), static_cast<uint32_t>(p));
   std::sort(by_depth.begin(), by_depth.end());
-  const FilmProjection project{cam};
-  for (const auto& [depth, index] : by_depth) {
-    double px, py, radius;
-    if (!project(field.position(index), kCut * field.h(index), px, py, radius)) continue;
-    const int x0 = std::max(0, static_cast<int>(std::floor((px - radius) / kTile))), x1 = std::min(tiles_x - 1, static_cast<int>(std::floor((px + radius) / kTile)));
-    const int y0 = std::max(0, static_cast<int>(std::floor((py - radius) / kTile))), y1 = std::min(tiles_y - 1, static_cast<int>(std::floor((py + radius) / kTile)));
-    for (int ty = y0; ty <= y1; ++ty)
-      for (int tx = x0; tx <= x1; ++tx) tiles[static_cast<size_t>(ty * tiles_x + tx)].push_back(index);
-  }
   // Where pixel (x, y)'s ray ends, and what leaves that end toward the camera.
   const auto end_of = [&](int x, int y, const Ray& ray, double& t_hit, std::vector<Along>& gathered) {
     t_hit = kInfinity;
@@ -247,6 +229,19 @@ nlohmann::json render_into(const Scene& scene, const ParticleField& field, const
     std::vector<uint32_t> order(by_depth.size());
     std::transform(by_depth.begin(), by_depth.end(), order.begin(), [](const auto& e) { return e.second; });
     return {{"splat_lattice", splat_network(in, order, sink, options)}};
+  }
+  // The march: particles binned to 16 x 16 tiles of pixels by their footprints (march() orders
+  // each ray's).
+  const int tiles_x = (cam.width_px + kTile - 1) / kTile, tiles_y = (cam.height_px + kTile - 1) / kTile;
+  std::vector<std::vector<uint32_t>> tiles(static_cast<size_t>(tiles_x) * static_cast<size_t>(tiles_y));
+  const FilmProjection project{cam};
+  for (const auto& [depth, index] : by_depth) {
+    double px, py, radius;
+    if (!project(field.position(index), kCut * field.h(index), px, py, radius)) continue;
+    const int x0 = std::max(0, static_cast<int>(std::floor((px - radius) / kTile))), x1 = std::min(tiles_x - 1, static_cast<int>(std::floor((px + radius) / kTile)));
+    const int y0 = std::max(0, static_cast<int>(std::floor((py - radius) / kTile))), y1 = std::min(tiles_y - 1, static_cast<int>(std::floor((py + radius) / kTile)));
+    for (int ty = y0; ty <= y1; ++ty)
+      for (int tx = x0; tx <= x1; ++tx) tiles[static_cast<size_t>(ty * tiles_x + tx)].push_back(index);
   }
   ProgressTracker progress(options.progress, static_cast<long long>(tiles.size()));
   parallel_for(static_cast<long long>(tiles.size()), options.threads, 1, [&](long long t0, long long t1) {
