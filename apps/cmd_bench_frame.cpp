@@ -35,6 +35,13 @@
 #endif
 
 namespace haze::app {
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
 namespace {
 
 struct FrameArgs {
@@ -80,12 +87,6 @@ Image host_colour(const std::vector<float>& depth, int width, int height) {
     for (int x = 0; x < width; ++x)
       colour.set(x, y, std::isinf(depth[static_cast<size_t>(y) * static_cast<size_t>(width) + static_cast<size_t>(x)]) ? Rgb(0.05, 0.1, 0.2) : Rgb(0.3, 0.25, 0.2));
   return colour;
-}
-
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  const size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
 struct StageRow {

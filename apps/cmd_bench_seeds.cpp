@@ -184,12 +184,6 @@ Scene frame_scene(const SeedRow& row, const Scene& base, int f) {
   return s;
 }
 
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  const size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
 constexpr double kNotMeasured = std::numeric_limits<double>::quiet_NaN();
 
 struct SeedResult {

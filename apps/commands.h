@@ -30,6 +30,8 @@ Command add_bench(CLI::App& app);
 Command add_bench_frame(CLI::App& bench);
 // `haze bench seeds` under `bench` (cmd_bench_seeds.cpp).
 Command add_bench_seeds(CLI::App& bench);
+// The median of the benchmarks' per-frame times (cmd_bench_frame.cpp).
+double median(std::vector<double> v);
 Command add_methods(CLI::App& app);
 // Every registered method and its settings, for help texts.
 std::string methods_help();
