@@ -346,8 +346,8 @@ RowFrame row_frame_of(const Marcher& m, const Vec3& eye, const Vec3& a, const Ve
   return frame;
 }
 
-// Row y's layers (march_layers) for a camera whose rays leave one eye, in a scene without surfaces
-// of Haze's own and no surface layer asked for: the rays made and clipped in float32 lanes
+// Row y's L_in and T (march_layers) for a camera whose rays leave one eye, in a scene without
+// surfaces of Haze's own (march_layers writes C): the rays made and clipped in float32 lanes
 // (march_row_packet), the kernel, the spans. Buffers per thread, kept.
 void march_row_layers_from(const Marcher& m, const MarchVolume& v, const View& view, const Vec3& eye, int y, LayerSpans out) {
   const auto width = static_cast<size_t>(view.camera.width_px), padded = width + 64;  // whole vectors of any target
@@ -406,7 +406,9 @@ void march_lattice_layers(const Marcher& m, const MarchVolume& v, const View& vi
   thread_local std::vector<float> kept;  // [6][ny][nx]: L_in, then T; this thread's, frame after frame
   std::vector<float>& nodes = kept;
   nodes.reserve(6 * most_x * most_y), nodes.resize(6 * nx * ny);
+  // Row r of the kernel's result (L_in then T per channel): one row per layer where grey.
   const size_t grey = v.channels == 1 ? 0 : 1;
+  const auto result_row = [grey](size_t r) { return r < 3 ? r * grey : 3 + (r - 3) * grey; };
   const auto node_rows = [&](long long j0, long long j1) {
     const size_t padded = nx + 64;
     thread_local std::vector<float> packed, result;
@@ -420,7 +422,7 @@ void march_lattice_layers(const Marcher& m, const MarchVolume& v, const View& vi
       march_row_packet(frame, packed.data(), padded, nx);
       march_rays(v, m.volume.phase, packet_of(packed, result, padded, nx));
       for (size_t r = 0; r < 6; ++r) {
-        const float* from = result.data() + (r < 3 ? r * grey : 3 + (r - 3) * grey) * padded;
+        const float* from = result.data() + result_row(r) * padded;
         std::copy_n(from, nx, nodes.data() + (r * ny + j) * nx);
       }
     }
@@ -481,6 +483,8 @@ void march_lattice_layers(const Marcher& m, const MarchVolume& v, const View& vi
       // Pixels next to a rough node, each its own ray: the runs of them, each a packet.
       const std::uint8_t* near = rough.data() + j * nx;
       const auto own = [&](size_t x) { const size_t i = column[x]; return (near[i] | near[i + 1] | near[i + nx] | near[i + nx + 1]) != 0; };
+      Vec3 a, b;
+      camera.row_frame(y + 0.5, a, b);
       for (size_t x = 0; x < width;) {
         if (!own(x)) {
           ++x;
@@ -488,14 +492,11 @@ void march_lattice_layers(const Marcher& m, const MarchVolume& v, const View& vi
         }
         const size_t run = x;
         while (x < width && own(x)) ++x;
-        Vec3 a, b;
-        camera.row_frame(y + 0.5, a, b);
-        a += static_cast<double>(run) * b;
-        RowFrame frame = row_frame_of(m, eye, a, b);
+        const RowFrame frame = row_frame_of(m, eye, a + static_cast<double>(run) * b, b);
         const size_t count = x - run;
         march_row_packet(frame, packed.data(), padded, count);
         march_rays(v, m.volume.phase, packet_of(packed, result, padded, count));
-        for (size_t r = 0; r < 6; ++r) std::copy_n(result.data() + (r < 3 ? r * grey : 3 + (r - 3) * grey) * padded, count, line.data() + r * padded + run);
+        for (size_t r = 0; r < 6; ++r) std::copy_n(result.data() + result_row(r) * padded, count, line.data() + r * padded + run);
       }
       for (const auto& [span, first] : {std::pair{out.inscatter, size_t(0)}, std::pair{out.transmittance, size_t(3)}}) {
         const float* r = line.data() + first * padded;

@@ -13,6 +13,28 @@ namespace haze::particles {
 namespace {
 constexpr double kMaxValues = 16e6;        // floats per map (64 MB): texels are widened beyond it
 
+// The depth nodes s0 + k ds, k < count, within `reach` of depth t: [first, past the last).
+std::pair<size_t, size_t> nodes_within(double t, double reach, double s0, double ds, size_t count) {
+  const double first = std::max(0.0, std::ceil((t - reach - s0) / ds));
+  const double last = std::min(static_cast<double>(count) - 1.0, std::floor((t + reach - s0) / ds));
+  return {static_cast<size_t>(first), static_cast<size_t>(std::max(0.0, last + 1.0))};
+}
+
+// One Gaussian on the texel ray whose nodes start at depth[base]: nodes [k0, k1) take amplitude
+// times node(k), the nodes past them its whole integral, amplitude (1 + before): into `tail` at
+// the first of them (the running sum carries it on), else into each.
+template <class Node>
+void add_gaussian(float* depth, size_t base, size_t k0, size_t k1, size_t count, double amplitude, double before, const Node& node, float* tail) {
+  for (size_t k = k0; k < k1; ++k) depth[base + k] += static_cast<float>(amplitude * node(k));
+  const auto whole = static_cast<float>(amplitude * (1.0 + before));
+  const size_t after = std::max(k0, k1);
+  if (tail) {
+    if (after < count) tail[base + after] += whole;
+  } else {
+    for (size_t k = after; k < count; ++k) depth[base + k] += whole;
+  }
+}
+
 }  // namespace
 
 LightDepthMap::LightDepthMap(const ParticleField& field, const Light& light, int threads) : light_(light) {
@@ -179,13 +201,13 @@ void LightDepthMap::splat_parallel(Face& f, const Vec3& x, double h, double w, i
   if (t < -kCut * h || i0 > i1 || j0 > j1) return;
   const ErfTable& erf = ErfTable::instance();
   const auto k_count = static_cast<size_t>(nodes_);
-  const auto k0 = static_cast<size_t>(std::max(0.0, std::ceil((t - kCut * h - s0_) / ds_)));
-  const auto k1 = static_cast<size_t>(std::max(0.0, std::min(static_cast<double>(k_count) - 1.0, std::floor((t + kCut * h - s0_) / ds_)) + 1.0));  // past the last
+  const std::pair<size_t, size_t> range = nodes_within(t, kCut * h, s0_, ds_, k_count);
+  const size_t k0 = range.first, k1 = range.second;
   const double before = erf(t / h);
-  thread_local std::vector<double> node, across, down;
-  std::vector<double>& nodes = node;
-  std::vector<double>& column = across;
-  std::vector<double>& row = down;
+  thread_local std::vector<double> kept_nodes, kept_columns, kept_rows;
+  std::vector<double>& nodes = kept_nodes;
+  std::vector<double>& column = kept_columns;
+  std::vector<double>& row = kept_rows;
   nodes.clear(), column.clear(), row.clear();
   for (size_t k = k0; k < k1; ++k) nodes.push_back(erf((s0_ + static_cast<double>(k) * ds_ - t) / h) + before);
   const double texel = 2.0 * extent_ / resolution_;
@@ -198,17 +220,10 @@ void LightDepthMap::splat_parallel(Face& f, const Vec3& x, double h, double w, i
     for (int i = i0; i <= i1; ++i) {
       const double u = column[static_cast<size_t>(i - i0)];
       if (u * u + v * v >= kCut * kCut) continue;
-      const double amplitude = scale * std::exp(-(u * u + v * v));
-      const size_t texel_index = static_cast<size_t>(j) * m + static_cast<size_t>(i), base = texel_index * k_count;
-      for (size_t k = k0; k < k1; ++k) f.depth[base + k] += static_cast<float>(amplitude * nodes[k - k0]);
-      const auto whole = static_cast<float>(amplitude * (1.0 + before));
-      const size_t after = std::max(k0, k1);
-      if (tail) {
-        if (after < k_count) tail[base + after] += whole;
-      } else {
-        for (size_t k = after; k < k_count; ++k) f.depth[base + k] += whole;
-        f.touched[texel_index] = 1;
-      }
+      const size_t texel_index = static_cast<size_t>(j) * m + static_cast<size_t>(i);
+      add_gaussian(f.depth.data(), texel_index * k_count, k0, k1, k_count, scale * std::exp(-(u * u + v * v)), before,
+                   [&](size_t k) { return nodes[k - k0]; }, tail);
+      if (!tail) f.touched[texel_index] = 1;
     }
   }
 }
@@ -275,20 +290,12 @@ void LightDepthMap::splat(Face& f, std::span<const Gaussian> gaussians, bool run
           const double t = glm::dot(to, d), perp2 = glm::dot(to, to) - t * t;
           if (perp2 >= kCut * kCut * h * h || t < -kCut * h) continue;
           const double amplitude = w * std::exp(-perp2 / (h * h)) * h * 0.5 * sqrt_pi, before = erf(t / h);
-          const size_t base = (static_cast<size_t>(j) * static_cast<size_t>(m) + static_cast<size_t>(i)) * k_count;
-          // nodes with s_k in [t - 3h, t + 3h]
-          const auto k0 = static_cast<long long>(std::max(0.0, std::ceil((t - kCut * h - s0_) / ds_)));
-          const auto k1 = std::min(static_cast<long long>(k_count) - 1, static_cast<long long>(std::floor((t + kCut * h - s0_) / ds_)));
-          for (long long k = k0; k <= k1; ++k)
-            f.depth[base + static_cast<size_t>(k)] += static_cast<float>(amplitude * (erf((s0_ + static_cast<double>(k) * ds_ - t) / h) + before));
-          const long long after = std::max(k0, k1 + 1);
-          const auto whole = static_cast<float>(amplitude * (1.0 + before));
-          if (running) {
-            if (after < static_cast<long long>(k_count)) tail[base + static_cast<size_t>(after)] += whole;
-          } else {
-            for (auto k = static_cast<size_t>(after); k < k_count; ++k) f.depth[base + k] += whole;
-            f.touched[static_cast<size_t>(j) * static_cast<size_t>(m) + static_cast<size_t>(i)] = 1;
-          }
+          const size_t texel_index = static_cast<size_t>(j) * static_cast<size_t>(m) + static_cast<size_t>(i);
+          const auto [k0, k1] = nodes_within(t, kCut * h, s0_, ds_, k_count);
+          const double width = h;  // a plain variable: lambdas capture no structured bindings (clang)
+          add_gaussian(f.depth.data(), texel_index * k_count, k0, k1, k_count, amplitude, before,
+                       [&](size_t k) { return erf((s0_ + static_cast<double>(k) * ds_ - t) / width) + before; }, running ? tail.data() : nullptr);
+          if (!running) f.touched[texel_index] = 1;
         }
     }
   });

@@ -2,13 +2,11 @@
 #include <haze/core/error.h>
 #include <haze/core/stopwatch.h>
 #include <haze/particles/network.h>
-#include <haze/particles/splat.h>
 
 #include "erf_table.h"
 #include "network_internal.h"
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 
 namespace haze::particles {
