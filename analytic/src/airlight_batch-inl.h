@@ -238,7 +238,7 @@ HWY_NOINLINE void LayersFromTails(const TailRow& row, const float* HWY_RESTRICT 
   using V = hn::Vec<decltype(d)>;
   const size_t lanes = hn::Lanes(d);
   const bool grey = row.sigma_t[0] == row.sigma_t[1] && row.sigma_t[1] == row.sigma_t[2];
-  const V zero = hn::Zero(d), one = hn::Set(d, 1.0f), three_quarters = hn::Set(d, 0.75f);
+  const V zero = hn::Zero(d), one = hn::Set(d, 1.0f), cancel = hn::Set(d, kTailsCancel);
   for (size_t i = 0; i < row.count; i += lanes) {
     const V t0 = hn::LoadU(d, row.t0 + i), end = hn::LoadU(d, ends + i);
     const auto inside = hn::Gt(end, t0), finite = hn::Lt(end, hn::Set(d, 3e38f));
@@ -248,7 +248,7 @@ HWY_NOINLINE void LayersFromTails(const TailRow& row, const float* HWY_RESTRICT 
     for (int c = 0; c < 3; ++c) {
       t[c] = c > 0 && grey ? t[0] : hn::IfThenElseZero(finite, hn::Exp(d, hn::Mul(hn::Set(d, -row.sigma_t[c]), length)));
       const V whole = hn::LoadU(d, row.whole[c] + i), far = hn::Mul(t[c], hn::LoadU(d, sums[c] + i));
-      cancels = hn::Or(cancels, hn::Gt(far, hn::Mul(three_quarters, whole)));
+      cancels = hn::Or(cancels, hn::Gt(far, hn::Mul(cancel, whole)));
       l[c] = hn::IfThenElseZero(inside, hn::Max(zero, hn::Sub(whole, far)));
     }
     for (int c = 0; c < 3; ++c) t[c] = hn::IfThenElse(inside, t[c], one);

@@ -124,7 +124,7 @@ void layers_from_tails_reference(const TailRow& row, const float* ends, const fl
       }
       t[c] = c > 0 && grey ? t[0] : std::isfinite(end) ? std::exp(-row.sigma_t[c] * (end - t0)) : 0.0f;
       const float far = t[c] * sums[c][i];
-      cancels = cancels || far > 0.75f * row.whole[c][i];
+      cancels = cancels || far > kTailsCancel * row.whole[c][i];
       l[c] = std::max(0.0f, row.whole[c][i] - far);
     }
     redo[i] = cancels ? 1.0f : 0.0f;

@@ -7,6 +7,7 @@
 // airlight onto a surface is not shadowed. Like the thesis' model it has no multiple scattering.
 #include <haze/analytic/airlight.h>
 #include <haze/analytic/airlight_batch.h>
+#include <haze/analytic/surface_batch.h>
 #include <haze/analytic/methods.h>
 #include <haze/core/features.h>
 #include <haze/core/error.h>
@@ -104,7 +105,15 @@ class AnalyticSolution final : public MethodSolution {
         table_(std::move(table)),
         lambert_(std::move(lambert)),
         phong_(std::move(phong)) {
-    for (const AnalyticLight& light : lights_) positions_.insert(positions_.end(), {light.position.x, light.position.y, light.position.z});
+    for (const AnalyticLight& light : lights_) {
+      positions_.insert(positions_.end(), {light.position.x, light.position.y, light.position.z});
+      shadows_.emplace_back(scene_.surfaces, light.position);
+    }
+    const Aabb box = medium_->bounds();
+    for (int e = 0; e < 3; ++e) {
+      shading_medium_.lo[e] = box.lo[e], shading_medium_.hi[e] = box.hi[e];
+      shading_medium_.sigma_t[e] = static_cast<float>(sigma_t_[e]), shading_medium_.sigma_s[e] = static_cast<float>(sigma_s_[e]);
+    }
   }
 
   RenderResult render(const View& view, const RenderOptions& options) const override {
@@ -113,6 +122,23 @@ class AnalyticSolution final : public MethodSolution {
     const Stopwatch watch;
     RenderResult result = RenderResult::for_view(view);
     ProgressTracker progress(options.progress, camera.height_px);
+    if (layers_pass()) {  // render_layers' rows
+      parallel_for(camera.height_px, options.threads, 1, [&](long long y0, long long y1) {
+        for (auto y = static_cast<int>(y0); y < y1 && !progress.cancelled(); ++y) {
+          const float* rgb = row_layers(view, y);
+          const size_t padded = padded_count(static_cast<size_t>(camera.width_px));
+          const auto at = [&](size_t part, int x) {
+            const float* v = rgb + 3 * (part * padded + static_cast<size_t>(x));
+            return Rgb(v[0], v[1], v[2]);
+          };
+          for (int x = 0; x < camera.width_px; ++x) result.set(x, y, PixelLayers{at(0, x), at(1, x), at(2, x)});
+          progress.advance();
+        }
+      });
+      progress.throw_if_cancelled();
+      result.stats = {{"seconds", watch.seconds()}};
+      return result;
+    }
     const AirlightKernel add_airlight = kernel_;
     const SurfaceShading shade{*medium_, scene_.surfaces, lights_, sigma_t_, sigma_s_, grey_, surface_airlight_, lambert_, phong_};
     parallel_for(camera.height_px, options.threads, 1, [&](long long y0, long long y1) {
@@ -257,11 +283,11 @@ class AnalyticSolution final : public MethodSolution {
   }
 
   // Per pixel, a row of rays in SIMD lanes: L_in = sum of sigma_s I (g(t0) - T g(end)) to each ray's
-  // end, the tails' form of render_distances. Where T g(end) is above 3/4 of g(t0) the difference
-  // would lose more than the table's 1e-3 to cancellation (short stretches): those pixels take the
-  // float64 segment path render() takes for them.
+  // end, the tails' form of render_distances, surfaces' shadows cutting it into lit stretches
+  // (row_layers). Where T g(end) is above kTailsCancel of g(t0) (airlight_batch.h: what the
+  // difference keeps below it) the pixel takes the float64 segment path. render() takes the same rows.
   bool render_layers(const View& view, LayerSpans out, const RenderOptions& options) const override {
-    if (!one_pass()) return false;
+    if (!layers_pass()) return false;
     const auto body = [&](long long y0, long long y1) {
       for (auto y = static_cast<int>(y0); y < y1; ++y) layers_row(view, y, out);
     };
@@ -318,11 +344,14 @@ class AnalyticSolution final : public MethodSolution {
   }
 
  private:
-  // Point lights without surfaces, the SIMD kernel: render_distances' one pass (and add_glow's).
-  bool one_pass() const {
-    if (!scene_.surfaces.empty() || !airlight_ || kernel_ != &add_airlight) return false;
+  // Point lights, the SIMD kernel: render_layers' rows of tails (surfaces shadowing the airlight
+  // and shaded in SIMD lanes).
+  bool layers_pass() const {
+    if (!airlight_ || kernel_ != &add_airlight) return false;
     return std::none_of(lights_.begin(), lights_.end(), [](const AnalyticLight& light) { return light.spot(); });
   }
+  // And without surfaces: render_distances' one pass (and add_glow's).
+  bool one_pass() const { return layers_pass() && scene_.surfaces.empty(); }
   // Cameras whose rays leave one eye: a light's glow is about its direction from there.
   static bool glows(const Camera& camera) {
     return camera.type == Camera::Type::pinhole || (camera.type == Camera::Type::matrices && camera.projection[2][3] != 0.0);
@@ -342,6 +371,11 @@ class AnalyticSolution final : public MethodSolution {
   struct RowRays {
     TailRow row;
     float *t0, *t1, *whole[3];  // whole: where tail_sums puts the row's sums at t0 (row.whole)
+    TailLight* tails;           // the row's, tails_per_light of them per light
+    size_t tails_per_light;
+    float* geometry;            // per light: t, h, share (count rounded up to 16 each)
+    size_t padded;
+    float* share(size_t l) const { return geometry + (3 * l + 2) * padded; }
   };
   // The kernels' arrays hold whole vectors: count rounded up to 16 (airlight_batch.h).
   static size_t padded_count(size_t count) { return (count + 15) / 16 * 16; }
@@ -392,7 +426,7 @@ class AnalyticSolution final : public MethodSolution {
     }
     TailRow row{tails.data(), tails.size(), t0, t1, {whole, whole + padded, whole + 2 * padded}, {}, count};
     for (int c = 0; c < 3; ++c) row.sigma_t[c] = static_cast<float>(sigma_t_[c]);
-    return {row, t0, t1, {whole, whole + padded, whole + 2 * padded}};
+    return {row, t0, t1, {whole, whole + padded, whole + 2 * padded}, tails.data(), grey_ ? size_t(1) : size_t(3), geometry, padded};
   }
 
   // render_distances' row y: the row's rays, then its slices.
@@ -415,14 +449,14 @@ class AnalyticSolution final : public MethodSolution {
     const float* ends;
     const float* sums[3];
   };
-  EndTails end_tails(const View& view, int y, int x0, const RowRays& r, size_t count) const {
+  EndTails end_tails(const float* depth, const RowRays& r, size_t count) const {
     const size_t padded = padded_count(count);
-    thread_local std::vector<float> ends, at, at_end;
+    thread_local std::vector<float> kept_ends, kept_at, kept_sums;
+    std::vector<float>&ends = kept_ends, &at = kept_at, &at_end = kept_sums;
     ends.assign(padded, 0.0f), at.assign(padded, 0.0f), at_end.assign(3 * padded, 0.0f);
     bool any_end = false;
     for (size_t i = 0; i < count; ++i) {
-      const double depth = view.max_distance(x0 + static_cast<int>(i), y);
-      ends[i] = !(depth >= 0.0) ? r.t0[i] : std::min(r.t1[i], std::isfinite(depth) ? static_cast<float>(depth) : INFINITY);
+      ends[i] = !(depth[i] >= 0.0f) ? r.t0[i] : std::min(r.t1[i], depth[i]);
       at[i] = std::isfinite(ends[i]) ? std::max(ends[i], r.t0[i]) : r.t0[i];
       any_end = any_end || std::isfinite(ends[i]);
     }
@@ -431,66 +465,252 @@ class AnalyticSolution final : public MethodSolution {
     if (any_end) tail_sums(table_, r.row, at.data(), sums);
     return {ends.data(), {sums[0], sums[1], sums[2]}};
   }
-
-  // layers_from_tails over the row into the thread's kept buffer: L_in, then T (RGB triples), then
-  // the flags of the pixels to redo, each part count rounded up to 16 long.
-  static float* tails_to_layers(const RowRays& r, const EndTails& e, size_t count) {
-    thread_local std::vector<float> layers;
-    const size_t padded = padded_count(count);
-    layers.resize(7 * padded);
-    layers_from_tails(r.row, e.ends, e.sums, layers.data(), layers.data() + 3 * padded, layers.data() + 6 * padded);
-    return layers.data();
+  // The view's depths along pixels [x0, x0 + count) of row y, into the thread's kept buffer.
+  static const float* view_depths(const View& view, int y, int x0, size_t count) {
+    thread_local std::vector<float> kept;
+    std::vector<float>& depth = kept;
+    depth.resize(count);
+    for (size_t i = 0; i < count; ++i) depth[i] = static_cast<float>(view.max_distance(x0 + static_cast<int>(i), y));
+    return depth.data();
   }
 
-  // render_layers' row y.
-  void layers_row(const View& view, int y, LayerSpans out) const {
+  // layers_from_tails over the row into `layers`: L_in, then T (RGB triples), then the flags of the
+  // pixels to redo, each part count rounded up to 16 long.
+  static void tails_to_layers(const RowRays& r, const EndTails& e, size_t count, float* layers) {
+    const size_t padded = padded_count(count);
+    layers_from_tails(r.row, e.ends, e.sums, layers, layers + 3 * padded, layers + 6 * padded);
+  }
+
+  // A lit stretch [a, b] of ray x toward light l, where the light's shadows cut the ray.
+  struct LitPiece {
+    size_t x, light;
+    double a, b;
+  };
+
+  // Row y's layers into the thread's kept buffer: L_in, T and the surface's radiance as RGB triples,
+  // each part the row's width rounded up to 16 long. The tails at each ray's entry and end, each
+  // light's share 0 on rays its shadows touch; where they cut a ray, its lit stretches' tails
+  // added light by light; pixels whose difference of tails would cancel (airlight_batch.h) by the
+  // float64 path; the surfaces' radiance by shade_points, surface by surface.
+  const float* row_layers(const View& view, int y) const {
     const Camera& camera = view.camera;
     const auto width = static_cast<size_t>(camera.width_px);
-    const RowRays r = ray_tails(camera, y, 0, width, 0.0, lights_.size(), false);
-    const EndTails e = end_tails(view, y, 0, r, width);
-    const size_t padded = padded_count(width);
-    float* const l_rgb = tails_to_layers(r, e, width);
+    const size_t padded = padded_count(width), lights = lights_.size();
+    const std::vector<Surface>& surfaces = scene_.surfaces;
+    const RowRays r = ray_tails(camera, y, 0, width, 0.0, lights, false);
+    struct Hit {
+      const Surface* surface;
+      double t;
+      Vec3 normal;
+    };
+    thread_local std::vector<Hit> kept_hits;
+    thread_local std::vector<Ray> kept_rays;
+    thread_local std::vector<float> kept_depth, kept_layers;
+    thread_local std::vector<LitPiece> kept_pieces;
+    thread_local std::vector<std::pair<double, double>> kept_stretches;
+    std::vector<Hit>& hits = kept_hits;
+    std::vector<Ray>& rays = kept_rays;
+    std::vector<LitPiece>& pieces = kept_pieces;
+    std::vector<std::pair<double, double>>& stretches = kept_stretches;
+    std::vector<float>& layers = kept_layers;
+    layers.assign(10 * padded, 0.0f);
+    float* const l_rgb = layers.data();
     float* const t_rgb = l_rgb + 3 * padded;
-    const float* const redo_at = t_rgb + 3 * padded;
+    float* const s_rgb = t_rgb + 3 * padded;
+    float* const redo = s_rgb + 3 * padded;
+    // Each ray's end: the view's depth, or the nearest surface before it.
+    const float* depth = view_depths(view, y, 0, width);
+    if (!surfaces.empty()) {
+      rays.resize(width), hits.resize(width);
+      camera.row_rays(y, rays.data());
+      kept_depth.assign(depth, depth + width);
+      for (size_t x = 0; x < width; ++x) {
+        Hit& h = hits[x];
+        h.surface = nearest_surface(surfaces, rays[x], view.max_distance(static_cast<int>(x), y), h.t, h.normal);
+        if (h.surface) kept_depth[x] = static_cast<float>(h.t);
+      }
+      depth = kept_depth.data();
+    }
+    // Each light's shadows along the rays: its share 1 where it lights all of a ray's stretch in
+    // the medium, else 0 with the lit stretches of those it lights in part.
+    pieces.clear();
+    for (size_t l = 0; l < lights && !surfaces.empty(); ++l) {
+      float* const share = r.share(l);
+      bool whole = true;
+      for (size_t x = 0; x < width; ++x) {
+        const double t0 = r.t0[x], end = !(depth[x] >= 0.0f) ? t0 : std::min(static_cast<double>(r.t1[x]), static_cast<double>(depth[x]));
+        const LightShadows::Stretch seen = shadows_[l].classify(rays[x], t0, end);
+        share[x] = seen == LightShadows::Stretch::lit ? 1.0f : 0.0f;
+        whole = whole && seen == LightShadows::Stretch::lit;
+        if (seen != LightShadows::Stretch::partial) continue;
+        stretches.clear();
+        lit_stretches(surfaces, rays[x], t0, end, lights_[l].position, stretches);
+        for (const auto& [a, b] : stretches) pieces.push_back({x, l, a, b});
+      }
+      for (size_t k = 0; k < r.tails_per_light; ++k) r.tails[l * r.tails_per_light + k].share = whole ? nullptr : share;
+    }
+    const EndTails e = end_tails(depth, r, width);
+    tails_to_layers(r, e, width, layers.data());
+    add_lit_pieces(r, pieces, l_rgb, redo);
     for (size_t x = 0; x < width; ++x)
-      if (redo_at[x] != 0.0f) {
+      if (redo[x] != 0.0f) {
         const Rgb l = exact_airlight(camera.pixel_ray(static_cast<int>(x), y), r.t0[x], e.ends[x]);
         for (int c = 0; c < 3; ++c) l_rgb[3 * x + c] = static_cast<float>(l[c]);
       }
-    const auto copy_row = [&](const float* rgb, ImageSpan to) {
-      if (to.channels == 3) {
-        std::copy_n(rgb, 3 * width, to.pixel(0, y));
-        return;
-      }
-      for (size_t x = 0; x < width; ++x) std::copy_n(rgb + 3 * x, 3, to.pixel(static_cast<int>(x), y));
-    };
-    copy_row(l_rgb, out.inscatter), copy_row(t_rgb, out.transmittance);
-    if (out.surface.data)  // the background where nothing ends the ray, else the host's (0)
-      for (size_t x = 0; x < width; ++x) {
-        const auto px = static_cast<int>(x);
-        const Rgb surface = std::isinf(view.max_distance(px, y)) ? scene_.background : Rgb(0.0);
-        float* si = out.surface.pixel(px, y);
-        for (int c = 0; c < 3; ++c) si[c] = static_cast<float>(surface[c]);
-      }
+    // The surfaces: the background where nothing ends the ray, the host's (0) behind its depth.
+    for (size_t x = 0; x < width; ++x) {
+      const bool open = std::isinf(view.max_distance(static_cast<int>(x), y)) && (surfaces.empty() || !hits[x].surface);
+      for (int c = 0; c < 3; ++c) s_rgb[3 * x + c] = open ? static_cast<float>(scene_.background[c]) : 0.0f;
+    }
+    for (const Surface& surface : surfaces) shade_row(surface, rays, hits, s_rgb);
+    return layers.data();
   }
 
-  // The point lights' airlight along [t0, end] of a ray by the float64 segment path.
+  // The lit pieces' airlight added light by light: per piece e^(-sigma_t (a - t0)) S(a) - e^(-sigma_t
+  // (b - t0)) S(b), S the light's tails; a piece whose difference would cancel flags its ray.
+  void add_lit_pieces(const RowRays& r, const std::vector<LitPiece>& pieces, float* l_rgb, float* redo) const {
+    thread_local std::vector<float> kept;
+    std::vector<float>& scratch = kept;
+    for (size_t l = 0; l < lights_.size(); ++l) {
+      size_t count = 0;
+      for (const LitPiece& p : pieces) count += p.light == l;
+      if (count == 0) continue;
+      const size_t padded = padded_count(count);
+      scratch.assign(26 * padded, 0.0f);
+      float *t = scratch.data(), *h = t + padded, *a = h + padded, *b = a + padded, *sa = b + padded, *sb = sa + 3 * padded;
+      float *t0 = sb + 3 * padded, *ta = t0 + padded, *tb = ta + 3 * padded, *b_at = tb + 3 * padded, *unused = b_at + padded;
+      size_t k = 0;
+      for (const LitPiece& p : pieces) {
+        if (p.light != l) continue;
+        t[k] = r.geometry[3 * l * r.padded + p.x], h[k] = r.geometry[(3 * l + 1) * r.padded + p.x], t0[k] = r.t0[p.x];
+        a[k] = static_cast<float>(p.a), b[k] = std::isfinite(p.b) ? static_cast<float>(p.b) : INFINITY;
+        ++k;
+      }
+      TailLight tails[3];
+      for (size_t c = 0; c < r.tails_per_light; ++c) {
+        tails[c] = r.tails[l * r.tails_per_light + c];
+        tails[c].t = t, tails[c].h = h, tails[c].share = nullptr;
+      }
+      TailRow row{tails, r.tails_per_light, nullptr, nullptr, {}, {}, count};
+      float* const at_a[3] = {sa, sa + padded, sa + 2 * padded};
+      float* const at_b[3] = {sb, sb + padded, sb + 2 * padded};
+      tail_sums(table_, row, a, at_a);
+      for (size_t i = 0; i < count; ++i) b_at[i] = std::isfinite(b[i]) ? b[i] : a[i];  // an endless piece: T = 0 takes its tails
+      tail_sums(table_, row, b_at, at_b);
+      // e^(-sigma_t (a - t0)) and e^(-sigma_t (b - t0)) per channel in lanes: layers_from_tails'
+      // transmittance from t0 to a and to b (its L_in, from zero tails, unused).
+      row.t0 = t0, row.whole[0] = row.whole[1] = row.whole[2] = unused;
+      for (size_t c = 0; c < 3; ++c) row.sigma_t[c] = static_cast<float>(sigma_t_[c]);
+      layers_from_tails(row, a, row.whole, unused, ta, unused);
+      layers_from_tails(row, b, row.whole, unused, tb, unused);
+      k = 0;
+      for (const LitPiece& p : pieces) {
+        if (p.light != l) continue;
+        for (size_t c = 0; c < 3; ++c) {
+          const float near = ta[3 * k + c] * at_a[c][k], far = tb[3 * k + c] * at_b[c][k];
+          if (far > kTailsCancel * near) redo[p.x] = 1.0f;
+          l_rgb[3 * p.x + c] += std::max(0.0f, near - far);
+        }
+        ++k;
+      }
+    }
+  }
+
+  // The row's pixels that hit `surface`, shaded in SIMD lanes into s_rgb (RGB triples).
+  template <class Hits>
+  void shade_row(const Surface& surface, const std::vector<Ray>& rays, const Hits& hits, float* s_rgb) const {
+    const size_t lights = lights_.size();
+    thread_local std::vector<size_t> kept_at;
+    thread_local std::vector<float> kept;
+    std::vector<size_t>& at = kept_at;
+    at.clear();
+    for (size_t x = 0; x < hits.size(); ++x)
+      if (hits[x].surface == &surface) at.push_back(x);
+    if (at.empty()) return;
+    const size_t padded = padded_count(at.size());
+    std::vector<float>& f = kept;
+    f.assign((10 + lights + 3) * padded, 0.0f);
+    const auto part = [&](size_t k) { return f.data() + k * padded; };
+    const Aabb bounds = medium_->bounds();
+    const auto* sphere = std::get_if<Sphere>(&surface.shape);
+    for (size_t i = 0; i < at.size(); ++i) {
+      const auto& h = hits[at[i]];
+      const Ray& ray = rays[at[i]];
+      const Vec3 p = ray.at(h.t);
+      for (size_t e = 0; e < 3; ++e) {
+        part(e)[i] = static_cast<float>(p[static_cast<int>(e)]), part(3 + e)[i] = static_cast<float>(h.normal[static_cast<int>(e)]);
+        part(6 + e)[i] = static_cast<float>(ray.direction[static_cast<int>(e)]);
+      }
+      part(9)[i] = surface_airlight_ && bounds.contains(off_surface(p, h.normal)) ? 1.0f : 0.0f;
+      // A plane, or a sphere seen from outside, hides nothing on its lit side from its own point.
+      const bool outer = std::holds_alternative<Plane>(surface.shape) || (sphere && glm::dot(h.normal, p - sphere->center) > 0.0);
+      for (size_t l = 0; l < lights; ++l) {
+        const bool seen = glm::dot(lights_[l].position - p, h.normal) > 0.0 && !shadows_[l].hidden(p, outer ? &surface : nullptr);
+        part(10 + l)[i] = seen ? 1.0f : 0.0f;
+      }
+    }
+    thread_local std::vector<ShadingLight> kept_lights;
+    std::vector<ShadingLight>& shading = kept_lights;
+    shading.clear();
+    for (size_t l = 0; l < lights; ++l) {
+      const AnalyticLight& light = lights_[l];
+      shading.push_back({{static_cast<float>(light.position.x), static_cast<float>(light.position.y), static_cast<float>(light.position.z)},
+                         {static_cast<float>(light.intensity.r), static_cast<float>(light.intensity.g), static_cast<float>(light.intensity.b)},
+                         part(10 + l)});
+    }
+    const ShadingMaterial material{{static_cast<float>(surface.kd.r), static_cast<float>(surface.kd.g), static_cast<float>(surface.kd.b)},
+                                   {static_cast<float>(surface.ks.r), static_cast<float>(surface.ks.g), static_cast<float>(surface.ks.b)},
+                                   static_cast<float>(surface.shininess),
+                                   surface_airlight_ && lambert_ && surface.kd != Rgb(0.0) ? &*lambert_ : nullptr,
+                                   surface_airlight_ && surface.ks != Rgb(0.0) ? &phong_.at(surface.shininess) : nullptr};
+    const ShadingPoints points{{part(0), part(1), part(2)}, {part(3), part(4), part(5)}, {part(6), part(7), part(8)}, part(9), at.size()};
+    float* const radiance = part(10 + lights);
+    shade_points(shading_medium_, material, shading.data(), lights, points, radiance);
+    for (size_t i = 0; i < at.size(); ++i) std::copy_n(radiance + 3 * i, 3, s_rgb + 3 * at[i]);
+  }
+
+  // render_layers' row y, copied into the caller's spans.
+  void layers_row(const View& view, int y, LayerSpans out) const {
+    const auto width = static_cast<size_t>(view.camera.width_px);
+    const size_t padded = padded_count(width);
+    const float* const rgb = row_layers(view, y);
+    const auto copy_row = [&](const float* from, ImageSpan to) {
+      if (!to.data) return;
+      if (to.channels == 3) {
+        std::copy_n(from, 3 * width, to.pixel(0, y));
+        return;
+      }
+      for (size_t x = 0; x < width; ++x) std::copy_n(from + 3 * x, 3, to.pixel(static_cast<int>(x), y));
+    };
+    copy_row(rgb, out.inscatter), copy_row(rgb + 3 * padded, out.transmittance), copy_row(rgb + 6 * padded, out.surface);
+  }
+
+  // The point lights' airlight along [t0, end] of a ray by the float64 segment path, over the
+  // stretches each light lights.
   Rgb exact_airlight(const Ray& ray, double t0, double end) const {
-    const Vec3 o = ray.at(t0);
-    const float ox = static_cast<float>(o.x), oy = static_cast<float>(o.y), oz = static_cast<float>(o.z);
-    const float dx = static_cast<float>(ray.direction.x), dy = static_cast<float>(ray.direction.y), dz = static_cast<float>(ray.direction.z);
-    const float length = std::isfinite(end) ? static_cast<float>(end - t0) : INFINITY;
-    const SegmentBatch segment{&ox, &oy, &oz, &dx, &dy, &dz, &length, 1};
+    const Ray entry{ray.at(t0), ray.direction};
+    thread_local std::vector<std::pair<double, double>> kept;
+    std::vector<std::pair<double, double>>& stretches = kept;
     Rgb sum(0.0);
     for (const auto& light : lights_) {
       const Vec3& p = light.position;
-      for (int c = 0; c < (grey_ ? 1 : 3); ++c) {
-        float v = 0.0f;
-        add_airlight_float64(table_, {static_cast<float>(p.x), static_cast<float>(p.y), static_cast<float>(p.z), static_cast<float>(sigma_t_[c]),
-                                      static_cast<float>(sigma_s_[c]), grey_ ? 1.0f : static_cast<float>(light.intensity[c])},
-                             segment, &v);
-        if (grey_) sum += static_cast<double>(v) * light.intensity;
-        else sum[c] += static_cast<double>(v);
+      stretches.clear();
+      if (scene_.surfaces.empty()) stretches.emplace_back(0.0, end - t0);
+      else lit_stretches(scene_.surfaces, entry, 0.0, end - t0, p, stretches);
+      for (const auto& [a, b] : stretches) {
+        const Vec3 o = entry.at(a);
+        const float ox = static_cast<float>(o.x), oy = static_cast<float>(o.y), oz = static_cast<float>(o.z);
+        const float dx = static_cast<float>(ray.direction.x), dy = static_cast<float>(ray.direction.y), dz = static_cast<float>(ray.direction.z);
+        const float length = std::isfinite(b) ? static_cast<float>(b - a) : INFINITY;
+        const SegmentBatch segment{&ox, &oy, &oz, &dx, &dy, &dz, &length, 1};
+        for (int c = 0; c < (grey_ ? 1 : 3); ++c) {
+          float v = 0.0f;
+          add_airlight_float64(table_, {static_cast<float>(p.x), static_cast<float>(p.y), static_cast<float>(p.z), static_cast<float>(sigma_t_[c]),
+                                        static_cast<float>(sigma_s_[c]), grey_ ? 1.0f : static_cast<float>(light.intensity[c])},
+                               segment, &v);
+          if (grey_) sum += std::exp(-sigma_t_[c] * a) * static_cast<double>(v) * light.intensity;
+          else sum[c] += std::exp(-sigma_t_[c] * a) * static_cast<double>(v);
+        }
       }
     }
     return sum;
@@ -501,7 +721,10 @@ class AnalyticSolution final : public MethodSolution {
   void glow_row(const View& view, size_t l, double glow_angle, int y, int x0, int x1, ImageSpan out) const {
     const auto count = static_cast<size_t>(x1 - x0);
     const RowRays r = ray_tails(view.camera, y, x0, count, glow_angle, l, true);
-    const float* const layers = tails_to_layers(r, end_tails(view, y, x0, r, count), count);  // no float64 redo here
+    thread_local std::vector<float> kept;
+    std::vector<float>& layers = kept;
+    layers.resize(7 * padded_count(count));
+    tails_to_layers(r, end_tails(view_depths(view, y, x0, count), r, count), count, layers.data());  // no float64 redo here
     for (size_t i = 0; i < count; ++i) {
       float* pixel = out.pixel(x0 + static_cast<int>(i), y);
       for (int c = 0; c < 3; ++c) pixel[c] += layers[3 * i + static_cast<size_t>(c)];
@@ -537,6 +760,8 @@ class AnalyticSolution final : public MethodSolution {
   const Scene scene_;
   const std::vector<AnalyticLight> lights_;
   std::vector<double> positions_;  // the lights' positions, xyz each (RowGeometry::lights)
+  std::vector<LightShadows> shadows_;  // per light, over scene_.surfaces
+  ShadingMedium shading_medium_;
   const std::unique_ptr<Medium> medium_;
   const Rgb sigma_t_, sigma_s_;
   const bool grey_, airlight_, surface_airlight_;

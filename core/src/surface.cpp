@@ -67,17 +67,26 @@ bool occluded(const std::vector<Surface>& surfaces, const Vec3& x, const Vec3& d
 
 namespace {
 
-// The roots of a t^2 + b t + c = 0 (a may be 0), appended.
-void roots(double a, double b, double c, std::vector<double>& out) {
+// The roots of a t^2 + b t + c = 0 (a may be 0) into r; how many.
+int solve(double a, double b, double c, double r[2]) {
   if (std::abs(a) < 1e-300) {
-    if (b != 0.0) out.push_back(-c / b);
-    return;
+    if (b == 0.0) return 0;
+    r[0] = -c / b;
+    return 1;
   }
   const double d = b * b - 4.0 * a * c;
-  if (d < 0.0) return;
+  if (d < 0.0) return 0;
   const double q = -0.5 * (b + std::copysign(std::sqrt(d), b));  // stable form
-  out.push_back(q / a);
-  if (q != 0.0) out.push_back(c / q);
+  r[0] = q / a;
+  if (q == 0.0) return 1;
+  r[1] = c / q;
+  return 2;
+}
+
+// The roots, appended.
+void roots(double a, double b, double c, std::vector<double>& out) {
+  double r[2];
+  out.insert(out.end(), r, r + solve(a, b, c, r));
 }
 
 // Where `lit` changes along [t0, t1]: 64 points (u / (1 - u) past t0 for an infinite t1), each
@@ -109,7 +118,9 @@ void mesh_shadow_edges(double t0, double t1, const Lit& lit, std::vector<double>
 void lit_stretches(const std::vector<Surface>& surfaces, const Ray& ray, double t0, double t1, const Vec3& light,
                    std::vector<std::pair<double, double>>& out) {
   if (!(t1 > t0)) return;
-  std::vector<double> cuts;
+  thread_local std::vector<double> kept;  // a frame allocates nothing
+  std::vector<double>& cuts = kept;
+  cuts.clear();
   const Vec3& o = ray.origin;
   const Vec3& d = ray.direction;
   auto lit = [&](double t) {
@@ -153,6 +164,79 @@ void lit_stretches(const std::vector<Surface>& surfaces, const Ray& ray, double 
     if (!is_lit && open) out.emplace_back(start, a), open = false;
   }
   if (open) out.emplace_back(start, t1);
+}
+
+LightShadows::LightShadows(const std::vector<Surface>& surfaces, const Vec3& light) : light_(light) {
+  for (const Surface& s : surfaces) {
+    if (std::holds_alternative<Mesh>(s.shape)) meshes_.push_back(&s);
+    if (const auto* plane = std::get_if<Plane>(&s.shape)) planes_.push_back({&s, plane->point, plane->normal, glm::dot(light - plane->point, plane->normal)});
+    if (const auto* sphere = std::get_if<Sphere>(&s.shape)) {
+      const Vec3 lc = sphere->center - light;
+      const double dist2 = glm::dot(lc, lc), r2 = sphere->radius * sphere->radius;
+      spheres_.push_back({&s, sphere->center, dist2 > 0.0 ? lc / std::sqrt(dist2) : Vec3(0.0), r2, dist2 > r2 ? 1.0 - r2 / dist2 : 0.0});
+    }
+  }
+}
+
+bool LightShadows::hidden(const Vec3& x, const Surface* self) const {
+  const Vec3 e = light_ - x;  // s in (0, 1) runs from x to the light
+  const double length2 = glm::dot(e, e);
+  if (!(length2 > 0.0)) return false;
+  const double length = std::sqrt(length2), s_min = kSurfaceOffset / length, s_max = 1.0 - 1e-9;  // occluded()'s bounds
+  for (const Face& p : planes_) {
+    if (p.surface == self) continue;
+    // Surface::intersect's root along x -> light: where the plane separates them.
+    const double denom = glm::dot(e, p.normal);
+    if (std::abs(denom) < 1e-12 * length) continue;
+    const double s = glm::dot(p.point - x, p.normal) / denom;
+    if (s > s_min && s < s_max) return true;
+  }
+  for (const Cone& c : spheres_) {
+    if (c.surface == self) continue;
+    const Vec3 oc = x - c.center;
+    const double b = glm::dot(oc, e), cc = glm::dot(oc, oc) - c.r2, disc = b * b - length2 * cc;
+    if (disc < 0.0) continue;
+    const double root = std::sqrt(disc), s1 = (-b - root) / length2, s2 = (-b + root) / length2;
+    if ((s1 > s_min && s1 < s_max) || (s2 > s_min && s2 < s_max)) return true;
+  }
+  for (const Surface* m : meshes_)
+    if (std::get<Mesh>(m->shape).triangles->occluded(Ray{x, e / length}, kSurfaceOffset, length * s_max)) return true;
+  return false;
+}
+
+LightShadows::Stretch LightShadows::classify(const Ray& ray, double t0, double t1) const {
+  if (!(t1 > t0)) return Stretch::lit;
+  if (!meshes_.empty()) return Stretch::partial;
+  const Vec3& o = ray.origin;
+  const Vec3& d = ray.direction;
+  const double dd = glm::dot(d, d);
+  // An edge inside (t0, t1), a root of a t^2 + b t + c there that `keep` takes: short of the ends
+  // by 1e-6 of the stretch (a ray ending on a surface has that surface's root at its end, in or out
+  // by rounding; a sliver that thin is decided with the rest).
+  const double margin = 1e-6 * (std::isfinite(t1) ? t1 - t0 : 1.0 + std::abs(t0));
+  const auto crosses = [&](double a, double b, double c, auto&& keep) {
+    double r[2];
+    const int n = solve(a, b, c, r);
+    for (int k = 0; k < n; ++k)
+      if (r[k] > t0 + margin && r[k] < t1 - margin && keep(r[k])) return true;
+    return false;
+  };
+  const auto any = [](double) { return true; };
+  for (const Face& p : planes_)
+    if (crosses(0.0, glm::dot(d, p.normal), glm::dot(o - p.point, p.normal), any)) return Stretch::partial;
+  const Vec3 w = o - light_;
+  for (const Cone& s : spheres_) {
+    const Vec3 oc = o - s.center;
+    if (crosses(dd, 2.0 * glm::dot(oc, d), glm::dot(oc, oc) - s.r2, any)) return Stretch::partial;
+    if (s.cos2 == 0.0) continue;  // the light inside: the sphere's surface is the only edge
+    const double dv = glm::dot(d, s.axis), wv = glm::dot(w, s.axis);
+    // The nappe beyond the light: (x - L) . axis > 0.
+    if (crosses(dv * dv - s.cos2 * dd, 2.0 * (wv * dv - s.cos2 * glm::dot(w, d)), wv * wv - s.cos2 * glm::dot(w, w),
+                [&](double t) { return wv + t * dv > 0.0; }))
+      return Stretch::partial;
+  }
+  const double mid = std::isfinite(t1) ? 0.5 * (t0 + t1) : t0 + 1.0 + std::abs(t0);
+  return hidden(ray.at(mid)) ? Stretch::dark : Stretch::lit;
 }
 
 }  // namespace haze

@@ -3,6 +3,7 @@
 #include <haze/core/camera.h>
 #include <haze/core/rng.h>
 #include <haze/analytic/airlight_batch.h>
+#include <haze/analytic/surface_batch.h>
 
 #include <glm/ext/matrix_clip_space.hpp>
 #include <glm/ext/matrix_transform.hpp>
@@ -218,6 +219,38 @@ TEST_P(AirlightBatchTargets, LayersFromTailsMatchScalarReference) {
 
 // A row frame's geometry in float64 lanes against the same rays one at a time: pinhole and a host's
 // perspective matrices, in a box and unbounded, a light on a ray among them.
+// Surface shading in lanes against its scalar reference: points on and off a box of fog, lights
+// seen and hidden, Lambert and Phong with their J tables, grey and coloured media.
+TEST_P(AirlightBatchTargets, ShadePointsMatchScalarReference) {
+  static const SurfaceAirlightTable lambert(table(), 0.0, 32, 32), phong(table(), 24.0, 32, 32);
+  Rng rng(19, 3);
+  const size_t n = 37, padded = 48;
+  std::vector<float> f(10 * padded, 0.0f), visible(2 * padded, 0.0f);
+  for (size_t i = 0; i < n; ++i) {
+    const Vec3 normal = direction_around(Vec3(0, 1, 0), rng.uniform(), 2.0 * kPi * rng.uniform());
+    const Vec3 view = direction_around(-normal, rng.uniform(), 2.0 * kPi * rng.uniform());
+    for (size_t e = 0; e < 3; ++e) {
+      f[e * padded + i] = static_cast<float>(6.0 * rng.uniform() - 3.0);
+      f[(3 + e) * padded + i] = static_cast<float>(normal[static_cast<int>(e)]), f[(6 + e) * padded + i] = static_cast<float>(view[static_cast<int>(e)]);
+    }
+    f[9 * padded + i] = i % 4 == 0 ? 0.0f : 1.0f;
+    visible[i] = i % 5 == 0 ? 0.0f : 1.0f, visible[padded + i] = 1.0f;
+  }
+  const auto part = [&](size_t k) { return f.data() + k * padded; };
+  const ShadingPoints points{{part(0), part(1), part(2)}, {part(3), part(4), part(5)}, {part(6), part(7), part(8)}, part(9), n};
+  const ShadingLight lights[2] = {{{0.5f, 2.0f, 0.3f}, {5.0f, 4.0f, 3.0f}, visible.data()}, {{-1.5f, 1.0f, -2.0f}, {1.0f, 2.0f, 3.0f}, visible.data() + padded}};
+  for (bool grey : {true, false})
+    for (bool specular : {false, true}) {
+      const ShadingMedium medium{{-2.0, -2.0, -HUGE_VAL}, {2.0, 2.5, HUGE_VAL}, {0.3f, grey ? 0.3f : 0.5f, grey ? 0.3f : 0.9f}, {0.25f, 0.2f, 0.1f}};
+      const ShadingMaterial material{{0.6f, 0.3f, 0.2f}, {specular ? 0.4f : 0.0f, specular ? 0.4f : 0.0f, specular ? 0.4f : 0.0f}, 24.0f, &lambert,
+                                     specular ? &phong : nullptr};
+      std::vector<float> got(3 * n), want(3 * n);
+      shade_points(medium, material, lights, 2, points, got.data());
+      shade_points_reference(medium, material, lights, 2, points, want.data());
+      for (size_t k = 0; k < 3 * n; ++k) ASSERT_NEAR(got[k], want[k], 1e-4f * (std::abs(want[k]) + 1e-3f)) << "value " << k << " grey " << grey << " specular " << specular;
+    }
+}
+
 TEST_P(AirlightBatchTargets, RowGeometryMatchesRays) {
   Camera pinhole;
   pinhole.position = Vec3(0.2, 1.5, 6.0), pinhole.look_at = Vec3(0.0, 0.5, 0.0), pinhole.width_px = 53, pinhole.height_px = 31;
@@ -286,6 +319,49 @@ TEST(AirlightBatch, SlicesAgreeWithQuadrature) {
       }
     }
     std::printf("g %.1f: froxel slices against quadrature, worst error %.2e of the whole ray's in-scatter\n", g, worst);
+  }
+}
+
+// The difference of one ray's tails at two points, g(a) - e^(-sigma_t (b - a)) g(b), against
+// quadrature of [a, b] as the far tail nears the near one: the table's errors at the two points
+// nearly cancel (airlight_batch.h, kTailsCancel). Lights in an 8-unit box, stretches 1e-3 to 10.
+TEST(AirlightBatch, TailDifferencesKeepTheirPrecisionBelowTheCancelShare) {
+  for (double g : {0.0, 0.5, 0.9}) {
+    const PhaseFunction phase = PhaseFunction::henyey_greenstein(g);
+    const AirlightTable table(phase);
+    const float sigma = 0.26f;
+    const Vec3 light(0.3, 1.5, 0.2);
+    Rng rng(3, 1);
+    const size_t n = 2048;
+    std::vector<float> t_c(n), h_c(n), a(n, 0.0f), b(n), near(n), far(n), unused(3 * n);
+    std::vector<Ray> rays(n);
+    for (size_t i = 0; i < n; ++i) {
+      rays[i] = {Vec3(8.0 * rng.uniform() - 4.0, 3.5 * rng.uniform(), 8.0 * rng.uniform() - 4.0),
+                 direction_around(Vec3(0, 0, 1), 1.0 - 2.0 * rng.uniform(), 2.0 * kPi * rng.uniform())};
+      const Vec3 to = light - rays[i].origin;
+      const double t = glm::dot(to, rays[i].direction);
+      t_c[i] = static_cast<float>(t), h_c[i] = static_cast<float>(glm::length(to - t * rays[i].direction));
+      b[i] = static_cast<float>(0.001 * std::pow(10000.0, rng.uniform()));
+    }
+    const TailLight tail{t_c.data(), h_c.data(), sigma, {1.0f, 0.0f, 0.0f}};
+    const TailRow row{&tail, 1, a.data(), b.data(), {}, {sigma, sigma, sigma}, n};
+    float* const at_a[3] = {near.data(), unused.data(), unused.data() + n};
+    float* const at_b[3] = {far.data(), unused.data(), unused.data() + n};
+    tail_sums(table, row, a.data(), at_a);
+    tail_sums(table, row, b.data(), at_b);
+    double worst_below_09 = 0.0, worst = 0.0;
+    for (size_t i = 0; i < n; ++i) {
+      const double T = std::exp(-static_cast<double>(sigma * b[i]));
+      const double ratio = T * static_cast<double>(far[i]) / static_cast<double>(near[i]);
+      if (ratio > static_cast<double>(kTailsCancel)) continue;  // the float64 path's
+      const double exact = airlight_quadrature(phase, {sigma, 1.0, 1.0}, AirlightSegment::from_points(rays[i].origin, rays[i].direction, light, b[i]), 1e-10);
+      const double error = std::abs(static_cast<double>(near[i]) - T * static_cast<double>(far[i]) - exact) / exact;
+      (ratio < 0.9 ? worst_below_09 : worst) = std::max(ratio < 0.9 ? worst_below_09 : worst, error);
+    }
+    std::printf("g %.1f: tails' differences against quadrature, worst %.2e below a far share of 0.9, %.2e up to %.3f\n", g, worst_below_09, worst,
+                static_cast<double>(kTailsCancel));
+    EXPECT_LT(worst_below_09, 3e-3) << g;
+    EXPECT_LT(worst, 1.5e-2) << g;
   }
 }
 

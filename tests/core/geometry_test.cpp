@@ -195,6 +195,41 @@ TEST(Surface, LitStretchesEndAtTheShadowsEdges) {
 }
 
 // One direction's cone of a set of 64 covers 4 pi / 64 steradians: 2 pi (1 - cos(atan t)).
+// LightShadows' lit / dark / partial against lit_stretches over random view stretches past a
+// sphere and a plane, with lights outside and inside the sphere: a stretch called lit is lit all
+// along, one called dark nowhere (to 1e-6 of its length, the edges' margin); most need no cutting.
+TEST(Surface, LightShadowsAgreeWithLitStretches) {
+  const std::vector<Surface> surfaces{Surface{Plane{Vec3(0.0, 0.0, 0.0), Vec3(0.0, 1.0, 0.0)}}, Surface{Sphere{Vec3(0.4, 0.6, 0.8), 0.6}}};
+  Rng rng(23, 2);
+  for (const Vec3& light : {Vec3(-1.2, 1.8, 0.0), Vec3(0.3, 2.2, 1.4), Vec3(0.5, 0.7, 0.9)}) {
+    const LightShadows shadows(surfaces, light);
+    int partial = 0, dark = 0;
+    const int n = 4000;
+    for (int i = 0; i < n; ++i) {
+      const Ray ray{Vec3(8.0 * rng.uniform() - 4.0, 0.1 + 3.0 * rng.uniform(), 8.0 * rng.uniform() - 4.0),
+                    direction_around(Vec3(0, 1, 0), 2.0 * rng.uniform() - 1.0, 2.0 * kPi * rng.uniform())};
+      double t_hit;
+      Vec3 normal;
+      nearest_surface(surfaces, ray, 12.0, t_hit, normal);
+      const double t0 = 0.5 * rng.uniform() * t_hit, t1 = t_hit;
+      std::vector<std::pair<double, double>> lit;
+      lit_stretches(surfaces, ray, t0, t1, light, lit);
+      double length = 0.0;
+      for (const auto& [a, b] : lit) length += b - a;
+      switch (shadows.classify(ray, t0, t1)) {
+        case LightShadows::Stretch::lit: ASSERT_NEAR(length, t1 - t0, 1e-6 * (t1 - t0)) << "ray " << i; break;
+        case LightShadows::Stretch::dark:
+          ASSERT_NEAR(length, 0.0, 1e-6 * (t1 - t0)) << "ray " << i;
+          ++dark;
+          break;
+        case LightShadows::Stretch::partial: ++partial; break;
+      }
+    }
+    EXPECT_LT(partial, n / 3) << "light at " << light.x;
+    EXPECT_GT(dark, 0) << "light at " << light.x;
+  }
+}
+
 TEST(Directions, ConeTangentCoversOneDirectionsShare) {
   for (int count : {3, 8, 64, 4096}) {
     const double alpha = std::atan(cone_tangent(count));

@@ -196,18 +196,24 @@ TEST(Layers, AutoPassesTheChosenMethodsLayers) {
       ASSERT_LT(relative(layered.inscatter->at(x, y) + layered.transmittance->at(x, y) * layered.surface->at(x, y), plain.radiance.at(x, y)), 1e-6);
 }
 
-// The layers into the caller's memory (render_layers) against render's: analytic's one pass
-// (the tails in SIMD lanes, short stretches through render's float64 path) within 1e-3 relative
-// RMS and 2e-3 per pixel of its layers, in a box, in unbounded fog and in a coloured medium, over a
-// host's floor and the sky; RGBA rows with padding left as they were; propagation's march into the
+// The layers into the caller's memory (render_layers) against render's: analytic's rows of tails
+// (SIMD lanes) against its float64 kernel's per-segment render within 1e-3 relative RMS and 2e-3
+// per pixel of L_in, in a box, in unbounded fog and in a coloured medium, over a host's floor and
+// the sky, and with surfaces (a Phong floor, a sphere shadowing the light: lit stretches, C shaded
+// in float32 lanes within 1e-4 of float64); RGBA rows with padding left as they were; propagation's march into the
 // spans (march_layers: the rows of its render, the same kernel) as its render's; dom's gather as
 // its render's with a point light, and under a sun the marcher's kernel with the moments' light
 // toward the eye per cell (4.4e-4 relative RMS, 2.3e-3 at worst: held to 4e-3 there, as its
 // froxels are).
 TEST(Layers, RenderLayersIntoCallerMemoryMatchesRender) {
   grids::register_methods();
-  for (const std::string variant : {"box", "unbounded", "coloured", "propagation", "dom", "dom sun"}) {
+  for (const std::string variant : {"box", "unbounded", "coloured", "surfaces", "propagation", "dom", "dom sun"}) {
     Scene scene = testing::fog_box(48, 32, Vec3(0.1, -0.1, 0.4));
+    if (variant == "surfaces") {
+      scene.medium->albedo = Rgb(0.9, 0.7, 0.5);
+      scene.surfaces.push_back({Plane{Vec3(0.0, -0.9, 0.0), Vec3(0.0, 1.0, 0.0)}, Rgb(0.5), Rgb(0.2), 20.0});
+      scene.surfaces.push_back({Sphere{Vec3(0.3, -0.4, 0.0), 0.35}, Rgb(0.6, 0.3, 0.2), Rgb(0.0), 1.0});
+    }
     if (variant == "dom sun") scene.lights = {DirectionalLight{glm::normalize(Vec3(0.3, -1.0, 0.2)), Rgb(2.0)}};
     if (variant == "unbounded") scene.medium->bounds = Aabb{};
     if (variant == "coloured") scene.medium->albedo = Rgb(0.9, 0.7, 0.5);
@@ -221,8 +227,12 @@ TEST(Layers, RenderLayersIntoCallerMemoryMatchesRender) {
     RenderOptions prepared;
     if (variant == "propagation") prepared.settings = {{"resolution", 16}};
     if (variant.starts_with("dom")) prepared.settings = {{"resolution", 12}, {"directions", 32}, {"terms", 9}};
-    const Solution solution = prepare(scene, variant == "propagation" ? variant : variant.starts_with("dom") ? "dom" : "analytic", prepared);
-    const RenderResult exact = solution.render(View{scene.camera, depth, true});
+    const std::string method = variant == "propagation" ? variant : variant.starts_with("dom") ? "dom" : "analytic";
+    const Solution solution = prepare(scene, method, prepared);
+    const View layered{scene.camera, depth, true};
+    RenderOptions float64;
+    float64.settings = {{"kernel", "float64"}};
+    const RenderResult exact = method == "analytic" ? prepare(scene, method, float64).render(layered) : solution.render(layered);
     const size_t stride = 4 * 48 + 3;
     std::vector<float> l(stride * 32, -7.0f), t(3 * 48 * 32), c(3 * 48 * 32);
     solution.render_layers(View{scene.camera, depth}, {ImageSpan{l.data(), 48, 32, 4, stride}, ImageSpan{t.data(), 48, 32}, ImageSpan{c.data(), 48, 32}});
@@ -236,7 +246,8 @@ TEST(Layers, RenderLayersIntoCallerMemoryMatchesRender) {
         worst = std::max(worst, glm::length(got - want) / std::max(glm::length(want), 1e-6));
         ASSERT_EQ(li[3], -7.0f) << "alpha written";
         ASSERT_LT(glm::length(Rgb(t[at], t[at + 1], t[at + 2]) - exact.transmittance->at(x, y)), 1e-6) << variant << " T at " << x << ", " << y;
-        ASSERT_LT(glm::length(Rgb(c[at], c[at + 1], c[at + 2]) - exact.surface->at(x, y)), 1e-6) << variant << " C at " << x << ", " << y;
+        const Rgb surface = exact.surface->at(x, y);
+        ASSERT_LT(glm::length(Rgb(c[at], c[at + 1], c[at + 2]) - surface), 1e-6 + 1e-4 * glm::length(surface)) << variant << " C at " << x << ", " << y;
       }
     std::printf("render_layers (%s) against render: L_in %.2e relative RMS, %.2e at worst\n", variant.c_str(), std::sqrt(d2 / r2), worst);
     EXPECT_LT(std::sqrt(d2 / r2), 1e-3) << variant;

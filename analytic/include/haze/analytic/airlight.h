@@ -209,7 +209,9 @@ class SurfaceAirlightTable {
   // As AirlightTable::cached; the key adds the exponent and sizes to the airlight table's.
   static SurfaceAirlightTable cached(const AirlightTable& airlight, double exponent, const std::filesystem::path& dir,
                                      int t_samples = 64, int angle_samples = 64, int threads = 0, bool* from_cache = nullptr);
-  const std::vector<float>& values() const { return j_; }
+  const std::vector<float>& values() const { return j_; }  // (1 + T) J, T fastest
+  int t_samples() const { return nt_; }
+  int angle_samples() const { return na_; }
 
  private:
   friend class LegendreSurfaceTables;

@@ -67,6 +67,38 @@ inline Vec3 off_surface(const Vec3& p, const Vec3& normal) { return p + 1e-9 * (
 void lit_stretches(const std::vector<Surface>& surfaces, const Ray& ray, double t0, double t1, const Vec3& light,
                    std::vector<std::pair<double, double>>& out);
 
+// The cheap questions before lit_stretches and occluded() for one point light, its constants per
+// surface computed once. classify: does the light see all of a view stretch, none of it, or part
+// of it? Planes' and spheres' shadow edges (their surfaces and the tangent cones, the nappe beyond
+// the light) in closed form; with no edge inside the stretch, hidden() at its middle decides. A
+// mesh in the scene makes every stretch `partial` (lit_stretches bisects it). hidden: occluded()
+// from x toward the light, planes and spheres in closed form, meshes by their own test; `self`,
+// a plane or sphere x lies on with the light on its outer side, is left out. The surfaces must
+// outlive this object.
+class LightShadows {
+ public:
+  enum class Stretch { lit, dark, partial };
+  LightShadows(const std::vector<Surface>& surfaces, const Vec3& light);
+  Stretch classify(const Ray& ray, double t0, double t1) const;
+  bool hidden(const Vec3& x, const Surface* self = nullptr) const;
+
+ private:
+  struct Cone {
+    const Surface* surface;
+    Vec3 center, axis;  // the sphere's centre; the unit axis from the light through it
+    double r2, cos2;    // radius squared; cos^2 of the tangent cone's half-angle (0: the light inside)
+  };
+  struct Face {
+    const Surface* surface;
+    Vec3 point, normal;
+    double light_side;  // (light - point) . normal
+  };
+  Vec3 light_;
+  std::vector<Cone> spheres_;
+  std::vector<Face> planes_;
+  std::vector<const Surface*> meshes_;
+};
+
 }  // namespace haze
 
 #pragma GCC visibility pop
