@@ -90,54 +90,72 @@ HWY_NOINLINE size_t AirlightBatch(const float* HWY_RESTRICT table, int na, int n
 // The unit tail g(d) = G(d) / (sigma_s I) of rays whose light projects to t_c along them at
 // distance h_c from their lines, at distances `at` (airlight_batch.h, TailRow).
 // N vectors of rays at once, step by step across the N: N independent chains in program order,
-// which the CPU overlaps (one chain alone is a long run of dependent latencies).
+// which the CPU overlaps (one chain alone is a long run of dependent latencies). The geometry
+// (TailGeometry: d_sv, h, w and the eta coordinate) does not depend on sigma_t: a coloured
+// medium's three channels of one light share it.
 template <int N, class D, class V>
-HWY_INLINE void UnitTails(D d, const float* HWY_RESTRICT table, int na, int ne, float eta_max, const V* t_c, const V* h_c, V sigma, const V* at,
-                          V* g) {
+struct TailGeometry {
+  V d_sv[N], h[N], w[N], y[N];
+  hn::Vec<hn::RebindToSigned<D>> fj[N];
+};
+template <int N, class D, class V>
+HWY_INLINE void TailGeometryN(D d, int ne, float eta_max, const V* t_c, const V* h_c, const V* at, TailGeometry<N, D, V>& g) {
   const hn::RebindToSigned<D> di;
-  const V zero = hn::Zero(d), one = hn::Set(d, 1.0f);
-  V d_sv[N], h[N], w[N], a[N];
+  const V zero = hn::Zero(d);
   for (int n = 0; n < N; ++n) {
     const V t = hn::Sub(t_c[n], at[n]);
-    d_sv[n] = hn::Sqrt(hn::MulAdd(t, t, hn::Mul(h_c[n], h_c[n])));
-    h[n] = hn::Max(hn::Max(h_c[n], hn::Mul(hn::Set(d, 1e-6f), d_sv[n])), hn::Set(d, 1e-20f));
+    g.d_sv[n] = hn::Sqrt(hn::MulAdd(t, t, hn::Mul(h_c[n], h_c[n])));
+    g.h[n] = hn::Max(hn::Max(h_c[n], hn::Mul(hn::Set(d, 1e-6f), g.d_sv[n])), hn::Set(d, 1e-20f));
     // w = (xi + r) / h without cancellation (xi = -t), floored where the point sits on the light.
     const auto behind = hn::Le(t, zero);
-    w[n] = hn::Max(hn::Div(hn::IfThenElse(behind, hn::Sub(d_sv[n], t), h[n]), hn::IfThenElse(behind, h[n], hn::Add(d_sv[n], t))), hn::Set(d, 1e-30f));
-    a[n] = hn::Min(hn::Mul(hn::Mul(sigma, h[n]), hn::Add(one, w[n])), hn::Set(d, 1e30f));
-  }
-  // LogTail's lookup, N at a time.
-  hn::Vec<decltype(di)> index[N];
-  V x[N], y[N];
-  for (int n = 0; n < N; ++n) {
-    const V fa = hn::Mul(hn::Sqrt(hn::Div(a[n], hn::Add(one, a[n]))), hn::Set(d, static_cast<float>(na - 1)));
-    const V e = hn::Min(hn::Max(hn::Log(d, w[n]), hn::Set(d, -eta_max)), hn::Set(d, eta_max));
+    g.w[n] = hn::Max(hn::Div(hn::IfThenElse(behind, hn::Sub(g.d_sv[n], t), g.h[n]), hn::IfThenElse(behind, g.h[n], hn::Add(g.d_sv[n], t))),
+                     hn::Set(d, 1e-30f));
+    const V e = hn::Min(hn::Max(hn::Log(d, g.w[n]), hn::Set(d, -eta_max)), hn::Set(d, eta_max));
     const V fe = hn::Mul(hn::Add(e, hn::Set(d, eta_max)), hn::Set(d, static_cast<float>(ne - 1) / (2.0f * eta_max)));
-    const V fi = hn::Min(hn::Floor(fa), hn::Set(d, static_cast<float>(na - 2)));
     const V fj = hn::Min(hn::Floor(fe), hn::Set(d, static_cast<float>(ne - 2)));
-    x[n] = hn::Sub(fa, fi), y[n] = hn::Sub(fe, fj);
-    index[n] = hn::ConvertTo(di, hn::MulAdd(fi, hn::Set(d, static_cast<float>(ne)), fj));
+    g.y[n] = hn::Sub(fe, fj), g.fj[n] = hn::ConvertTo(di, fj);
+  }
+}
+// LogTail's lookup for sigma, N at a time, from the shared geometry.
+template <int N, class D, class V>
+HWY_INLINE void UnitTailsFrom(D d, const float* HWY_RESTRICT table, int na, int ne, const TailGeometry<N, D, V>& g, V sigma, V* out) {
+  const hn::RebindToSigned<D> di;
+  const V one = hn::Set(d, 1.0f);
+  hn::Vec<decltype(di)> index[N];
+  V x[N], a[N];
+  for (int n = 0; n < N; ++n) {
+    a[n] = hn::Min(hn::Mul(hn::Mul(sigma, g.h[n]), hn::Add(one, g.w[n])), hn::Set(d, 1e30f));
+    const V fa = hn::Mul(hn::Sqrt(hn::Div(a[n], hn::Add(one, a[n]))), hn::Set(d, static_cast<float>(na - 1)));
+    const V fi = hn::Min(hn::Floor(fa), hn::Set(d, static_cast<float>(na - 2)));
+    x[n] = hn::Sub(fa, fi);
+    index[n] = hn::Add(hn::Mul(hn::ConvertTo(di, fi), hn::Set(di, ne)), g.fj[n]);
   }
   for (int n = 0; n < N; ++n) {
     const V t00 = hn::GatherIndex(d, table, index[n]), t10 = hn::GatherIndex(d, table + ne, index[n]);
     const V t01 = hn::GatherIndex(d, table + 1, index[n]), t11 = hn::GatherIndex(d, table + ne + 1, index[n]);
     const V t0 = hn::MulAdd(x[n], hn::Sub(t10, t00), t00), t1 = hn::MulAdd(x[n], hn::Sub(t11, t01), t01);
-    const V log_tail = hn::MulAdd(y[n], hn::Sub(t1, t0), t0);
-    const V scale = hn::Div(hn::Set(d, 2.0f), hn::Mul(hn::Mul(hn::Add(one, w[n]), hn::Add(one, a[n])), h[n]));
-    g[n] = hn::Mul(hn::Exp(d, hn::NegMulAdd(sigma, d_sv[n], log_tail)), scale);
+    const V log_tail = hn::MulAdd(g.y[n], hn::Sub(t1, t0), t0);
+    const V scale = hn::Div(hn::Set(d, 2.0f), hn::Mul(hn::Mul(hn::Add(one, g.w[n]), hn::Add(one, a[n])), g.h[n]));
+    out[n] = hn::Mul(hn::Exp(d, hn::NegMulAdd(sigma, g.d_sv[n], log_tail)), scale);
   }
 }
-
 // s[n][c] = sum over the row's lights of weight[c] g(at[n]), for the N vectors of rays at offsets i[n].
 template <int N, class D, class V>
 HWY_INLINE void SumTailsN(D d, const float* HWY_RESTRICT table, int na, int ne, float eta_max, const TailRow& row, const size_t* i, const V* at,
                           V (*s)[3]) {
   for (int n = 0; n < N; ++n) s[n][0] = s[n][1] = s[n][2] = hn::Zero(d);
+  TailGeometry<N, D, V> geometry;
+  const float *t = nullptr, *h = nullptr;  // whose geometry it holds
   for (size_t l = 0; l < row.light_count; ++l) {
     const TailLight& light = row.lights[l];
-    V t_c[N], h_c[N], g[N];
-    for (int n = 0; n < N; ++n) t_c[n] = hn::LoadU(d, light.t + i[n]), h_c[n] = hn::LoadU(d, light.h + i[n]);
-    UnitTails<N>(d, table, na, ne, eta_max, t_c, h_c, hn::Set(d, light.sigma_t), at, g);
+    if (light.t != t || light.h != h) {
+      V t_c[N], h_c[N];
+      for (int n = 0; n < N; ++n) t_c[n] = hn::LoadU(d, light.t + i[n]), h_c[n] = hn::LoadU(d, light.h + i[n]);
+      TailGeometryN<N>(d, ne, eta_max, t_c, h_c, at, geometry);
+      t = light.t, h = light.h;
+    }
+    V g[N];
+    UnitTailsFrom<N>(d, table, na, ne, geometry, hn::Set(d, light.sigma_t), g);
     for (int n = 0; n < N; ++n) {
       if (light.share) g[n] = hn::Mul(g[n], hn::LoadU(d, light.share + i[n]));
       for (int c = 0; c < 3; ++c) s[n][c] = hn::MulAdd(hn::Set(d, light.weight[c]), g[n], s[n][c]);
@@ -145,7 +163,7 @@ HWY_INLINE void SumTailsN(D d, const float* HWY_RESTRICT table, int na, int ne, 
   }
 }
 
-// Chains UnitTails interleaves: four fill the out-of-order window on AVX-512 (1.3x over one).
+// Chains UnitTailsFrom interleaves: four fill the out-of-order window on AVX-512 (1.3x over one).
 constexpr int kChains = 4;
 
 HWY_NOINLINE void TailSums(const float* HWY_RESTRICT table, int na, int ne, float eta_max, const TailRow& row, const float* at,

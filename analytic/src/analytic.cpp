@@ -7,6 +7,7 @@
 // airlight onto a surface is not shadowed. Like the thesis' model it has no multiple scattering.
 #include <haze/analytic/airlight.h>
 #include <haze/analytic/airlight_batch.h>
+#include <haze/analytic/shadow_batch.h>
 #include <haze/analytic/surface_batch.h>
 #include <haze/analytic/methods.h>
 #include <haze/core/features.h>
@@ -534,23 +535,36 @@ class AnalyticSolution final : public MethodSolution {
     // Each light's shadows along the rays: its share 1 where it lights all of a ray's stretch in
     // the medium, else 0 with the lit stretches of those it lights in part.
     pieces.clear();
-    for (size_t l = 0; l < lights && !surfaces.empty(); ++l) {
-      float* const share = r.share(l);
-      bool whole = true;
+    if (!surfaces.empty()) {
+      thread_local std::vector<double> kept_soa;
+      std::vector<double>& soa = kept_soa;
+      soa.assign(8 * padded, 0.0);
+      const auto column = [&](size_t k) { return soa.data() + k * padded; };
       for (size_t x = 0; x < width; ++x) {
-        const double t0 = r.t0[x], end = !(depth[x] >= 0.0f) ? t0 : std::min(static_cast<double>(r.t1[x]), static_cast<double>(depth[x]));
-        const LightShadows::Stretch seen = shadows_[l].classify(rays[x], t0, end);
-        share[x] = seen == LightShadows::Stretch::lit ? 1.0f : 0.0f;
-        whole = whole && seen == LightShadows::Stretch::lit;
-        if (seen != LightShadows::Stretch::partial) continue;
-        stretches.clear();
-        lit_stretches(surfaces, rays[x], t0, end, lights_[l].position, stretches);
-        for (const auto& [a, b] : stretches) pieces.push_back({x, l, a, b});
+        for (int k = 0; k < 3; ++k) column(static_cast<size_t>(k))[x] = rays[x].origin[k], column(3 + static_cast<size_t>(k))[x] = rays[x].direction[k];
+        column(6)[x] = r.t0[x];
+        column(7)[x] = !(depth[x] >= 0.0f) ? static_cast<double>(r.t0[x]) : std::min(static_cast<double>(r.t1[x]), static_cast<double>(depth[x]));
       }
-      for (size_t k = 0; k < r.tails_per_light; ++k) r.tails[l * r.tails_per_light + k].share = whole ? nullptr : share;
+      const ShadowRays stretch_rays{{column(0), column(1), column(2)}, {column(3), column(4), column(5)}, column(6), column(7), width};
+      float* const seen = redo;  // the classes, before redo is written
+      for (size_t l = 0; l < lights; ++l) {
+        float* const share = r.share(l);
+        classify_stretches(shadows_[l], stretch_rays, seen);
+        bool whole = true;
+        for (size_t x = 0; x < width; ++x) {
+          share[x] = seen[x] == 0.0f ? 1.0f : 0.0f;  // lit, dark or partial: 0, 1, 2
+          whole = whole && seen[x] == 0.0f;
+          if (seen[x] != 2.0f) continue;
+          stretches.clear();
+          if (shadows_[l].meshes()) lit_stretches(surfaces, rays[x], column(6)[x], column(7)[x], lights_[l].position, stretches);
+          else lit_pieces(shadows_[l], rays[x], column(6)[x], column(7)[x], stretches);
+          for (const auto& [a, b] : stretches) pieces.push_back({x, l, a, b});
+        }
+        for (size_t k = 0; k < r.tails_per_light; ++k) r.tails[l * r.tails_per_light + k].share = whole ? nullptr : share;
+      }
     }
     const EndTails e = end_tails(depth, r, width);
-    tails_to_layers(r, e, width, layers.data());
+    layers_from_tails(r.row, e.ends, e.sums, l_rgb, t_rgb, redo);
     add_lit_pieces(r, pieces, l_rgb, redo);
     for (size_t x = 0; x < width; ++x)
       if (redo[x] != 0.0f) {
@@ -632,7 +646,10 @@ class AnalyticSolution final : public MethodSolution {
     f.assign((10 + lights + 3) * padded, 0.0f);
     const auto part = [&](size_t k) { return f.data() + k * padded; };
     const Aabb bounds = medium_->bounds();
-    const auto* sphere = std::get_if<Sphere>(&surface.shape);
+    thread_local std::vector<double> kept_points;
+    std::vector<double>& points64 = kept_points;
+    points64.assign(3 * padded, 0.0);
+    const double* const x64[3] = {points64.data(), points64.data() + padded, points64.data() + 2 * padded};
     for (size_t i = 0; i < at.size(); ++i) {
       const auto& h = hits[at[i]];
       const Ray& ray = rays[at[i]];
@@ -642,13 +659,10 @@ class AnalyticSolution final : public MethodSolution {
         part(6 + e)[i] = static_cast<float>(ray.direction[static_cast<int>(e)]);
       }
       part(9)[i] = surface_airlight_ && bounds.contains(off_surface(p, h.normal)) ? 1.0f : 0.0f;
-      // A plane, or a sphere seen from outside, hides nothing on its lit side from its own point.
-      const bool outer = std::holds_alternative<Plane>(surface.shape) || (sphere && glm::dot(h.normal, p - sphere->center) > 0.0);
-      for (size_t l = 0; l < lights; ++l) {
-        const bool seen = glm::dot(lights_[l].position - p, h.normal) > 0.0 && !shadows_[l].hidden(p, outer ? &surface : nullptr);
-        part(10 + l)[i] = seen ? 1.0f : 0.0f;
-      }
+      for (size_t e = 0; e < 3; ++e) points64[e * padded + i] = p[static_cast<int>(e)];
     }
+    // Whether each light is hidden (shade_points takes it where the normal faces it).
+    for (size_t l = 0; l < lights; ++l) light_visible(shadows_[l], x64, at.size(), nullptr, part(10 + l));
     thread_local std::vector<ShadingLight> kept_lights;
     std::vector<ShadingLight>& shading = kept_lights;
     shading.clear();

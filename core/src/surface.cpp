@@ -169,7 +169,7 @@ void lit_stretches(const std::vector<Surface>& surfaces, const Ray& ray, double 
 LightShadows::LightShadows(const std::vector<Surface>& surfaces, const Vec3& light) : light_(light) {
   for (const Surface& s : surfaces) {
     if (std::holds_alternative<Mesh>(s.shape)) meshes_.push_back(&s);
-    if (const auto* plane = std::get_if<Plane>(&s.shape)) planes_.push_back({&s, plane->point, plane->normal, glm::dot(light - plane->point, plane->normal)});
+    if (const auto* plane = std::get_if<Plane>(&s.shape)) planes_.push_back({&s, plane->point, plane->normal});
     if (const auto* sphere = std::get_if<Sphere>(&s.shape)) {
       const Vec3 lc = sphere->center - light;
       const double dist2 = glm::dot(lc, lc), r2 = sphere->radius * sphere->radius;
@@ -230,9 +230,10 @@ LightShadows::Stretch LightShadows::classify(const Ray& ray, double t0, double t
     if (crosses(dd, 2.0 * glm::dot(oc, d), glm::dot(oc, oc) - s.r2, any)) return Stretch::partial;
     if (s.cos2 == 0.0) continue;  // the light inside: the sphere's surface is the only edge
     const double dv = glm::dot(d, s.axis), wv = glm::dot(w, s.axis);
-    // The nappe beyond the light: (x - L) . axis > 0.
+    // The cone is an edge only past the tangent circle, |c - L| cos^2 along the axis from the light.
+    const double circle = std::sqrt(s.r2 / (1.0 - s.cos2)) * s.cos2;
     if (crosses(dv * dv - s.cos2 * dd, 2.0 * (wv * dv - s.cos2 * glm::dot(w, d)), wv * wv - s.cos2 * glm::dot(w, w),
-                [&](double t) { return wv + t * dv > 0.0; }))
+                [&](double t) { return wv + t * dv > circle; }))
       return Stretch::partial;
   }
   const double mid = std::isfinite(t1) ? 0.5 * (t0 + t1) : t0 + 1.0 + std::abs(t0);

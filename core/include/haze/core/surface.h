@@ -82,7 +82,7 @@ class LightShadows {
   Stretch classify(const Ray& ray, double t0, double t1) const;
   bool hidden(const Vec3& x, const Surface* self = nullptr) const;
 
- private:
+  // The constants, for batched forms of these tests (method analytic's shadow_batch.h).
   struct Cone {
     const Surface* surface;
     Vec3 center, axis;  // the sphere's centre; the unit axis from the light through it
@@ -91,8 +91,13 @@ class LightShadows {
   struct Face {
     const Surface* surface;
     Vec3 point, normal;
-    double light_side;  // (light - point) . normal
   };
+  const Vec3& light() const { return light_; }
+  const std::vector<Cone>& spheres() const { return spheres_; }
+  const std::vector<Face>& planes() const { return planes_; }
+  bool meshes() const { return !meshes_.empty(); }
+
+ private:
   Vec3 light_;
   std::vector<Cone> spheres_;
   std::vector<Face> planes_;
