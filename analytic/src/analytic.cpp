@@ -92,7 +92,7 @@ struct SurfaceShading {
 class AnalyticSolution final : public MethodSolution {
  public:
   AnalyticSolution(const Scene& scene, std::vector<AnalyticLight> lights, std::unique_ptr<Medium> medium, const Rgb& sigma_t,
-                   const Rgb& sigma_s, bool grey, bool airlight, bool surface_airlight, AirlightKernel kernel, AirlightTable table,
+                   const Rgb& sigma_s, bool grey, bool airlight, bool surface_airlight, bool view_shadows, AirlightKernel kernel, AirlightTable table,
                    std::optional<SurfaceAirlightTable> lambert, std::map<double, SurfaceAirlightTable> phong)
       : scene_(scene),
         lights_(std::move(lights)),
@@ -102,6 +102,7 @@ class AnalyticSolution final : public MethodSolution {
         grey_(grey),
         airlight_(airlight),
         surface_airlight_(surface_airlight),
+        view_shadows_(view_shadows),
         kernel_(kernel),
         table_(std::move(table)),
         lambert_(std::move(lambert)),
@@ -194,7 +195,7 @@ class AnalyticSolution final : public MethodSolution {
           // seen from its start and carried to the segment's entry by e^(-sigma_t offset).
           const SegmentBatch* lit = &batch;
           SegmentBatch stretch_batch{};
-          if (!scene_.surfaces.empty()) {
+          if (view_shadows_ && !scene_.surfaces.empty()) {
             for (auto* v : {&sx, &sy, &sz, &sl}) v->clear();
             owner.clear(), offset.clear();
             for (int x = 0; x < camera.width_px; ++x) {
@@ -241,7 +242,7 @@ class AnalyticSolution final : public MethodSolution {
             for (const auto& light : lights_) {
               if (!light.spot()) continue;
               stretches.clear();
-              if (scene_.surfaces.empty()) stretches.emplace_back(0.0, t1 - t0);
+              if (!view_shadows_ || scene_.surfaces.empty()) stretches.emplace_back(0.0, t1 - t0);
               else lit_stretches(scene_.surfaces, Ray{entry, ray.direction}, 0.0, t1 - t0, light.position, stretches);
               for (const auto& [a, b] : stretches)
                 for (int c = 0; c < 3; ++c) {
@@ -535,7 +536,7 @@ class AnalyticSolution final : public MethodSolution {
     // Each light's shadows along the rays: its share 1 where it lights all of a ray's stretch in
     // the medium, else 0 with the lit stretches of those it lights in part.
     pieces.clear();
-    if (!surfaces.empty()) {
+    if (view_shadows_ && !surfaces.empty()) {
       thread_local std::vector<double> kept_soa;
       std::vector<double>& soa = kept_soa;
       soa.assign(8 * padded, 0.0);
@@ -709,7 +710,7 @@ class AnalyticSolution final : public MethodSolution {
     for (const auto& light : lights_) {
       const Vec3& p = light.position;
       stretches.clear();
-      if (scene_.surfaces.empty()) stretches.emplace_back(0.0, end - t0);
+      if (!view_shadows_ || scene_.surfaces.empty()) stretches.emplace_back(0.0, end - t0);
       else lit_stretches(scene_.surfaces, entry, 0.0, end - t0, p, stretches);
       for (const auto& [a, b] : stretches) {
         const Vec3 o = entry.at(a);
@@ -778,7 +779,7 @@ class AnalyticSolution final : public MethodSolution {
   ShadingMedium shading_medium_;
   const std::unique_ptr<Medium> medium_;
   const Rgb sigma_t_, sigma_s_;
-  const bool grey_, airlight_, surface_airlight_;
+  const bool grey_, airlight_, surface_airlight_, view_shadows_;
   const AirlightKernel kernel_;
   const AirlightTable table_;
   const std::optional<SurfaceAirlightTable> lambert_;
@@ -806,6 +807,7 @@ class AnalyticMethod final : public Method {
     const int eta_samples = static_cast<int>(settings.integer("table_eta"));
     const bool surface_airlight = settings.integer("surface_airlight") == 1;
     const bool airlight = settings.integer("airlight") == 1;
+    const bool view_shadows = settings.integer("view_shadows") == 1;
     // Dynamic g (seed 002 sec. 4.3): > 0 builds g-independent Legendre tables (cached) and sums
     // them for the scene's g with enough orders for this relative tolerance.
     const double dynamic_g = settings.number("dynamic_g_tolerance");
@@ -888,7 +890,7 @@ class AnalyticMethod final : public Method {
       }
     }
     auto solution = std::make_unique<AnalyticSolution>(scene, std::move(lights), std::move(medium), sigma_t, sigma_s, grey, airlight,
-                                                       surface_airlight, simd_kernel ? &add_airlight : &add_airlight_float64, table, std::move(lambert), std::move(phong));
+                                                       surface_airlight, view_shadows, simd_kernel ? &add_airlight : &add_airlight_float64, table, std::move(lambert), std::move(phong));
     solution->stats = {{"table_seconds", watch.seconds()},
                        {"airlight_path", simd_kernel ? "simd" : "float64"},
                        {"tables_reused", all_reused},
@@ -916,6 +918,8 @@ MethodInfo analytic_info() {
                    SettingInfo::integer("table_eta", 512, 16, 4096, "airlight table samples along the angle eta"),
                    SettingInfo::integer("surface_airlight", 1, 0, 1, "1: surfaces also receive the airlight (tables J1 and J_n)"),
                    SettingInfo::integer("airlight", 1, 0, 1, "0: leave out the view ray's airlight (surfaces only)"),
+                   SettingInfo::integer("view_shadows", 1, 0, 1,
+                                        "0: surfaces do not shadow the view rays' airlight, as the thesis renders (its sec. 6.2.2 leaves volumetric shadows to future work)"),
                    SettingInfo::number("dynamic_g_tolerance", 0.0, 0.0, 0.5,
                                        "> 0: sum g-independent Legendre tables for the scene's HG g to this relative tolerance"),
                    SettingInfo::choice("kernel", "simd", {"simd", "float64"},

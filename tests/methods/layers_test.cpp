@@ -256,6 +256,41 @@ TEST(Layers, RenderLayersIntoCallerMemoryMatchesRender) {
   }
 }
 
+// Analytic's view_shadows 0 (the thesis' model: surfaces end the view rays but do not shadow their
+// airlight) is the airlight of the same scene without its surfaces and a host's depth where they
+// were: in the rows of tails and in the float64 kernel's per-segment render.
+TEST(Layers, AnalyticWithoutViewShadowsIsTheAirlightToTheSurfaces) {
+  Scene scene = testing::fog_box(48, 32, Vec3(0.1, -0.1, 0.4));
+  scene.surfaces.push_back({Plane{Vec3(0.0, -0.9, 0.0), Vec3(0.0, 1.0, 0.0)}, Rgb(0.5), Rgb(0.0), 1.0});
+  scene.surfaces.push_back({Sphere{Vec3(0.3, -0.4, 0.0), 0.35}, Rgb(0.6, 0.3, 0.2), Rgb(0.0), 1.0});
+  std::vector<float> depth;
+  for (int y = 0; y < 32; ++y)
+    for (int x = 0; x < 48; ++x) {
+      double t;
+      Vec3 normal;
+      nearest_surface(scene.surfaces, scene.camera.pixel_ray(x, y), kInfinity, t, normal);
+      depth.push_back(static_cast<float>(t));
+    }
+  Scene bare = scene;
+  bare.surfaces.clear();
+  const RenderResult want = prepare(bare, "analytic").render(View{bare.camera, depth, true});
+  for (const std::string kernel : {"simd", "float64"}) {
+    RenderOptions options;
+    options.settings = {{"view_shadows", 0}, {"kernel", kernel}};
+    const RenderResult got = prepare(scene, "analytic", options).render(View{scene.camera, {}, true});
+    RenderOptions shadowed;
+    shadowed.settings = {{"kernel", kernel}};
+    const RenderResult dark = prepare(scene, "analytic", shadowed).render(View{scene.camera, {}, true});
+    double shadow = 0.0;
+    for (int y = 0; y < 32; ++y)
+      for (int x = 0; x < 48; ++x) {
+        ASSERT_LT(relative(got.inscatter->at(x, y), want.inscatter->at(x, y)), 2e-3) << kernel << " at " << x << ", " << y;
+        shadow = std::max(shadow, relative(dark.inscatter->at(x, y), want.inscatter->at(x, y)));
+      }
+    EXPECT_GT(shadow, 0.05) << kernel << ": the sphere's shadow darkens the airlight when view_shadows is on";
+  }
+}
+
 TEST(Layers, BadViewsAreClearErrors) {
   grids::register_methods();
   const Scene scene = fog_scene(true, false, false);

@@ -69,8 +69,8 @@ void lit_stretches(const std::vector<Surface>& surfaces, const Ray& ray, double 
 
 // The cheap questions before lit_stretches and occluded() for one point light, its constants per
 // surface computed once. classify: does the light see all of a view stretch, none of it, or part
-// of it? Planes' and spheres' shadow edges (their surfaces and the tangent cones, the nappe beyond
-// the light) in closed form; with no edge inside the stretch, hidden() at its middle decides. A
+// of it? Planes' and spheres' shadow edges (their surfaces and the tangent cones past their
+// tangent circles) in closed form; with no edge inside the stretch, hidden() at its middle decides. A
 // mesh in the scene makes every stretch `partial` (lit_stretches bisects it). hidden: occluded()
 // from x toward the light, planes and spheres in closed form, meshes by their own test; `self`,
 // a plane or sphere x lies on with the light on its outer side, is left out. The surfaces must
