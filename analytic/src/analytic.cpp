@@ -543,7 +543,7 @@ class AnalyticSolution final : public MethodSolution {
       const auto column = [&](size_t k) { return soa.data() + k * padded; };
       for (size_t x = 0; x < width; ++x) {
         for (int k = 0; k < 3; ++k) column(static_cast<size_t>(k))[x] = rays[x].origin[k], column(3 + static_cast<size_t>(k))[x] = rays[x].direction[k];
-        column(6)[x] = r.t0[x];
+        column(6)[x] = static_cast<double>(r.t0[x]);
         column(7)[x] = !(depth[x] >= 0.0f) ? static_cast<double>(r.t0[x]) : std::min(static_cast<double>(r.t1[x]), static_cast<double>(depth[x]));
       }
       const ShadowRays stretch_rays{{column(0), column(1), column(2)}, {column(3), column(4), column(5)}, column(6), column(7), width};
@@ -569,7 +569,7 @@ class AnalyticSolution final : public MethodSolution {
     add_lit_pieces(r, pieces, l_rgb, redo);
     for (size_t x = 0; x < width; ++x)
       if (redo[x] != 0.0f) {
-        const Rgb l = exact_airlight(camera.pixel_ray(static_cast<int>(x), y), r.t0[x], e.ends[x]);
+        const Rgb l = exact_airlight(camera.pixel_ray(static_cast<int>(x), y), static_cast<double>(r.t0[x]), static_cast<double>(e.ends[x]));
         for (int c = 0; c < 3; ++c) l_rgb[3 * x + c] = static_cast<float>(l[c]);
       }
     // The surfaces: the background where nothing ends the ray, the host's (0) behind its depth.
