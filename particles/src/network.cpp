@@ -89,44 +89,65 @@ void direct_light(NetworkSolution& s, const ParticleField& field, const std::vec
   const MaterialDesc& material = field.particles().material;
   const DirectionSet& dirs = *s.directions;
   const auto n = field.size(), d = static_cast<size_t>(dirs.size()), channels = static_cast<size_t>(s.channels);
-  parallel_for(static_cast<long long>(particles.size()), threads, 16, [&](long long q0, long long q1) {
-    std::vector<float> cosines(d), phase(d);
-    for (auto q = static_cast<size_t>(q0); q < static_cast<size_t>(q1); ++q) {
-      const auto p = static_cast<size_t>(particles[q]);
-      for (size_t c = 0; c < channels; ++c)
-        for (size_t i = 0; i < d; ++i) s.source[c][i * n + p] = 0.0f;
-      const Vec3 x = field.position(p);
-      const double nearest = 0.25 * field.h(p);
-      for (size_t l = 0; l < delta.size(); ++l) {
-        const LightDepthMap& map = s.light_maps[l];
-        LightArrival a;
-        if (!arrival(*delta[l], x, a)) continue;
-        Rgb e(0.0);
-        if (a.distance > 0.0) {
-          // The particle's share of the light: E averaged over its Gaussian (2-point Gauss-Hermite
-          // per axis), not E at its centre, which misses the light its fringe gets near lit edges.
-          for (const Vec3& node : gaussian_nodes(x, field.h(p))) {
-            LightArrival at;
-            if (map.arrival(node, material.sigma_t, nearest, at) && !occluded(s.surfaces, node, at.to_light, at.distance))
-              e += 0.125 * at.irradiance;
+  // Blocks of kBlock particles: their sources into `block` ([c][i][k], direction-major), then
+  // written to s.source ([c][i * n + p]) a run of kBlock at a time where the block's particles
+  // are consecutive (one cache line per direction, not kBlock scattered stores each).
+  constexpr size_t kBlock = 16;
+  const auto body = [&](long long q0, long long q1) {
+    thread_local std::vector<float> kept_cosines, kept_phase, kept_block;
+    std::vector<float>&cosines = kept_cosines, &phase = kept_phase, &block = kept_block;
+    cosines.resize(d), phase.resize(d);
+    for (auto b0 = static_cast<size_t>(q0); b0 < static_cast<size_t>(q1); b0 += kBlock) {
+      const size_t count = std::min(kBlock, static_cast<size_t>(q1) - b0);
+      block.assign(channels * d * kBlock, 0.0f);
+      for (size_t k = 0; k < count; ++k) {
+        const auto p = static_cast<size_t>(particles[b0 + k]);
+        const Vec3 x = field.position(p);
+        const double nearest = 0.25 * field.h(p);
+        for (size_t l = 0; l < delta.size(); ++l) {
+          const LightDepthMap& map = s.light_maps[l];
+          LightArrival a;
+          if (!arrival(*delta[l], x, a)) continue;
+          Rgb e(0.0);
+          if (a.distance > 0.0) {
+            // The particle's share of the light: E averaged over its Gaussian (2-point Gauss-Hermite
+            // per axis), not E at its centre, which misses the light its fringe gets near lit edges.
+            for (const Vec3& node : gaussian_nodes(x, field.h(p))) {
+              LightArrival at;
+              if (map.arrival(node, material.sigma_t, nearest, at) && !occluded(s.surfaces, node, at.to_light, at.distance))
+                e += 0.125 * at.irradiance;
+            }
+          } else {  // the light at the centre: no direction; a point light's irradiance at `nearest`
+            const auto* point = std::get_if<PointLight>(delta[l]);
+            e = point ? point->intensity / (nearest * nearest) * glm::exp(-material.sigma_t * map.depth(x)) : Rgb(0.0);
+            a.to_light = Vec3(0.0);
           }
-        } else {  // the light at the centre: no direction; a point light's irradiance at `nearest`
-          const auto* point = std::get_if<PointLight>(delta[l]);
-          e = point ? point->intensity / (nearest * nearest) * glm::exp(-material.sigma_t * map.depth(x)) : Rgb(0.0);
-          a.to_light = Vec3(0.0);
-        }
-        if (e == Rgb(0.0)) continue;
-        for (size_t i = 0; i < d; ++i) cosines[i] = static_cast<float>(-glm::dot(a.to_light, dirs[static_cast<int>(i)]));
-        simd::eval_phase(material.phase, cosines.data(), phase.data(), d);
-        double sum = 0.0;
-        for (size_t i = 0; i < d; ++i) sum += static_cast<double>(phase[i]) * dirs.weight(static_cast<int>(i));
-        for (size_t c = 0; c < channels; ++c) {
-          const auto scale = static_cast<float>(e[static_cast<int>(c)] / sum);  // quadrature over directions gives back E exactly
-          for (size_t i = 0; i < d; ++i) s.source[c][i * n + p] += scale * phase[i];
+          if (e == Rgb(0.0)) continue;
+          for (size_t i = 0; i < d; ++i) cosines[i] = static_cast<float>(-glm::dot(a.to_light, dirs[static_cast<int>(i)]));
+          simd::eval_phase(material.phase, cosines.data(), phase.data(), d);
+          double sum = 0.0;
+          for (size_t i = 0; i < d; ++i) sum += static_cast<double>(phase[i]) * dirs.weight(static_cast<int>(i));
+          for (size_t c = 0; c < channels; ++c) {
+            const auto scale = static_cast<float>(e[static_cast<int>(c)] / sum);  // quadrature over directions gives back E exactly
+            float* const to = block.data() + c * d * kBlock + k;
+            for (size_t i = 0; i < d; ++i) to[i * kBlock] += scale * phase[i];
+          }
         }
       }
+      const auto first = static_cast<size_t>(particles[b0]);
+      const bool run = static_cast<size_t>(particles[b0 + count - 1]) - first == count - 1 &&
+                       std::is_sorted(particles.begin() + static_cast<long>(b0), particles.begin() + static_cast<long>(b0 + count));
+      for (size_t c = 0; c < channels; ++c)
+        for (size_t i = 0; i < d; ++i) {
+          const float* from = block.data() + (c * d + i) * kBlock;
+          float* const to = s.source[c].data() + i * n;
+          if (run) std::copy_n(from, count, to + first);
+          else
+            for (size_t k = 0; k < count; ++k) to[static_cast<size_t>(particles[b0 + k])] = from[k];
+        }
     }
-  });
+  };
+  parallel_for(static_cast<long long>(particles.size()), threads, 16, [&body](long long q0, long long q1) { body(q0, q1); });
 }
 
 void all_transmittance(NetworkSolution& s, const MaterialDesc& material, int threads) {
