@@ -442,31 +442,95 @@ class AnalyticSolution final : public MethodSolution {
     airlight_slices(table_, r.row, at, &out.inscatter[first].x, &out.transmittance[first].x, 3 * rays_per_slice);
   }
 
-  // The ends in the medium of rays [x0, x0 + count) of row y (the view's depth or t1; t0 where the
-  // depth is NaN or negative, as the composite takes it), and the tails of ray_tails' row r at
-  // their entries (into r.whole) and at their ends. An endless ray's tails at its entry stand in
-  // at its end (it takes all of them: T = 0); a row of endless rays (the sky in unbounded fog)
-  // skips the second sums.
+  // The ends in the medium of a row's rays (the depth or t1; t0 where the depth is NaN or negative,
+  // as the composite takes it) and where their tails are taken: an endless ray's tails at its
+  // entry stand in at its end (it takes all of them: T = 0).
+  struct RowEnds {
+    const float* ends;
+    const float* at;
+    bool any_end;
+  };
+  static RowEnds row_ends(const float* depth, const RowRays& r, size_t count) {
+    const size_t padded = padded_count(count);
+    thread_local std::vector<float> kept;
+    std::vector<float>& v = kept;
+    v.assign(2 * padded, 0.0f);
+    bool any_end = false;
+    for (size_t i = 0; i < count; ++i) {
+      v[i] = !(depth[i] >= 0.0f) ? r.t0[i] : std::min(r.t1[i], depth[i]);
+      v[padded + i] = std::isfinite(v[i]) ? std::max(v[i], r.t0[i]) : r.t0[i];
+      any_end = any_end || std::isfinite(v[i]);
+    }
+    return {v.data(), v.data() + padded, any_end};
+  }
+  // The tails of ray_tails' row r at their entries (into r.whole) and at their ends; a row of
+  // endless rays (the sky in unbounded fog) skips the second sums.
   struct EndTails {
     const float* ends;
     const float* sums[3];
   };
   EndTails end_tails(const float* depth, const RowRays& r, size_t count) const {
     const size_t padded = padded_count(count);
-    thread_local std::vector<float> kept_ends, kept_at, kept_sums;
-    std::vector<float>&ends = kept_ends, &at = kept_at, &at_end = kept_sums;
-    ends.assign(padded, 0.0f), at.assign(padded, 0.0f), at_end.assign(3 * padded, 0.0f);
-    bool any_end = false;
-    for (size_t i = 0; i < count; ++i) {
-      ends[i] = !(depth[i] >= 0.0f) ? r.t0[i] : std::min(r.t1[i], depth[i]);
-      at[i] = std::isfinite(ends[i]) ? std::max(ends[i], r.t0[i]) : r.t0[i];
-      any_end = any_end || std::isfinite(ends[i]);
-    }
+    const RowEnds e = row_ends(depth, r, count);
+    thread_local std::vector<float> kept;
+    std::vector<float>& at_end = kept;
+    at_end.assign(3 * padded, 0.0f);
     float* const sums[3] = {at_end.data(), at_end.data() + padded, at_end.data() + 2 * padded};
     tail_sums(table_, r.row, r.t0, r.whole);
-    if (any_end) tail_sums(table_, r.row, at.data(), sums);
-    return {ends.data(), {sums[0], sums[1], sums[2]}};
+    if (e.any_end) tail_sums(table_, r.row, e.at, sums);
+    return {e.ends, {sums[0], sums[1], sums[2]}};
   }
+  // The row lattice takes an odd pixel's L_in from its neighbours, the cubic through x - 3, x - 1,
+  // x + 1 and x + 3, where it differs from the linear one (their second difference, the linear
+  // mean's error) by at most this share of it.
+  static constexpr float kRowTolerance = 5e-4f;
+
+  // L_in, T and redo of every pixel of the row from its tails.
+  void whole_row_layers(const RowRays& r, const float* depth, size_t count, float* l_rgb, float* t_rgb, float* redo) const {
+    const EndTails e = end_tails(depth, r, count);
+    layers_from_tails(r.row, e.ends, e.sums, l_rgb, t_rgb, redo);
+  }
+  // The same for the pixels in `set`: their rays gathered into a row of their own, its layers
+  // scattered back.
+  void set_layers(const RowRays& r, const RowEnds& e, const std::vector<size_t>& set, float* l_rgb, float* t_rgb, float* redo) const {
+    const size_t m = set.size(), mp = padded_count(m), lights = lights_.size();
+    thread_local std::vector<float> kept;
+    thread_local std::vector<TailLight> kept_tails;
+    std::vector<float>& f = kept;
+    std::vector<TailLight>& tails = kept_tails;
+    f.assign((16 + 3 * lights) * mp, 0.0f);
+    float *t0 = f.data(), *ends = t0 + mp, *at = ends + mp, *whole = at + mp, *sums = whole + 3 * mp, *l = sums + 3 * mp, *t = l + 3 * mp;
+    float *flags = t + 3 * mp, *geometry = flags + mp;
+    for (size_t k = 0; k < m; ++k) t0[k] = r.t0[set[k]], ends[k] = e.ends[set[k]], at[k] = e.at[set[k]];
+    tails.assign(r.tails, r.tails + r.row.light_count);
+    for (size_t j = 0; j < lights; ++j) {
+      float* const g = geometry + 3 * j * mp;
+      const float* const from = r.geometry + 3 * j * r.padded;
+      for (size_t k = 0; k < m; ++k) g[k] = from[set[k]], g[mp + k] = from[r.padded + set[k]], g[2 * mp + k] = from[2 * r.padded + set[k]];
+      for (size_t c = 0; c < r.tails_per_light; ++c) {
+        TailLight& tail = tails[j * r.tails_per_light + c];
+        tail.t = g, tail.h = g + mp, tail.share = tail.share ? g + 2 * mp : nullptr;
+      }
+    }
+    TailRow row = r.row;
+    row.lights = tails.data(), row.t0 = t0, row.count = m;
+    float* const at_entry[3] = {whole, whole + mp, whole + 2 * mp}, *const at_end[3] = {sums, sums + mp, sums + 2 * mp};
+    row.whole[0] = whole, row.whole[1] = whole + mp, row.whole[2] = whole + 2 * mp;
+    tail_sums(table_, row, t0, at_entry);
+    if (e.any_end) tail_sums(table_, row, at, at_end);
+    layers_from_tails(row, ends, at_end, l, t, flags);
+    for (size_t k = 0; k < m; ++k) {
+      std::copy_n(l + 3 * k, 3, l_rgb + 3 * set[k]), std::copy_n(t + 3 * k, 3, t_rgb + 3 * set[k]);
+      redo[set[k]] = flags[k];
+    }
+  }
+  // T of pixel x alone (layers_from_tails' rule).
+  void transmittance_only(const RowRays& r, const RowEnds& e, size_t x, float* t_rgb) const {
+    const float t0 = r.t0[x], end = e.ends[x];
+    for (int c = 0; c < 3; ++c)
+      t_rgb[3 * x + static_cast<size_t>(c)] = !(end > t0) ? 1.0f : std::isfinite(end) ? std::exp(-static_cast<float>(sigma_t_[c]) * (end - t0)) : 0.0f;
+  }
+
   // The view's depths along pixels [x0, x0 + count) of row y, into the thread's kept buffer.
   static const float* view_depths(const View& view, int y, int x0, size_t count) {
     thread_local std::vector<float> kept;
@@ -510,6 +574,9 @@ class AnalyticSolution final : public MethodSolution {
     thread_local std::vector<float> kept_depth, kept_layers;
     thread_local std::vector<LitPiece> kept_pieces;
     thread_local std::vector<std::pair<double, double>> kept_stretches;
+    thread_local std::vector<unsigned char> kept_cut;
+    std::vector<unsigned char>& cut = kept_cut;  // rays some light lights in part
+    cut.assign(padded, 0);
     std::vector<Hit>& hits = kept_hits;
     std::vector<Ray>& rays = kept_rays;
     std::vector<LitPiece>& pieces = kept_pieces;
@@ -548,6 +615,7 @@ class AnalyticSolution final : public MethodSolution {
       }
       const ShadowRays stretch_rays{{column(0), column(1), column(2)}, {column(3), column(4), column(5)}, column(6), column(7), width};
       float* const seen = redo;  // the classes, before redo is written
+      cut.assign(padded, 0);
       for (size_t l = 0; l < lights; ++l) {
         float* const share = r.share(l);
         classify_stretches(shadows_[l], stretch_rays, seen);
@@ -556,6 +624,7 @@ class AnalyticSolution final : public MethodSolution {
           share[x] = seen[x] == 0.0f ? 1.0f : 0.0f;  // lit, dark or partial: 0, 1, 2
           whole = whole && seen[x] == 0.0f;
           if (seen[x] != 2.0f) continue;
+          cut[x] = 1;
           stretches.clear();
           if (shadows_[l].meshes()) lit_stretches(surfaces, rays[x], column(6)[x], column(7)[x], lights_[l].position, stretches);
           else lit_pieces(shadows_[l], rays[x], column(6)[x], column(7)[x], stretches);
@@ -564,14 +633,66 @@ class AnalyticSolution final : public MethodSolution {
         for (size_t k = 0; k < r.tails_per_light; ++k) r.tails[l * r.tails_per_light + k].share = whole ? nullptr : share;
       }
     }
-    const EndTails e = end_tails(depth, r, width);
-    layers_from_tails(r.row, e.ends, e.sums, l_rgb, t_rgb, redo);
-    add_lit_pieces(r, pieces, l_rgb, redo);
-    for (size_t x = 0; x < width; ++x)
-      if (redo[x] != 0.0f) {
-        const Rgb l = exact_airlight(camera.pixel_ray(static_cast<int>(x), y), static_cast<double>(r.t0[x]), static_cast<double>(e.ends[x]));
-        for (int c = 0; c < 3; ++c) l_rgb[3 * x + c] = static_cast<float>(l[c]);
+    // The row lattice: odd pixels between two that end on the same surface (or none), at entries
+    // and ends varying smoothly, seen alike by every light and away from each, take L_in from
+    // their neighbours where the estimate is sure to kRowTolerance; the others their own tails.
+    const RowEnds ends = row_ends(depth, r, width);
+    thread_local std::vector<size_t> kept_own, kept_between;
+    std::vector<size_t>&own = kept_own, &between = kept_between;
+    own.clear(), between.clear();
+    const auto smooth = [](float a, float m, float b) {
+      if (!std::isfinite(a) || !std::isfinite(m) || !std::isfinite(b)) return std::isinf(a) && std::isinf(m) && std::isinf(b);
+      return std::abs(m - 0.5f * (a + b)) <= 1e-3f * (std::abs(m) + 1e-3f);
+    };
+    for (size_t x = 0; x < width; ++x) {
+      bool alike = x % 2 == 1 && x >= 3 && x + 3 < width && !cut[x - 1] && !cut[x] && !cut[x + 1] && smooth(r.t0[x - 1], r.t0[x], r.t0[x + 1]) &&
+                   smooth(ends.ends[x - 1], ends.ends[x], ends.ends[x + 1]) &&
+                   (surfaces.empty() || (hits[x - 1].surface == hits[x].surface && hits[x + 1].surface == hits[x].surface));
+      for (size_t l = 0; l < lights && alike && view_shadows_ && !surfaces.empty(); ++l)
+        alike = r.share(l)[x - 1] == r.share(l)[x] && r.share(l)[x + 1] == r.share(l)[x];
+      // Away from each light: the light's distance from the ray, from its entry and from its end
+      // change by at most 3% a pixel (L_in goes as 1 / h along a ray passing the light, the
+      // scattering at either end as 1 / d^2: the mean's error is second order in that change).
+      for (size_t l = 0; l < lights && alike; ++l) {
+        const float *t = r.geometry + 3 * l * r.padded, *h = t + r.padded;
+        const auto steady = [&](auto&& distance) { return std::abs(distance(x + 1) - distance(x - 1)) <= 0.06f * distance(x); };
+        const auto from = [&](const float* at) {
+          return [&, at](size_t i) { return std::isfinite(at[i]) ? std::hypot(t[i] - at[i], h[i]) : h[i]; };
+        };
+        alike = steady([&](size_t i) { return h[i]; }) && steady(from(r.t0)) && steady(from(ends.ends));
       }
+      (alike ? between : own).push_back(x);
+    }
+    if (between.empty()) {
+      whole_row_layers(r, depth, width, l_rgb, t_rgb, redo);
+    } else {
+      set_layers(r, ends, own, l_rgb, t_rgb, redo);
+      for (size_t x : between) transmittance_only(r, ends, x, t_rgb), redo[x] = 0.0f;
+    }
+    add_lit_pieces(r, pieces, l_rgb, redo);
+    const auto exact = [&](size_t x) {
+      const Rgb l = exact_airlight(camera.pixel_ray(static_cast<int>(x), y), static_cast<double>(r.t0[x]), static_cast<double>(ends.ends[x]));
+      for (int c = 0; c < 3; ++c) l_rgb[3 * x + c] = static_cast<float>(l[c]);
+    };
+    for (size_t x : own)
+      if (redo[x] != 0.0f) exact(x);
+    own.clear();  // now: the pixels between whose estimate is too uncertain
+    for (size_t x : between) {
+      bool close = true;
+      for (size_t c = 0; c < 3; ++c) {
+        const float* l = l_rgb + c;
+        const float a = l[3 * (x - 3)], b = l[3 * (x - 1)], d = l[3 * (x + 1)], e = l[3 * (x + 3)];
+        const float cubic = (9.0f * (b + d) - (a + e)) / 16.0f, curvature = std::abs(a - b - d + e) / 16.0f;  // cubic - linear
+        l_rgb[3 * x + c] = std::max(0.0f, cubic);
+        close = close && curvature <= kRowTolerance * cubic;
+      }
+      if (!close) own.push_back(x);
+    }
+    if (!own.empty()) {
+      set_layers(r, ends, own, l_rgb, t_rgb, redo);
+      for (size_t x : own)
+        if (redo[x] != 0.0f) exact(x);
+    }
     // The surfaces: the background where nothing ends the ray, the host's (0) behind its depth.
     for (size_t x = 0; x < width; ++x) {
       const bool open = std::isinf(view.max_distance(static_cast<int>(x), y)) && (surfaces.empty() || !hits[x].surface);
