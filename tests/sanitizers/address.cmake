@@ -27,7 +27,7 @@ endif()
 # build here runs AVX-512): AirlightBatch.FloatPathAgreesWithQuadrature (float32 error 4.8e-3 at
 # g -0.3, sigma_t 0.3, bound 1e-3) and NetworkRender.SingleScatteringMatchesTheReference (rms
 # 0.057, bound 0.04).
-set(slow "AirlightBatch.FloatPath|NetworkRender.SingleScattering|ExtremesMatrix|DomCloud|VdbScene|Reference.WhiteFurnace|Reference.SingleScatteringMatchesQuadrature|SurfaceLight.DomGathers"
+set(slow "AirlightBatch.FloatPath|AirlightBatch.TailDifferences|Layers.AnalyticRowLattice|Layers.AnalyticWithoutViewShadows|NetworkRender.SingleScattering|ExtremesMatrix|DomCloud|VdbScene|Reference.WhiteFurnace|Reference.SingleScatteringMatchesQuadrature|SurfaceLight.DomGathers"
          "DomEmission.Box|Propagation.MatchesTheReferenceInSingle|DomErrors.ThickCells|MeshSurfaces.TwoTriangles"
          "NetworkRender.(Floor|SurfacesAreLit)|NetworkEmission|Layers.(Network|HostMatrices|CompositeIsTheImage)"
          "SurfaceShadows.ShadowVolume|Analytic.(SurfaceRadiance|MatchesQuadratureOnUnbounded)|Airlight.TableMatches"
