@@ -490,17 +490,22 @@ class AnalyticSolution final : public MethodSolution {
     const EndTails e = end_tails(depth, r, count);
     layers_from_tails(r.row, e.ends, e.sums, l_rgb, t_rgb, redo);
   }
-  // The same for the pixels in `set`: their rays gathered into a row of their own, its layers
-  // scattered back.
-  void set_layers(const RowRays& r, const RowEnds& e, const std::vector<size_t>& set, float* l_rgb, float* t_rgb, float* redo) const {
+  // The pixels in `set` as a row of their own (their entries, ends and each light's geometry
+  // gathered) with its tails' sums at the entries (row.whole) and at the ends (at_end; 0 where no
+  // ray of the row ends in the medium).
+  struct SetRow {
+    TailRow row;
+    const float* ends;
+    float* at_end[3];
+  };
+  SetRow set_row(const RowRays& r, const RowEnds& e, const std::vector<size_t>& set) const {
     const size_t m = set.size(), mp = padded_count(m), lights = lights_.size();
     thread_local std::vector<float> kept;
     thread_local std::vector<TailLight> kept_tails;
     std::vector<float>& f = kept;
     std::vector<TailLight>& tails = kept_tails;
-    f.assign((16 + 3 * lights) * mp, 0.0f);
-    float *t0 = f.data(), *ends = t0 + mp, *at = ends + mp, *whole = at + mp, *sums = whole + 3 * mp, *l = sums + 3 * mp, *t = l + 3 * mp;
-    float *flags = t + 3 * mp, *geometry = flags + mp;
+    f.assign((10 + 3 * lights) * mp, 0.0f);
+    float *t0 = f.data(), *ends = t0 + mp, *at = ends + mp, *whole = at + mp, *sums = whole + 3 * mp, *geometry = sums + 3 * mp;
     for (size_t k = 0; k < m; ++k) t0[k] = r.t0[set[k]], ends[k] = e.ends[set[k]], at[k] = e.at[set[k]];
     tails.assign(r.tails, r.tails + r.row.light_count);
     for (size_t j = 0; j < lights; ++j) {
@@ -512,23 +517,42 @@ class AnalyticSolution final : public MethodSolution {
         tail.t = g, tail.h = g + mp, tail.share = tail.share ? g + 2 * mp : nullptr;
       }
     }
-    TailRow row = r.row;
-    row.lights = tails.data(), row.t0 = t0, row.count = m;
-    float* const at_entry[3] = {whole, whole + mp, whole + 2 * mp}, *const at_end[3] = {sums, sums + mp, sums + 2 * mp};
-    row.whole[0] = whole, row.whole[1] = whole + mp, row.whole[2] = whole + 2 * mp;
-    tail_sums(table_, row, t0, at_entry);
-    if (e.any_end) tail_sums(table_, row, at, at_end);
-    layers_from_tails(row, ends, at_end, l, t, flags);
-    for (size_t k = 0; k < m; ++k) {
-      std::copy_n(l + 3 * k, 3, l_rgb + 3 * set[k]), std::copy_n(t + 3 * k, 3, t_rgb + 3 * set[k]);
+    SetRow out{r.row, ends, {sums, sums + mp, sums + 2 * mp}};
+    out.row.lights = tails.data(), out.row.t0 = t0, out.row.count = m;
+    float* const at_entry[3] = {whole, whole + mp, whole + 2 * mp};
+    out.row.whole[0] = whole, out.row.whole[1] = whole + mp, out.row.whole[2] = whole + 2 * mp;
+    tail_sums(table_, out.row, t0, at_entry);
+    if (e.any_end) tail_sums(table_, out.row, at, out.at_end);
+    return out;
+  }
+  // L_in, T and redo of the pixels in `set` from their tails (set_row's), scattered into the row's.
+  void set_layers(const RowRays& r, const RowEnds& e, const std::vector<size_t>& set, float* l_rgb, float* t_rgb, float* redo) const {
+    const SetRow s = set_row(r, e, set);
+    const size_t mp = padded_count(set.size());
+    thread_local std::vector<float> kept;
+    std::vector<float>& f = kept;
+    f.resize(7 * mp);
+    float *const l = f.data(), *const t = l + 3 * mp, *const flags = t + 3 * mp;
+    layers_from_tails(s.row, s.ends, s.at_end, l, t, flags);
+    for (size_t k = 0; k < set.size(); ++k) {
+      for (size_t c = 0; c < 3; ++c) l_rgb[3 * set[k] + c] = l[3 * k + c], t_rgb[3 * set[k] + c] = t[3 * k + c];
       redo[set[k]] = flags[k];
     }
   }
-  // T of pixel x alone (layers_from_tails' rule).
-  void transmittance_only(const RowRays& r, const RowEnds& e, size_t x, float* t_rgb) const {
-    const float t0 = r.t0[x], end = e.ends[x];
-    for (int c = 0; c < 3; ++c)
-      t_rgb[3 * x + static_cast<size_t>(c)] = !(end > t0) ? 1.0f : std::isfinite(end) ? std::exp(-static_cast<float>(sigma_t_[c]) * (end - t0)) : 0.0f;
+  // L_in, T and redo of every pixel of the row, the tails taken for the pixels in `set` alone (the
+  // others' L_in 0): their sums scattered into the row's, layers_from_tails over all of it.
+  void layers_of_set(const RowRays& r, const RowEnds& e, const std::vector<size_t>& set, float* l_rgb, float* t_rgb, float* redo) const {
+    const SetRow s = set_row(r, e, set);
+    const size_t padded = r.padded;
+    thread_local std::vector<float> kept;
+    std::vector<float>& f = kept;
+    f.assign(3 * padded, 0.0f);
+    float* const at_end[3] = {f.data(), f.data() + padded, f.data() + 2 * padded};
+    for (size_t c = 0; c < 3; ++c) {
+      std::fill_n(r.whole[c], padded, 0.0f);
+      for (size_t k = 0; k < set.size(); ++k) r.whole[c][set[k]] = s.row.whole[c][k], at_end[c][set[k]] = s.at_end[c][k];
+    }
+    layers_from_tails(r.row, e.ends, at_end, l_rgb, t_rgb, redo);
   }
 
   // The view's depths along pixels [x0, x0 + count) of row y, into the thread's kept buffer.
@@ -545,6 +569,42 @@ class AnalyticSolution final : public MethodSolution {
   static void tails_to_layers(const RowRays& r, const EndTails& e, size_t count, float* layers) {
     const size_t padded = padded_count(count);
     layers_from_tails(r.row, e.ends, e.sums, layers, layers + 3 * padded, layers + 6 * padded);
+  }
+
+  // Clears ok[s - 1][x] where a light's squared distance from the ray, from its entry t0 or from
+  // its end changes by over 0.12 s of itself between pixels x - s and x + s, s = 1, 2 (t, h: the
+  // light's place along and off each ray; t0 or end null where it is the same for every ray: the
+  // eye in the medium, no ray ending in it). Plain loops over restrict pointers, which the
+  // compiler takes in lanes; `squares` holds 3 * count floats.
+  static void steady_to_light(const float* __restrict t, const float* __restrict h, const float* __restrict t0, const float* __restrict end,
+                              size_t count, float* __restrict ok1, float* __restrict ok2, float* __restrict squares) {
+    float* const d[3] = {squares, squares + count, squares + 2 * count};  // from the ray, the entry, the end
+    const float* const at[3] = {nullptr, t0, end};
+    for (size_t i = 0; i < count; ++i) d[0][i] = h[i] * h[i];
+    for (int k = 0; k < 3; ++k) {
+      if (k > 0 && !at[k]) continue;
+      float* __restrict const dk = d[k];
+      const float* __restrict const from = at[k];
+      if (k > 0)
+        for (size_t i = 0; i < count; ++i) {
+          const float along = t[i] - from[i];  // an endless ray's: inf, never moved
+          dk[i] = d[0][i] + along * along;
+        }
+      for (size_t x = 1; x + 1 < count; ++x) ok1[x] = std::abs(dk[x + 1] - dk[x - 1]) > 0.12f * dk[x] ? 0.0f : ok1[x];
+      for (size_t x = 2; x + 2 < count; ++x) ok2[x] = std::abs(dk[x + 2] - dk[x - 2]) > 0.24f * dk[x] ? 0.0f : ok2[x];
+    }
+  }
+
+  // Clears ok[s - 1][x] where v (entries or ends) does not vary smoothly over x - s, x, x + s: the
+  // middle within 1e-3 of the mean of the outer two, or all three endless. In lanes, like steady_to_light.
+  static void smooth_along(const float* __restrict v, size_t count, float* __restrict ok1, float* __restrict ok2) {
+    const auto smooth = [](float a, float m, float b) {
+      const bool finite = (std::abs(a) < INFINITY) & (std::abs(m) < INFINITY) & (std::abs(b) < INFINITY);
+      const bool close = std::abs(m - 0.5f * (a + b)) <= 1e-3f * (std::abs(m) + 1e-3f);
+      return (finite & close) | ((a == INFINITY) & (m == INFINITY) & (b == INFINITY));
+    };
+    for (size_t x = 1; x + 1 < count; ++x) ok1[x] = smooth(v[x - 1], v[x], v[x + 1]) ? ok1[x] : 0.0f;
+    for (size_t x = 2; x + 2 < count; ++x) ok2[x] = smooth(v[x - 2], v[x], v[x + 2]) ? ok2[x] : 0.0f;
   }
 
   // A lit stretch [a, b] of ray x toward light l, where the light's shadows cut the ray.
@@ -633,41 +693,51 @@ class AnalyticSolution final : public MethodSolution {
         for (size_t k = 0; k < r.tails_per_light; ++k) r.tails[l * r.tails_per_light + k].share = whole ? nullptr : share;
       }
     }
-    // The row lattice: odd pixels between two that end on the same surface (or none), at entries
-    // and ends varying smoothly, seen alike by every light and away from each, take L_in from
-    // their neighbours where the estimate is sure to kRowTolerance; the others their own tails.
+    // The row lattice, in two levels: pixels x = 2 mod 4 from x - 6, x - 2, x + 2 and x + 6, then
+    // the odd ones from x - 3, x - 1, x + 1 and x + 3 (their neighbours exact or of the first
+    // level), where the pixels between x - s and x + s end on the same surface (or none), at
+    // entries and ends varying smoothly, are seen alike by every light and lie away from each;
+    // their L_in is the cubic through the four where it is sure to kRowTolerance, the others'
+    // their own tails.
     const RowEnds ends = row_ends(depth, r, width);
-    thread_local std::vector<size_t> kept_own, kept_between;
-    std::vector<size_t>&own = kept_own, &between = kept_between;
-    own.clear(), between.clear();
-    const auto smooth = [](float a, float m, float b) {
-      if (!std::isfinite(a) || !std::isfinite(m) || !std::isfinite(b)) return std::isinf(a) && std::isinf(m) && std::isinf(b);
-      return std::abs(m - 0.5f * (a + b)) <= 1e-3f * (std::abs(m) + 1e-3f);
+    thread_local std::vector<size_t> kept_own, kept_between[2];
+    std::vector<size_t>& own = kept_own;
+    std::vector<size_t>* const between = kept_between;  // [s - 1]: the pixels at step s
+    own.clear(), between[0].clear(), between[1].clear();
+    // Away from each light: the light's distance from the ray, from its entry and from its end
+    // change by at most 3% a pixel (L_in goes as 1 / h along a ray passing the light, the
+    // scattering at either end as 1 / d^2: the mean's error is second order in that change).
+    // Compared squared (0.12 of the squares is 3% of the distances to first order), in lanes: it
+    // runs for every pixel and light.
+    thread_local std::vector<float> kept_steady;
+    std::vector<float>& steady = kept_steady;  // 1: steady, at steps 1 and 2; 3 rows of squares after them
+    steady.assign(5 * width, 1.0f);
+    float* const ok[2] = {steady.data(), steady.data() + width};
+    const bool one_entry = std::all_of(r.t0, r.t0 + width, [&](float t0) { return t0 == r.t0[0]; });
+    const bool endless = std::all_of(ends.ends, ends.ends + width, [](float end) { return end == INFINITY; });
+    for (size_t l = 0; l < lights; ++l) {
+      const float* const t = r.geometry + 3 * l * r.padded;
+      steady_to_light(t, t + r.padded, one_entry ? nullptr : r.t0, endless ? nullptr : ends.ends, width, ok[0], ok[1], ok[1] + width);
+    }
+    smooth_along(r.t0, width, ok[0], ok[1]), smooth_along(ends.ends, width, ok[0], ok[1]);
+    const bool shares = view_shadows_ && !surfaces.empty();
+    const auto alike = [&](size_t x, size_t s) {
+      if (x < 3 * s || x + 3 * s >= width || ok[s - 1][x] == 0.0f) return false;
+      for (size_t i = x - s; i <= x + s && !surfaces.empty(); ++i) {
+        if (cut[i] || hits[i].surface != hits[x].surface) return false;
+        for (size_t l = 0; l < lights && shares; ++l)
+          if (r.share(l)[i] != r.share(l)[x]) return false;
+      }
+      return true;
     };
     for (size_t x = 0; x < width; ++x) {
-      bool alike = x % 2 == 1 && x >= 3 && x + 3 < width && !cut[x - 1] && !cut[x] && !cut[x + 1] && smooth(r.t0[x - 1], r.t0[x], r.t0[x + 1]) &&
-                   smooth(ends.ends[x - 1], ends.ends[x], ends.ends[x + 1]) &&
-                   (surfaces.empty() || (hits[x - 1].surface == hits[x].surface && hits[x + 1].surface == hits[x].surface));
-      for (size_t l = 0; l < lights && alike && view_shadows_ && !surfaces.empty(); ++l)
-        alike = r.share(l)[x - 1] == r.share(l)[x] && r.share(l)[x + 1] == r.share(l)[x];
-      // Away from each light: the light's distance from the ray, from its entry and from its end
-      // change by at most 3% a pixel (L_in goes as 1 / h along a ray passing the light, the
-      // scattering at either end as 1 / d^2: the mean's error is second order in that change).
-      for (size_t l = 0; l < lights && alike; ++l) {
-        const float *t = r.geometry + 3 * l * r.padded, *h = t + r.padded;
-        const auto steady = [&](auto&& distance) { return std::abs(distance(x + 1) - distance(x - 1)) <= 0.06f * distance(x); };
-        const auto from = [&](const float* at) {
-          return [&, at](size_t i) { return std::isfinite(at[i]) ? std::hypot(t[i] - at[i], h[i]) : h[i]; };
-        };
-        alike = steady([&](size_t i) { return h[i]; }) && steady(from(r.t0)) && steady(from(ends.ends));
-      }
-      (alike ? between : own).push_back(x);
+      const size_t s = x % 4 == 2 ? 2 : x % 2 == 1 ? 1 : 0;
+      (s > 0 && alike(x, s) ? between[s - 1] : own).push_back(x);
     }
-    if (between.empty()) {
+    if (between[0].empty() && between[1].empty()) {
       whole_row_layers(r, depth, width, l_rgb, t_rgb, redo);
     } else {
-      set_layers(r, ends, own, l_rgb, t_rgb, redo);
-      for (size_t x : between) transmittance_only(r, ends, x, t_rgb), redo[x] = 0.0f;
+      layers_of_set(r, ends, own, l_rgb, t_rgb, redo);
     }
     add_lit_pieces(r, pieces, l_rgb, redo);
     const auto exact = [&](size_t x) {
@@ -676,22 +746,24 @@ class AnalyticSolution final : public MethodSolution {
     };
     for (size_t x : own)
       if (redo[x] != 0.0f) exact(x);
-    own.clear();  // now: the pixels between whose estimate is too uncertain
-    for (size_t x : between) {
-      bool close = true;
-      for (size_t c = 0; c < 3; ++c) {
-        const float* l = l_rgb + c;
-        const float a = l[3 * (x - 3)], b = l[3 * (x - 1)], d = l[3 * (x + 1)], e = l[3 * (x + 3)];
-        const float cubic = (9.0f * (b + d) - (a + e)) / 16.0f, curvature = std::abs(a - b - d + e) / 16.0f;  // cubic - linear
-        l_rgb[3 * x + c] = std::max(0.0f, cubic);
-        close = close && curvature <= kRowTolerance * cubic;
+    for (size_t s : {2, 1}) {
+      own.clear();  // now: the pixels at step s whose estimate is too uncertain
+      for (size_t x : between[s - 1]) {
+        bool close = true;
+        for (size_t c = 0; c < 3; ++c) {
+          const float* l = l_rgb + c;
+          const float a = l[3 * (x - 3 * s)], b = l[3 * (x - s)], d = l[3 * (x + s)], e = l[3 * (x + 3 * s)];
+          const float cubic = (9.0f * (b + d) - (a + e)) / 16.0f, curvature = std::abs(a - b - d + e) / 16.0f;  // cubic - linear
+          l_rgb[3 * x + c] = std::max(0.0f, cubic);
+          close = close & (curvature <= kRowTolerance * cubic);
+        }
+        if (!close) own.push_back(x);
       }
-      if (!close) own.push_back(x);
-    }
-    if (!own.empty()) {
-      set_layers(r, ends, own, l_rgb, t_rgb, redo);
-      for (size_t x : own)
-        if (redo[x] != 0.0f) exact(x);
+      if (!own.empty()) {
+        set_layers(r, ends, own, l_rgb, t_rgb, redo);
+        for (size_t x : own)
+          if (redo[x] != 0.0f) exact(x);
+      }
     }
     // The surfaces: the background where nothing ends the ray, the host's (0) behind its depth.
     for (size_t x = 0; x < width; ++x) {
