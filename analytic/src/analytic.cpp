@@ -469,9 +469,8 @@ class AnalyticSolution final : public MethodSolution {
     const float* ends;
     const float* sums[3];
   };
-  EndTails end_tails(const float* depth, const RowRays& r, size_t count) const {
+  EndTails end_tails(const RowEnds& e, const RowRays& r, size_t count) const {
     const size_t padded = padded_count(count);
-    const RowEnds e = row_ends(depth, r, count);
     thread_local std::vector<float> kept;
     std::vector<float>& at_end = kept;
     at_end.assign(3 * padded, 0.0f);
@@ -480,14 +479,14 @@ class AnalyticSolution final : public MethodSolution {
     if (e.any_end) tail_sums(table_, r.row, e.at, sums);
     return {e.ends, {sums[0], sums[1], sums[2]}};
   }
-  // The row lattice takes an odd pixel's L_in from its neighbours, the cubic through x - 3, x - 1,
-  // x + 1 and x + 3, where it differs from the linear one (their second difference, the linear
-  // mean's error) by at most this share of it.
+  // The row lattice takes a pixel's L_in from its neighbours at step s, the cubic through x - 3s,
+  // x - s, x + s and x + 3s, where it differs from the linear one (their second difference, the
+  // linear mean's error) by at most this share of it.
   static constexpr float kRowTolerance = 5e-4f;
 
   // L_in, T and redo of every pixel of the row from its tails.
-  void whole_row_layers(const RowRays& r, const float* depth, size_t count, float* l_rgb, float* t_rgb, float* redo) const {
-    const EndTails e = end_tails(depth, r, count);
+  void whole_row_layers(const RowRays& r, const RowEnds& ends, size_t count, float* l_rgb, float* t_rgb, float* redo) const {
+    const EndTails e = end_tails(ends, r, count);
     layers_from_tails(r.row, e.ends, e.sums, l_rgb, t_rgb, redo);
   }
   // The pixels in `set` as a row of their own (their entries, ends and each light's geometry
@@ -735,7 +734,7 @@ class AnalyticSolution final : public MethodSolution {
       (s > 0 && alike(x, s) ? between[s - 1] : own).push_back(x);
     }
     if (between[0].empty() && between[1].empty()) {
-      whole_row_layers(r, depth, width, l_rgb, t_rgb, redo);
+      whole_row_layers(r, ends, width, l_rgb, t_rgb, redo);
     } else {
       layers_of_set(r, ends, own, l_rgb, t_rgb, redo);
     }
@@ -932,7 +931,7 @@ class AnalyticSolution final : public MethodSolution {
     thread_local std::vector<float> kept;
     std::vector<float>& layers = kept;
     layers.resize(7 * padded_count(count));
-    tails_to_layers(r, end_tails(view_depths(view, y, x0, count), r, count), count, layers.data());  // no float64 redo here
+    tails_to_layers(r, end_tails(row_ends(view_depths(view, y, x0, count), r, count), r, count), count, layers.data());  // no float64 redo here
     for (size_t i = 0; i < count; ++i) {
       float* pixel = out.pixel(x0 + static_cast<int>(i), y);
       for (int c = 0; c < 3; ++c) pixel[c] += layers[3 * i + static_cast<size_t>(c)];

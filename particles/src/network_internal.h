@@ -124,8 +124,8 @@ struct SplatInputs {
   std::function<Rgb(int x, int y, const Ray& ray, double& t_end)> end_of;
 };
 
-// Where a render hands each pixel's layers (x, y), threaded.
-using PixelSink = std::function<void(int, int, const PixelLayers&)>;
+// Where a render hands its pixels' layers: a run of row y from pixel x0 on, threaded.
+using PixelSink = std::function<void(int y, int x0, std::span<const PixelLayers> run)>;
 
 // The splat of `front_to_back` (the particles by distance from the eye) into `sink`, per pixel;
 // or, without ends, over a lattice of kSplatNodesPerWidth nodes to the narrowest footprint's width,

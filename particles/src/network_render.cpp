@@ -264,7 +264,8 @@ nlohmann::json render_into(const Scene& scene, const ParticleField& field, const
           const Rgb radiance = march(
               along, material.sigma_t, scattered, [&](double t) { return direct(ray.origin + t * ray.direction, -ray.direction); }, transmittance,
               t_hit);
-          sink(x, y, {radiance, transmittance, leaving});
+          const PixelLayers layers{radiance, transmittance, leaving};
+          sink(y, x, {&layers, 1});
         }
       progress.advance();
     }
@@ -283,7 +284,9 @@ Image render_network(const Scene& scene, const ParticleField& field, const Netwo
 RenderResult render_network(const Scene& scene, const ParticleField& field, const NetworkSolution& solution, const RenderOptions& options,
                             const View& view, NetworkRender render) {
   RenderResult result = RenderResult::for_view(view);
-  result.stats = render_into(scene, field, solution, options, view, render, [&](int x, int y, const PixelLayers& p) { result.set(x, y, p); });
+  result.stats = render_into(scene, field, solution, options, view, render, [&](int y, int x0, std::span<const PixelLayers> run) {
+    for (size_t i = 0; i < run.size(); ++i) result.set(x0 + static_cast<int>(i), y, run[i]);
+  });
   return result;
 }
 
@@ -318,9 +321,12 @@ class NetworkMethodSolution final : public MethodSolution {
       float* p = span.pixel(x, y);
       p[0] = static_cast<float>(v.r), p[1] = static_cast<float>(v.g), p[2] = static_cast<float>(v.b);
     };
-    render_into(seen, *field_, solution_, options, view, render_, [&](int x, int y, const PixelLayers& p) {
-      put(out.inscatter, x, y, p.inscatter), put(out.transmittance, x, y, p.transmittance);
-      if (out.surface.data) put(out.surface, x, y, p.surface);
+    render_into(seen, *field_, solution_, options, view, render_, [&](int y, int x0, std::span<const PixelLayers> run) {
+      for (size_t i = 0; i < run.size(); ++i) {
+        const int x = x0 + static_cast<int>(i);
+        put(out.inscatter, x, y, run[i].inscatter), put(out.transmittance, x, y, run[i].transmittance);
+        if (out.surface.data) put(out.surface, x, y, run[i].surface);
+      }
     });
     return true;
   }

@@ -203,18 +203,21 @@ int splat_network(const SplatInputs& in, std::span<const uint32_t> front_to_back
             rays.t_end[j] = static_cast<float>(t_end);
           }
       splat_rays(particles.view(tiles[static_cast<size_t>(t)]), sigma_t, channels, rays.rays(in.end_of != nullptr));
-      for (int y = y0; y < y1; ++y)
+      for (int y = y0; y < y1; ++y) {
+        PixelLayers run[kTile];
         for (int x = x0; x < x1; ++x) {
           const size_t j = static_cast<size_t>((y - y0) * kTile + (x - x0));
           if (step == 1) {
             const Rgb leaving = in.end_of ? rays.leaving[j] : in.background;
-            sink(x, y, {Rgb(rays.radiance[0][j], rays.radiance[1][j], rays.radiance[2][j]),
-                              Rgb(rays.transmittance[0][j], rays.transmittance[1][j], rays.transmittance[2][j]), leaving});
+            run[x - x0] = {Rgb(rays.radiance[0][j], rays.radiance[1][j], rays.radiance[2][j]),
+                           Rgb(rays.transmittance[0][j], rays.transmittance[1][j], rays.transmittance[2][j]), leaving};
           } else {
             const size_t node = static_cast<size_t>(y) * static_cast<size_t>(lattice.nx) + static_cast<size_t>(x);
             for (size_t c = 0; c < 3; ++c) node_radiance[c][node] = rays.radiance[c][j], node_transmittance[c][node] = rays.transmittance[c][j];
           }
         }
+        if (step == 1) sink(y, x0, {run, static_cast<size_t>(x1 - x0)});
+      }
       progress.advance();
     }
   });
@@ -222,6 +225,9 @@ int splat_network(const SplatInputs& in, std::span<const uint32_t> front_to_back
   if (step == 1) return step;
   // Each pixel bilinear between its lattice's nodes.
   parallel_for(cam.height_px, options.threads, 16, [&](long long y0, long long y1) {
+    thread_local std::vector<PixelLayers> kept;  // a row's, handed to the sink at once
+    std::vector<PixelLayers>& row = kept;
+    row.resize(static_cast<size_t>(cam.width_px));
     for (auto y = static_cast<int>(y0); y < static_cast<int>(y1); ++y) {
       const int j = y / step;
       const double fy = static_cast<double>(y - j * step) / step;
@@ -237,8 +243,9 @@ int splat_network(const SplatInputs& in, std::span<const uint32_t> front_to_back
                                        w[3] * static_cast<double>(v[c][b + 1]);
           return sum;
         };
-        sink(x, y, {at(node_radiance), at(node_transmittance), in.background});
+        row[static_cast<size_t>(x)] = {at(node_radiance), at(node_transmittance), in.background};
       }
+      sink(y, 0, row);
     }
   });
   return step;
