@@ -574,23 +574,23 @@ class AnalyticSolution final : public MethodSolution {
   // its end changes by over 0.12 s of itself between pixels x - s and x + s, s = 1, 2 (t, h: the
   // light's place along and off each ray; t0 or end null where it is the same for every ray: the
   // eye in the medium, no ray ending in it). Plain loops over restrict pointers, which the
-  // compiler takes in lanes; `squares` holds 3 * count floats.
+  // compiler takes in lanes; `squares` holds 2 * count floats.
   static void steady_to_light(const float* __restrict t, const float* __restrict h, const float* __restrict t0, const float* __restrict end,
                               size_t count, float* __restrict ok1, float* __restrict ok2, float* __restrict squares) {
-    float* const d[3] = {squares, squares + count, squares + 2 * count};  // from the ray, the entry, the end
-    const float* const at[3] = {nullptr, t0, end};
-    for (size_t i = 0; i < count; ++i) d[0][i] = h[i] * h[i];
-    for (int k = 0; k < 3; ++k) {
-      if (k > 0 && !at[k]) continue;
-      float* __restrict const dk = d[k];
-      const float* __restrict const from = at[k];
-      if (k > 0)
-        for (size_t i = 0; i < count; ++i) {
-          const float along = t[i] - from[i];  // an endless ray's: inf, never moved
-          dk[i] = d[0][i] + along * along;
-        }
-      for (size_t x = 1; x + 1 < count; ++x) ok1[x] = std::abs(dk[x + 1] - dk[x - 1]) > 0.12f * dk[x] ? 0.0f : ok1[x];
-      for (size_t x = 2; x + 2 < count; ++x) ok2[x] = std::abs(dk[x + 2] - dk[x - 2]) > 0.24f * dk[x] ? 0.0f : ok2[x];
+    float *const d_ray = squares, *const d_point = squares + count;
+    const auto clear_moved = [&](const float* __restrict d) {
+      for (size_t x = 1; x + 1 < count; ++x) ok1[x] = std::abs(d[x + 1] - d[x - 1]) > 0.12f * d[x] ? 0.0f : ok1[x];
+      for (size_t x = 2; x + 2 < count; ++x) ok2[x] = std::abs(d[x + 2] - d[x - 2]) > 0.24f * d[x] ? 0.0f : ok2[x];
+    };
+    for (size_t i = 0; i < count; ++i) d_ray[i] = h[i] * h[i];
+    clear_moved(d_ray);
+    for (const float* __restrict from : {t0, end}) {
+      if (!from) continue;
+      for (size_t i = 0; i < count; ++i) {
+        const float along = t[i] - from[i];  // an endless ray's: inf, never moved
+        d_point[i] = d_ray[i] + along * along;
+      }
+      clear_moved(d_point);
     }
   }
 
@@ -674,7 +674,6 @@ class AnalyticSolution final : public MethodSolution {
       }
       const ShadowRays stretch_rays{{column(0), column(1), column(2)}, {column(3), column(4), column(5)}, column(6), column(7), width};
       float* const seen = redo;  // the classes, before redo is written
-      cut.assign(padded, 0);
       for (size_t l = 0; l < lights; ++l) {
         float* const share = r.share(l);
         classify_stretches(shadows_[l], stretch_rays, seen);
@@ -705,12 +704,11 @@ class AnalyticSolution final : public MethodSolution {
     own.clear(), between[0].clear(), between[1].clear();
     // Away from each light: the light's distance from the ray, from its entry and from its end
     // change by at most 3% a pixel (L_in goes as 1 / h along a ray passing the light, the
-    // scattering at either end as 1 / d^2: the mean's error is second order in that change).
-    // Compared squared (0.12 of the squares is 3% of the distances to first order), in lanes: it
-    // runs for every pixel and light.
+    // scattering at either end as 1 / d^2: the mean's error is second order in that change;
+    // compared squared, steady_to_light).
     thread_local std::vector<float> kept_steady;
-    std::vector<float>& steady = kept_steady;  // 1: steady, at steps 1 and 2; 3 rows of squares after them
-    steady.assign(5 * width, 1.0f);
+    std::vector<float>& steady = kept_steady;  // 1: steady, at steps 1 and 2; 2 rows of squares after them
+    steady.assign(4 * width, 1.0f);
     float* const ok[2] = {steady.data(), steady.data() + width};
     const bool one_entry = std::all_of(r.t0, r.t0 + width, [&](float t0) { return t0 == r.t0[0]; });
     const bool endless = std::all_of(ends.ends, ends.ends + width, [](float end) { return end == INFINITY; });

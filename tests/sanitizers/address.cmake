@@ -25,9 +25,9 @@ endif()
 # Tests that take 3 s or more in the main (optimised, uninstrumented) suite or 30 s or more here
 # stay there (this job ran 21 min alone on the AMD machine with them, its tests 1142 s), and two
 # accuracy tests whose error grows past their bound in this build (clang, -O1, one Highway
-# target; the main build's dispatch may pick AVX-512): AirlightBatch.FloatPathAgreesWithQuadrature (float32 error 4.8e-3 at
-# g -0.3, sigma_t 0.3, bound 1e-3) and NetworkRender.SingleScatteringMatchesTheReference (rms
-# 0.057, bound 0.04).
+# target; the main build's dispatch may pick AVX-512): AirlightBatch.FloatPathAgreesWithQuadrature
+# (float32 error 4.8e-3 at g -0.3, sigma_t 0.3, bound 1e-3) and
+# NetworkRender.SingleScatteringMatchesTheReference (rms 0.057, bound 0.04).
 set(slow "AirlightBatch.FloatPath|AirlightBatch.TailDifferences|Layers.AnalyticRowLattice|Layers.AnalyticWithoutViewShadows|NetworkRender.SingleScattering|ExtremesMatrix|DomCloud|VdbScene|Reference.WhiteFurnace|Reference.SingleScatteringMatchesQuadrature|SurfaceLight.DomGathers"
          "DomEmission.Box|Propagation.MatchesTheReferenceInSingle|DomErrors.ThickCells|MeshSurfaces.TwoTriangles"
          "NetworkRender.(Floor|SurfacesAreLit)|NetworkEmission|Layers.(Network|HostMatrices|CompositeIsTheImage)"
