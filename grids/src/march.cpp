@@ -371,8 +371,9 @@ void march_row_layers_from(const Marcher& m, const MarchVolume& v, const View& v
 
 // march_layers' lattice step in pixels (MarchSettings::kLatticeNodesPerCell): from one eye without a
 // host's depth, a node per kLatticeNodesPerCell of the narrowest cell as the view's central pixels
-// see it at the volume's farthest corner; else 1. `peaks`: the film positions of the lights in the
-// steps (point lights near dense cells, spots: peaks narrower than a cell) in or near the view.
+// see it at the volume's farthest corner, rounded down to 2^a or 3 2^a (so that the finer levels
+// halve it down to 2 or 3); else 1. `peaks`: the film positions of the lights in the steps (point
+// lights near dense cells, spots: peaks narrower than a cell) in or near the view.
 int lattice_step(const Marcher& m, const MarchVolume& v, const View& view, const Vec3& eye, std::vector<std::array<double, 2>>& peaks) {
   const Camera& camera = view.camera;
   if (!view.depth.empty()) return 1;
@@ -381,8 +382,9 @@ int lattice_step(const Marcher& m, const MarchVolume& v, const View& view, const
   for (int c = 0; c < 8; ++c) far = std::max(far, glm::length(Vec3(c & 1 ? box.hi.x : box.lo.x, c & 2 ? box.hi.y : box.lo.y, c & 4 ? box.hi.z : box.lo.z) - eye));
   const Vec3 h = m.volume.density.cell_size();
   const double cell_pixels = std::min({h.x, h.y, h.z}) / (far * camera.pixel_angle());
-  const int step = std::min(static_cast<int>(cell_pixels / MarchSettings::kLatticeNodesPerCell), std::max(camera.width_px, camera.height_px));
+  int step = std::min(static_cast<int>(cell_pixels / MarchSettings::kLatticeNodesPerCell), std::max(camera.width_px, camera.height_px));
   if (step < 2) return 1;
+  while (step & (step - 1)) step &= step - 1;  // the highest power of 2 in it
   peaks.clear();
   for (int l = 0; l < v.light_count; ++l) {
     const MarchLight& light = v.lights[l];
@@ -395,112 +397,245 @@ int lattice_step(const Marcher& m, const MarchVolume& v, const View& view, const
   return step;
 }
 
-// march_layers on a lattice: the rays through film points (i s + 0.5, j s + 0.5), i < nx, j < ny,
-// reaching past the last pixel, each row a packet; then every pixel bilinear between its nodes.
+// One level of march_lattice_layers: nodes at film points (i step + 0.5, j step + 0.5), i < nx,
+// j < ny, reaching past the last pixel; their L_in and T ([layers][ny][nx], L_in's rows first: 3
+// and 3, or 1 and 1 where the medium and lights are grey); which it holds; which are rough; which
+// cells (nodes i..i+1, j..j+1, at [j nx + i]) the next level resolves.
+struct LatticeLevel {
+  int step = 0;
+  size_t nx = 0, ny = 0;
+  std::vector<float> nodes;
+  // 2: in a cell the level above refines (its node there, or marched); 1: next to one
+  // (interpolated from the level above, for the second differences); 0: not held. Level 0 holds all.
+  std::vector<std::uint8_t> held;
+  std::vector<std::uint8_t> rough, refined;
+  // The refined cells' runs [first, end) along each row of cells: row j's in runs[run_start[j] ..
+  // run_start[j + 1]).
+  std::vector<std::array<std::uint32_t, 2>> runs;
+  std::vector<std::uint32_t> run_start;
+  std::vector<float> weight;  // t / step, t < step: a pixel's between the nodes of its cell
+  float* at(size_t r, size_t i, size_t j) { return nodes.data() + (r * ny + j) * nx + i; }
+};
+
+// march_layers on a lattice of levels: level 0's rays through every node, each row a packet; a
+// cell with a rough node at a corner (below) is refined by the next level, at half the step, which
+// marches the new nodes of such cells and tests them in turn; a pixel is bilinear between the
+// nodes of the first level whose cell around it is not refined, or takes its own ray where even
+// the finest level's is. Rough: a second difference along x or y over kLatticeSpread (of T, or of
+// L_in over its largest on level 0): a silhouette of the volume, the edge of a light, which the
+// bilinear interpolation would blur; and every node near a light in the steps (`peaks`).
 void march_lattice_layers(const Marcher& m, const MarchVolume& v, const View& view, const Vec3& eye, int s, std::span<const std::array<double, 2>> peaks,
                           LayerSpans out, int threads) {
   const Camera& camera = view.camera;
-  const auto nx = static_cast<size_t>((camera.width_px - 1) / s + 2), ny = static_cast<size_t>((camera.height_px - 1) / s + 2);
-  // The most nodes any step takes (2): the kept buffers grow once, not each time the step falls.
-  const auto most_x = static_cast<size_t>((camera.width_px - 1) / 2 + 2), most_y = static_cast<size_t>((camera.height_px - 1) / 2 + 2);
-  thread_local std::vector<float> kept;  // [6][ny][nx]: L_in, then T; this thread's, frame after frame
-  std::vector<float>& nodes = kept;
-  nodes.reserve(6 * most_x * most_y), nodes.resize(6 * nx * ny);
-  // Row r of the kernel's result (L_in then T per channel): one row per layer where grey.
-  const size_t grey = v.channels == 1 ? 0 : 1;
-  const auto result_row = [grey](size_t r) { return r < 3 ? r * grey : 3 + (r - 3) * grey; };
-  const auto node_rows = [&](long long j0, long long j1) {
-    const size_t padded = nx + 64;
+  const auto width = static_cast<size_t>(camera.width_px), height = static_cast<size_t>(camera.height_px);
+  int count = 1;
+  while ((s >> (count - 1)) > 2) ++count;  // s, s / 2, ..., 2 (s a power of 2)
+  // Kept per thread, the finest level first: slot k holds steps of at least 2^(k+1) pixels, so the
+  // buffers grow to their most once, not each time the step changes.
+  thread_local std::vector<LatticeLevel> kept;
+  int most_count = 1;  // for the largest step this film takes
+  while ((std::max(width, height) >> (most_count - 1)) > 2) ++most_count;
+  if (kept.size() < static_cast<size_t>(most_count)) kept.resize(static_cast<size_t>(most_count));
+  std::vector<LatticeLevel>& levels = kept;  // the rows' threads read this thread's
+  const auto level = [&levels, count](int k) -> LatticeLevel& { return levels[static_cast<size_t>(count - 1 - k)]; };
+  // The layers' rows: L_in's, then T's, each one row where grey.
+  const size_t grey = v.channels == 1 ? 0 : 1, layers = grey ? 6 : 2;
+  for (int k = 0; k < count; ++k) {
+    LatticeLevel& l = level(k);
+    l.step = s >> k;
+    l.nx = (width - 1) / static_cast<size_t>(l.step) + 2, l.ny = (height - 1) / static_cast<size_t>(l.step) + 2;
+    l.nodes.resize(layers * l.nx * l.ny), l.held.assign(l.nx * l.ny, k == 0 ? 2 : 0), l.rough.assign(l.nx * l.ny, 0), l.refined.assign(l.nx * l.ny, 0);
+    l.weight.resize(static_cast<size_t>(l.step));
+    for (int t = 0; t < l.step; ++t) l.weight[static_cast<size_t>(t)] = static_cast<float>(t) / static_cast<float>(l.step);
+  }
+  for (int slot = 0; slot < most_count; ++slot) {  // slot k: steps of 2^(k+1) or more
+    LatticeLevel& l = levels[static_cast<size_t>(slot)];
+    const size_t nodes = (((width - 1) >> (slot + 1)) + 2) * (((height - 1) >> (slot + 1)) + 2);
+    l.nodes.reserve(6 * nodes), l.held.reserve(nodes), l.rough.reserve(nodes), l.refined.reserve(nodes), l.runs.reserve(nodes / 2 + 1);
+    l.run_start.reserve(((height - 1) >> (slot + 1)) + 3), l.weight.reserve(std::max(width, height));
+  }
+  // Layer row r's in the kernel's result (L_in then T per channel, row 0 and 3 alone where grey).
+  const auto result_row = [layers](size_t r) { return r < layers / 2 ? r : 3 + r - layers / 2; };
+  // Rays through row y's film points at[0 .. n) (pixels), their layers into put(r, e, value).
+  const size_t most_rays = std::max(width, level(0).nx) + 64;
+  const auto march_points = [&](double y, const std::vector<float>& at, size_t n, auto&& put) {
     thread_local std::vector<float> packed, result;
-    packed.reserve(9 * (most_x + 64)), result.reserve(6 * (most_x + 64));
+    packed.reserve(9 * most_rays), result.reserve(6 * most_rays);
+    const size_t padded = n + 64;
     packed.resize(9 * padded), result.resize(6 * padded);
-    for (auto j = static_cast<size_t>(j0); j < static_cast<size_t>(j1); ++j) {
-      Vec3 a, b;
-      camera.row_frame(static_cast<double>(j) * s + 0.5, a, b);
-      a += 0.5 * b - 0.5 * s * b, b *= s;  // a + b (i + 0.5) = a_row + b_row (i s + 0.5)
-      RowFrame frame = row_frame_of(m, eye, a, b);
-      march_row_packet(frame, packed.data(), padded, nx);
-      march_rays(v, m.volume.phase, packet_of(packed, result, padded, nx));
-      for (size_t r = 0; r < 6; ++r) {
-        const float* from = result.data() + result_row(r) * padded;
-        std::copy_n(from, nx, nodes.data() + (r * ny + j) * nx);
+    Vec3 a, b;
+    camera.row_frame(y, a, b);
+    RowFrame frame = row_frame_of(m, eye, a, b);
+    frame.film = at.data();
+    march_row_packet(frame, packed.data(), padded, n);
+    march_rays(v, m.volume.phase, packet_of(packed, result, padded, n));
+    for (size_t r = 0; r < layers; ++r)
+      for (size_t e = 0; e < n; ++e) put(r, e, result[result_row(r) * padded + e]);
+  };
+  const auto room = [&](std::vector<float>& at, size_t n) {
+    at.reserve(most_rays), at.resize(n + 64, 0.0f);  // padded for whole vectors
+  };
+  // Level 0: every node.
+  {
+    LatticeLevel& l = level(0);
+    const auto rows = [&](long long j0, long long j1) {
+      thread_local std::vector<float> at;
+      room(at, l.nx);
+      for (size_t i = 0; i < l.nx; ++i) at[i] = static_cast<float>(i * static_cast<size_t>(l.step)) + 0.5f;
+      for (auto j = static_cast<size_t>(j0); j < static_cast<size_t>(j1); ++j)
+        march_points(static_cast<double>(j * static_cast<size_t>(l.step)) + 0.5, at, l.nx, [&](size_t r, size_t e, float value) { *l.at(r, e, j) = value; });
+    };
+    parallel_for(static_cast<long long>(l.ny), threads, 1, [&rows](long long j0, long long j1) { rows(j0, j1); });
+  }
+  float peak = 0.0f;
+  {
+    LatticeLevel& l = level(0);
+    for (size_t e = 0; e < layers / 2 * l.nx * l.ny; ++e) peak = std::max(peak, l.nodes[e]);
+  }
+  for (int k = 0; k < count; ++k) {
+    LatticeLevel& l = level(k);
+    if (k > 0) {
+      // The nodes in the refined cells of the level above (and those next to them), taken from it
+      // where they coincide, marched where new, interpolated from it next to them.
+      LatticeLevel& above = level(k - 1);
+      for (int pass = 2; pass >= 1; --pass)
+        for (size_t b = 0; b + 1 < above.ny; ++b)
+          for (size_t a = 0; a + 1 < above.nx; ++a) {
+            if (!above.refined[b * above.nx + a]) continue;
+            const size_t wide = pass == 1 ? 1 : 0;  // pass 1: a node wider
+            for (size_t j = 2 * b >= wide ? 2 * b - wide : 0; j <= std::min(l.ny - 1, 2 * b + 2 + wide); ++j)
+              for (size_t i = 2 * a >= wide ? 2 * a - wide : 0; i <= std::min(l.nx - 1, 2 * a + 2 + wide); ++i)
+                l.held[j * l.nx + i] = std::max<std::uint8_t>(l.held[j * l.nx + i], static_cast<std::uint8_t>(pass));
+          }
+      const auto rows = [&](long long j0, long long j1) {
+        thread_local std::vector<float> at;
+        thread_local std::vector<size_t> which;
+        room(at, l.nx), which.reserve(most_rays), which.clear();
+        for (auto j = static_cast<size_t>(j0); j < static_cast<size_t>(j1); ++j) {
+          size_t n = 0;
+          const size_t pj = j / 2;
+          const float fj = (j % 2) ? 0.5f : 0.0f;
+          for (size_t i = 0; i < l.nx; ++i) {
+            const std::uint8_t held = l.held[j * l.nx + i];
+            if (held == 0) continue;
+            const size_t pi = i / 2;
+            if (i % 2 == 0 && j % 2 == 0) {
+              for (size_t r = 0; r < layers; ++r) *l.at(r, i, j) = *above.at(r, pi, pj);
+            } else if (held == 2) {
+              at[n] = static_cast<float>(i * static_cast<size_t>(l.step)) + 0.5f;
+              if (which.size() <= n) which.push_back(i);
+              else which[n] = i;
+              ++n;
+            } else {
+              const float fi = (i % 2) ? 0.5f : 0.0f;
+              for (size_t r = 0; r < layers; ++r) {
+                const float* p = above.at(r, pi, pj);
+                const float top = fi > 0.0f ? p[0] + fi * (p[1] - p[0]) : p[0];
+                float below = top;
+                if (fj > 0.0f) {
+                  const float* q = p + above.nx;
+                  below = fi > 0.0f ? q[0] + fi * (q[1] - q[0]) : q[0];
+                }
+                *l.at(r, i, j) = top + fj * (below - top);
+              }
+            }
+          }
+          if (n > 0)
+            march_points(static_cast<double>(j * static_cast<size_t>(l.step)) + 0.5, at, n, [&](size_t r, size_t e, float value) { *l.at(r, which[e], j) = value; });
+        }
+      };
+      parallel_for(static_cast<long long>(l.ny), threads, 4, [&rows](long long j0, long long j1) { rows(j0, j1); });
+    }
+    // Rough nodes among those this level holds in refined cells.
+    const auto roughness = [&](long long j0, long long j1) {
+      for (auto j = static_cast<size_t>(j0); j < static_cast<size_t>(j1); ++j)
+        for (size_t i = 0; i < l.nx; ++i) {
+          if (l.held[j * l.nx + i] != 2) continue;
+          for (size_t r = 0; r < layers && !l.rough[j * l.nx + i]; ++r) {
+            const float* at = l.at(r, i, j);
+            const float limit = MarchSettings::kLatticeSpread * (r < layers / 2 ? peak : 1.0f);
+            const bool across = i > 0 && i + 1 < l.nx && std::abs(at[-1] - 2.0f * at[0] + at[1]) > limit;
+            const bool down = j > 0 && j + 1 < l.ny && std::abs(at[-static_cast<std::ptrdiff_t>(l.nx)] - 2.0f * at[0] + at[l.nx]) > limit;
+            if (across || down) l.rough[j * l.nx + i] = 1;
+          }
+        }
+    };
+    parallel_for(static_cast<long long>(l.ny), threads, 8, [&roughness](long long j0, long long j1) { roughness(j0, j1); });
+    for (const auto& [px, py] : peaks) {  // around a light in the steps, kLatticePeakNodes of this level's
+      const int reach = MarchSettings::kLatticePeakNodes, ci = static_cast<int>(std::floor((px - 0.5) / l.step)), cj = static_cast<int>(std::floor((py - 0.5) / l.step));
+      for (int j = std::max(0, cj - reach); j <= std::min(static_cast<int>(l.ny) - 1, cj + reach + 1); ++j)
+        for (int i = std::max(0, ci - reach); i <= std::min(static_cast<int>(l.nx) - 1, ci + reach + 1); ++i)
+          l.rough[static_cast<size_t>(j) * l.nx + static_cast<size_t>(i)] = 1;
+    }
+    // The cells the next level (or, on the last, each pixel's own ray) resolves: a rough corner,
+    // inside a cell the level above refined.
+    const LatticeLevel* above = k > 0 ? &level(k - 1) : nullptr;
+    l.runs.clear(), l.run_start.clear();
+    for (size_t j = 0; j + 1 < l.ny; ++j) {
+      l.run_start.push_back(static_cast<std::uint32_t>(l.runs.size()));
+      for (size_t i = 0; i + 1 < l.nx; ++i) {
+        const std::uint8_t* c = l.rough.data() + j * l.nx + i;
+        if (!(c[0] | c[1] | c[l.nx] | c[l.nx + 1]) || (above && !above->refined[(j / 2) * above->nx + i / 2])) continue;
+        l.refined[j * l.nx + i] = 1;
+        if (i > 0 && l.refined[j * l.nx + i - 1]) ++l.runs.back()[1];
+        else l.runs.push_back({static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(i + 1)});
       }
     }
-  };
-  // Bodies of one reference: std::function keeps them without allocating.
-  parallel_for(static_cast<long long>(ny), threads, 1, [&node_rows](long long j0, long long j1) { node_rows(j0, j1); });
-  // Rough nodes: a second difference along x or y over kLatticeSpread (of T, or of L_in over its
-  // largest on the lattice): a silhouette of the volume, an edge of a light, which the bilinear
-  // interpolation would blur. A pixel next to one takes its own ray: the runs of such pixels in a
-  // row, each a packet.
-  thread_local std::vector<std::uint8_t> kept_rough;
-  std::vector<std::uint8_t>& rough = kept_rough;
-  rough.reserve(most_x * most_y), rough.assign(nx * ny, 0);
-  float peak = 0.0f;
-  for (size_t k = 0; k < 3 * nx * ny; ++k) peak = std::max(peak, nodes[k]);
-  const auto roughness = [&](long long j0, long long j1) {
-    for (auto j = static_cast<size_t>(j0); j < static_cast<size_t>(j1); ++j)
-      for (size_t i = 0; i < nx; ++i)
-        for (size_t r = 0; r < 6 && !rough[j * nx + i]; ++r) {
-          const float* at = nodes.data() + (r * ny + j) * nx + i;
-          const float limit = MarchSettings::kLatticeSpread * (r < 3 ? peak : 1.0f);
-          const bool across = i > 0 && i + 1 < nx && std::abs(at[-1] - 2.0f * at[0] + at[1]) > limit;
-          const bool down = j > 0 && j + 1 < ny && std::abs(at[-static_cast<std::ptrdiff_t>(nx)] - 2.0f * at[0] + at[nx]) > limit;
-          if (across || down) rough[j * nx + i] = 1;
-        }
-  };
-  parallel_for(static_cast<long long>(ny), threads, 8, [&roughness](long long j0, long long j1) { roughness(j0, j1); });
-  for (const auto& [px, py] : peaks) {  // around a light in the steps, every pixel its own ray
-    const int reach = MarchSettings::kLatticePeakNodes, ci = static_cast<int>(std::floor((px - 0.5) / s)), cj = static_cast<int>(std::floor((py - 0.5) / s));
-    for (int j = std::max(0, cj - reach); j <= std::min(static_cast<int>(ny) - 1, cj + reach + 1); ++j)
-      for (int i = std::max(0, ci - reach); i <= std::min(static_cast<int>(nx) - 1, ci + reach + 1); ++i) rough[static_cast<size_t>(j) * nx + static_cast<size_t>(i)] = 1;
+    l.run_start.push_back(static_cast<std::uint32_t>(l.runs.size()));
   }
-  // Each pixel's column of nodes and its weight between them, the same in every row.
-  thread_local std::vector<size_t> kept_column;
-  thread_local std::vector<float> kept_fx;
-  std::vector<size_t>& column = kept_column;
-  std::vector<float>& fx = kept_fx;
-  column.resize(static_cast<size_t>(camera.width_px)), fx.resize(column.size());
-  for (int x = 0; x < camera.width_px; ++x)
-    column[static_cast<size_t>(x)] = static_cast<size_t>(x / s), fx[static_cast<size_t>(x)] = static_cast<float>(x % s) / static_cast<float>(s);
+  // Each pixel: level 0 between its nodes, then each finer level over the pixels of the cells the
+  // level above refines, then its own ray in the cells the last refines.
   const auto pixel_rows = [&](long long y0, long long y1) {
-    const auto width = static_cast<size_t>(camera.width_px);
     const size_t padded = width + 64;
-    thread_local std::vector<float> packed, result, blend, line;
-    blend.reserve(6 * most_x);
-    packed.resize(9 * padded), result.resize(6 * padded), blend.resize(6 * nx), line.resize(6 * padded);
-    for (auto y = static_cast<int>(y0); y < y1; ++y) {
-      const auto j = static_cast<size_t>(y / s);
-      const float fy = static_cast<float>(y % s) / static_cast<float>(s);
-      // Between the node rows, then along the row, each channel apart.
-      for (size_t r = 0; r < 6; ++r) {
-        const float* above = nodes.data() + (r * ny + j) * nx;
-        float* b = blend.data() + r * nx;
-        for (size_t i = 0; i < nx; ++i) b[i] = above[i] + fy * (above[i + nx] - above[i]);
-        float* l = line.data() + r * padded;
-        for (size_t x = 0; x < width; ++x) l[x] = b[column[x]] + fx[x] * (b[column[x] + 1] - b[column[x]]);
-      }
-      // Pixels next to a rough node, each its own ray: the runs of them, each a packet.
-      const std::uint8_t* near = rough.data() + j * nx;
-      const auto own = [&](size_t x) { const size_t i = column[x]; return (near[i] | near[i + 1] | near[i + nx] | near[i + nx + 1]) != 0; };
-      Vec3 a, b;
-      camera.row_frame(y + 0.5, a, b);
-      for (size_t x = 0; x < width;) {
-        if (!own(x)) {
-          ++x;
-          continue;
+    thread_local std::vector<float> line, at, mix;
+    thread_local std::vector<size_t> which;
+    const size_t mix_stride = (width - 1) / 2 + 2;  // nodes a row of any level holds
+    line.reserve(6 * (most_rays + 64)), line.resize(layers * padded), mix.reserve(6 * mix_stride), mix.resize(layers * mix_stride);
+    room(at, width), which.reserve(most_rays), which.clear();
+    // Pixels [x0, x1) of row y (x0 on a node) bilinear between level l's nodes: between its node
+    // rows, then each cell's pixels along x.
+    const auto blend = [&](LatticeLevel& l, size_t x0, size_t x1, size_t y) {
+      const auto step = static_cast<size_t>(l.step);
+      const size_t i0 = x0 / step, i1 = (x1 - 1) / step + 2, row = y / step;
+      const float fy = l.weight[y % step];
+      const float* w = l.weight.data();
+      for (size_t r = 0; r < layers; ++r) {
+        const float* above = l.at(r, 0, row);
+        float* b = mix.data() + r * mix_stride;
+        for (size_t i = i0; i < i1; ++i) b[i] = above[i] + fy * (above[i + l.nx] - above[i]);
+        float* to = line.data() + r * padded;
+        for (size_t i = i0, x = x0; x < x1; ++i, x += step) {
+          const float left = b[i], d = b[i + 1] - left;
+          const size_t n = std::min(step, x1 - x);
+          for (size_t t = 0; t < n; ++t) to[x + t] = left + w[t] * d;
         }
-        const size_t run = x;
-        while (x < width && own(x)) ++x;
-        const RowFrame frame = row_frame_of(m, eye, a + static_cast<double>(run) * b, b);
-        const size_t count = x - run;
-        march_row_packet(frame, packed.data(), padded, count);
-        march_rays(v, m.volume.phase, packet_of(packed, result, padded, count));
-        for (size_t r = 0; r < 6; ++r) std::copy_n(result.data() + result_row(r) * padded, count, line.data() + r * padded + run);
       }
-      for (const auto& [span, first] : {std::pair{out.inscatter, size_t(0)}, std::pair{out.transmittance, size_t(3)}}) {
+    };
+    for (auto y = static_cast<size_t>(y0); y < static_cast<size_t>(y1); ++y) {
+      blend(level(0), 0, width, y);
+      for (int k = 0; k < count; ++k) {
+        LatticeLevel& l = level(k);
+        const auto step = static_cast<size_t>(l.step);
+        const size_t b = y / step;
+        size_t n = 0;
+        for (size_t r = l.run_start[b]; r < l.run_start[b + 1]; ++r) {
+          const size_t x0 = l.runs[r][0] * step, x1 = std::min(width, l.runs[r][1] * step);
+          if (k + 1 < count) {
+            blend(level(k + 1), x0, x1, y);
+            continue;
+          }
+          for (size_t x = x0; x < x1; ++x) {
+            at[n] = static_cast<float>(x) + 0.5f;
+            if (which.size() <= n) which.push_back(x);
+            else which[n] = x;
+            ++n;
+          }
+        }
+        if (n > 0) march_points(static_cast<double>(y) + 0.5, at, n, [&](size_t r, size_t e, float value) { line[r * padded + which[e]] = value; });
+      }
+      for (const auto& [span, first] : {std::pair{out.inscatter, size_t(0)}, std::pair{out.transmittance, layers / 2}}) {
         const float* r = line.data() + first * padded;
-        put_row(r, r + padded, r + 2 * padded, width, span, y);
+        put_row(r, r + grey * padded, r + 2 * grey * padded, width, span, static_cast<int>(y));
       }
     }
   };
@@ -750,13 +885,17 @@ bool march_layers(const Scene& scene, const ExtinctionVolume& volume, const std:
     parallel_for(view.camera.height_px, options.threads, 1, [&rows](long long y0, long long y1) { rows(y0, y1); });
   }
   if (from_eye && out.surface.data) {
+    const float background[3] = {static_cast<float>(scene.background.r), static_cast<float>(scene.background.g), static_cast<float>(scene.background.b)};
     const auto fill = [&](long long y0, long long y1) {
-      for (auto y = static_cast<int>(y0); y < y1; ++y)
-        for (int x = 0; x < view.camera.width_px; ++x) {
-          const Rgb c = std::isinf(view.max_distance(x, y)) ? scene.background : Rgb(0.0);
-          float* p = out.surface.pixel(x, y);
-          p[0] = static_cast<float>(c.r), p[1] = static_cast<float>(c.g), p[2] = static_cast<float>(c.b);
+      const size_t channels = static_cast<size_t>(out.surface.channels), width = static_cast<size_t>(view.camera.width_px);
+      for (auto y = static_cast<int>(y0); y < y1; ++y) {
+        float* p = out.surface.pixel(0, y);
+        const float* depth = view.depth.empty() ? nullptr : view.depth.data() + static_cast<size_t>(y) * width;
+        for (size_t x = 0; x < width; ++x, p += channels) {
+          const bool open = !depth || std::isinf(depth[x]);
+          p[0] = open ? background[0] : 0.0f, p[1] = open ? background[1] : 0.0f, p[2] = open ? background[2] : 0.0f;
         }
+      }
     };
     parallel_for(view.camera.height_px, options.threads, 16, [&fill](long long y0, long long y1) { fill(y0, y1); });
   }

@@ -394,7 +394,7 @@ HWY_NOINLINE void RowPacket(const RowFrame& r, float* HWY_RESTRICT rows, size_t 
   float* HWY_RESTRICT steps = rows + 8 * stride;
   const V zero = hn::Zero(d), step = hn::Set(d, r.step), tiny = hn::Set(d, 1e-30f);
   for (size_t x0 = 0; x0 < count; x0 += lanes) {
-    const V px = hn::Add(hn::ConvertTo(d, hn::Iota(hn::RebindToSigned<decltype(d)>(), static_cast<int>(x0))), hn::Set(d, 0.5f));
+    const V px = r.film ? hn::LoadU(d, r.film + x0) : hn::Add(hn::ConvertTo(d, hn::Iota(hn::RebindToSigned<decltype(d)>(), static_cast<int>(x0))), hn::Set(d, 0.5f));
     V w[3];
     for (int e = 0; e < 3; ++e) w[e] = hn::MulAdd(hn::Set(d, r.b[e]), px, hn::Set(d, r.a[e]));
     const V inv_length = hn::Div(hn::Set(d, 1.0f), hn::Sqrt(hn::MulAdd(w[0], w[0], hn::MulAdd(w[1], w[1], hn::Mul(w[2], w[2])))));

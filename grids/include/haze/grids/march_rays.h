@@ -92,12 +92,14 @@ void march_toward_eye_reference(const MarchVolume& volume, const PhaseFunction& 
 // row_frame), clipped to the box [lo, hi] and to the host's depth (null: none), in steps of
 // `step`: into rows[r * stride + x] for pixels x < count, rows r = ox, oy, oz, dx, dy, dz, t0, dt,
 // steps (steps 0 where the ray misses the box; rows padded to whole vectors), in float32 lanes.
-// The SIMD kernel's own packet rows, without a float64 ray per pixel.
+// With `film`, ray x goes through a + b film[x] instead (any points of the row; `film` padded
+// to whole vectors as the rows). The SIMD kernel's own packet rows, without a float64 ray per pixel.
 struct RowFrame {
   float eye[3], a[3], b[3];
   float lo[3], hi[3];
   float step;
   const float* depth;  // the row's, or null
+  const float* film;   // the rays' film x, or null: x + 0.5
 };
 void march_row_packet(const RowFrame& row, float* rows, size_t stride, size_t count);
 

@@ -85,15 +85,18 @@ struct MarchSettings {
   bool toward_eye = true;
   static constexpr int kFarCells = 8;
   static constexpr float kFarDensity = 0.01f;
-  // march_layers from one eye without a host's depth or surfaces: where a cell spans more than two
-  // such steps of pixels, the rays are marched on a lattice of this many nodes per cell as the
-  // view sees it and the pixels interpolated bilinearly, but for those next to a rough node (below)
-  // and those within kLatticePeakNodes nodes of a light in the steps (a near point light, a spot)
-  // in view, which take their own rays (tests/grids/toward_eye_test.cpp measures the error).
-  static constexpr double kLatticeNodesPerCell = 2.5;
+  // march_layers from one eye without a host's depth or surfaces: where a cell spans two such
+  // steps of pixels or more, the rays are marched on a lattice of at least this many nodes per cell
+  // as the view sees it (its step in pixels a power of 2), and the cells with a rough node at a
+  // corner (below) on a lattice of half the step, and so on down to 2 pixels, below which the
+  // rough cells' pixels take their own rays; the others are bilinear between the nodes of the
+  // finest level that holds them. Nodes within kLatticePeakNodes of a level's nodes of a light
+  // in the steps (a near point light, a spot) in view count as rough (tests/grids/toward_eye_test.cpp
+  // measures the error).
+  static constexpr double kLatticeNodesPerCell = 1.25;
   static constexpr int kLatticePeakNodes = 4;
-  // A pixel next to a lattice node whose second difference along x or y exceeds this (in T, or in
-  // L_in over its largest) takes its own ray: the volume's silhouette, the edge of a light's cone.
+  // A lattice node whose second difference along x or y exceeds this (in T, or in L_in over its
+  // largest) is rough: the volume's silhouette, the edge of a light's cone.
   static constexpr float kLatticeSpread = 0.01f;
 };
 
