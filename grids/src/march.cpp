@@ -369,14 +369,13 @@ void march_row_layers_from(const Marcher& m, const MarchVolume& v, const View& v
     put_row(row(first), row(first + grey), row(first + 2 * grey), width, span, y);
 }
 
-// march_layers' lattice step in pixels (MarchSettings::kLatticeNodesPerCell): from one eye without a
-// host's depth, a node per kLatticeNodesPerCell of the narrowest cell as the view's central pixels
+// march_layers' lattice step in pixels (MarchSettings::kLatticeNodesPerCell): from one eye, a node
+// per kLatticeNodesPerCell of the narrowest cell as the view's central pixels
 // see it at the volume's farthest corner, rounded down to 2^a or 3 2^a (so that the finer levels
 // halve it down to 2 or 3); else 1. `peaks`: the film positions of the lights in the steps (point
 // lights near dense cells, spots: peaks narrower than a cell) in or near the view.
 int lattice_step(const Marcher& m, const MarchVolume& v, const View& view, const Vec3& eye, std::vector<std::array<double, 2>>& peaks) {
   const Camera& camera = view.camera;
-  if (!view.depth.empty()) return 1;
   const Aabb& box = m.volume.density.bounds();
   double far = 0.0;
   for (int c = 0; c < 8; ++c) far = std::max(far, glm::length(Vec3(c & 1 ? box.hi.x : box.lo.x, c & 2 ? box.hi.y : box.lo.y, c & 4 ? box.hi.z : box.lo.z) - eye));
@@ -409,6 +408,9 @@ struct LatticeLevel {
   // (interpolated from the level above, for the second differences); 0: not held. Level 0 holds all.
   std::vector<std::uint8_t> held;
   std::vector<std::uint8_t> rough, refined;
+  // Level 0's cells whose host depths are not bilinear between their corners' (an edge of the
+  // host's geometry): every level refines them, down to each pixel's own ray.
+  std::vector<std::uint8_t> deep;
   // The refined cells' runs [first, end) along each row of cells: row j's in runs[run_start[j] ..
   // run_start[j + 1]).
   std::vector<std::array<std::uint32_t, 2>> runs;
@@ -428,6 +430,7 @@ void march_lattice_layers(const Marcher& m, const MarchVolume& v, const View& vi
                           LayerSpans out, int threads) {
   const Camera& camera = view.camera;
   const auto width = static_cast<size_t>(camera.width_px), height = static_cast<size_t>(camera.height_px);
+  const float* depth = view.depth.empty() ? nullptr : view.depth.data();
   int count = 1;
   while ((s >> (count - 1)) > 2) ++count;  // s, s / 2, ..., 2 (s a power of 2)
   // Kept per thread, the finest level first: slot k holds steps of at least 2^(k+1) pixels, so the
@@ -445,28 +448,37 @@ void march_lattice_layers(const Marcher& m, const MarchVolume& v, const View& vi
     l.step = s >> k;
     l.nx = (width - 1) / static_cast<size_t>(l.step) + 2, l.ny = (height - 1) / static_cast<size_t>(l.step) + 2;
     l.nodes.resize(layers * l.nx * l.ny), l.held.assign(l.nx * l.ny, k == 0 ? 2 : 0), l.rough.assign(l.nx * l.ny, 0), l.refined.assign(l.nx * l.ny, 0);
+    l.deep.assign(k == 0 && depth ? l.nx * l.ny : 0, 0);
     l.weight.resize(static_cast<size_t>(l.step));
     for (int t = 0; t < l.step; ++t) l.weight[static_cast<size_t>(t)] = static_cast<float>(t) / static_cast<float>(l.step);
   }
   for (int slot = 0; slot < most_count; ++slot) {  // slot k: steps of 2^(k+1) or more
     LatticeLevel& l = levels[static_cast<size_t>(slot)];
     const size_t nodes = (((width - 1) >> (slot + 1)) + 2) * (((height - 1) >> (slot + 1)) + 2);
-    l.nodes.reserve(6 * nodes), l.held.reserve(nodes), l.rough.reserve(nodes), l.refined.reserve(nodes), l.runs.reserve(nodes / 2 + 1);
+    l.nodes.reserve(6 * nodes), l.held.reserve(nodes), l.rough.reserve(nodes), l.refined.reserve(nodes), l.deep.reserve(nodes), l.runs.reserve(nodes / 2 + 1);
     l.run_start.reserve(((height - 1) >> (slot + 1)) + 3), l.weight.reserve(std::max(width, height));
   }
   // Layer row r's in the kernel's result (L_in then T per channel, row 0 and 3 alone where grey).
   const auto result_row = [layers](size_t r) { return r < layers / 2 ? r : 3 + r - layers / 2; };
   // Rays through row y's film points at[0 .. n) (pixels), their layers into put(r, e, value).
   const size_t most_rays = std::max(width, level(0).nx) + 64;
+  // With a host's depth each ray ends at its pixel's (a node's: the pixel it passes through, the
+  // last row's or column's past the film).
   const auto march_points = [&](double y, const std::vector<float>& at, size_t n, auto&& put) {
-    thread_local std::vector<float> packed, result;
-    packed.reserve(9 * most_rays), result.reserve(6 * most_rays);
+    thread_local std::vector<float> packed, result, ends;
+    packed.reserve(9 * most_rays), result.reserve(6 * most_rays), ends.reserve(most_rays);
     const size_t padded = n + 64;
     packed.resize(9 * padded), result.resize(6 * padded);
     Vec3 a, b;
     camera.row_frame(y, a, b);
     RowFrame frame = row_frame_of(m, eye, a, b);
     frame.film = at.data();
+    if (depth) {
+      const float* row = depth + std::min(static_cast<size_t>(y), height - 1) * width;
+      ends.assign(padded, std::numeric_limits<float>::infinity());
+      for (size_t e = 0; e < n; ++e) ends[e] = row[std::min(static_cast<size_t>(at[e]), width - 1)];
+      frame.depth = ends.data();
+    }
     march_row_packet(frame, packed.data(), padded, n);
     march_rays(v, m.volume.phase, packet_of(packed, result, padded, n));
     for (size_t r = 0; r < layers; ++r)
@@ -486,6 +498,34 @@ void march_lattice_layers(const Marcher& m, const MarchVolume& v, const View& vi
         march_points(static_cast<double>(j * static_cast<size_t>(l.step)) + 0.5, at, l.nx, [&](size_t r, size_t e, float value) { *l.at(r, e, j) = value; });
     };
     parallel_for(static_cast<long long>(l.ny), threads, 1, [&rows](long long j0, long long j1) { rows(j0, j1); });
+  }
+  if (depth) {
+    // Level 0's cells whose pixels' depths stray from the bilinear of their corners' by more than
+    // kLatticeDepth cells (depths past the volume's farthest corner taken as there).
+    const Aabb& box = m.volume.density.bounds();
+    double far = 0.0;
+    for (int c = 0; c < 8; ++c) far = std::max(far, glm::length(Vec3(c & 1 ? box.hi.x : box.lo.x, c & 2 ? box.hi.y : box.lo.y, c & 4 ? box.hi.z : box.lo.z) - eye));
+    const Vec3 h = m.volume.density.cell_size();
+    const auto tolerance = static_cast<float>(MarchSettings::kLatticeDepth * std::min({h.x, h.y, h.z}));
+    const auto reach = static_cast<float>(far);
+    LatticeLevel& l = level(0);
+    const auto step = static_cast<size_t>(l.step);
+    const auto d = [&](size_t x, size_t y) { return std::min(depth[std::min(y, height - 1) * width + std::min(x, width - 1)], reach); };
+    const auto cells = [&](long long j0, long long j1) {
+      for (auto j = static_cast<size_t>(j0); j < static_cast<size_t>(j1); ++j)
+        for (size_t i = 0; i + 1 < l.nx; ++i) {
+          const float c00 = d(i * step, j * step), c10 = d((i + 1) * step, j * step), c01 = d(i * step, (j + 1) * step), c11 = d((i + 1) * step, (j + 1) * step);
+          bool off = false;
+          for (size_t y = j * step; y < std::min(height, (j + 1) * step) && !off; ++y) {
+            const float fy = l.weight[y - j * step], left = c00 + fy * (c01 - c00), right = c10 + fy * (c11 - c10);
+            const float* row = depth + y * width;
+            for (size_t x = i * step; x < std::min(width, (i + 1) * step); ++x)
+              off = off || std::abs(std::min(row[x], reach) - (left + l.weight[x - i * step] * (right - left))) > tolerance;
+          }
+          l.deep[j * l.nx + i] = off;
+        }
+    };
+    parallel_for(static_cast<long long>(l.ny - 1), threads, 8, [&cells](long long j0, long long j1) { cells(j0, j1); });
   }
   float peak = 0.0f;
   {
@@ -568,14 +608,16 @@ void march_lattice_layers(const Marcher& m, const MarchVolume& v, const View& vi
           l.rough[static_cast<size_t>(j) * l.nx + static_cast<size_t>(i)] = 1;
     }
     // The cells the next level (or, on the last, each pixel's own ray) resolves: a rough corner,
-    // inside a cell the level above refined.
+    // or in a deep cell of level 0, inside a cell the level above refined.
     const LatticeLevel* above = k > 0 ? &level(k - 1) : nullptr;
+    const LatticeLevel& first = level(0);
     l.runs.clear(), l.run_start.clear();
     for (size_t j = 0; j + 1 < l.ny; ++j) {
       l.run_start.push_back(static_cast<std::uint32_t>(l.runs.size()));
       for (size_t i = 0; i + 1 < l.nx; ++i) {
         const std::uint8_t* c = l.rough.data() + j * l.nx + i;
-        if (!(c[0] | c[1] | c[l.nx] | c[l.nx + 1]) || (above && !above->refined[(j / 2) * above->nx + i / 2])) continue;
+        const bool deep = depth && first.deep[(j >> k) * first.nx + (i >> k)];
+        if (!(deep || c[0] | c[1] | c[l.nx] | c[l.nx + 1]) || (above && !above->refined[(j / 2) * above->nx + i / 2])) continue;
         l.refined[j * l.nx + i] = 1;
         if (i > 0 && l.refined[j * l.nx + i - 1]) ++l.runs.back()[1];
         else l.runs.push_back({static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(i + 1)});
@@ -872,7 +914,7 @@ bool march_layers(const Scene& scene, const ExtinctionVolume& volume, const std:
   // Without surfaces of Haze's own, C is the background where no host depth ends the ray.
   const bool from_eye = one_eye && view.camera.row_frame(0.5, a, b) && scene.surfaces.empty();
   thread_local std::vector<std::array<double, 2>> peaks;  // kept as `lights`
-  if (const int step = from_eye ? lattice_step(marcher, simd_view, view, eye, peaks) : 1; step > 1) {
+  if (const int step = from_eye && settings.lattice ? lattice_step(marcher, simd_view, view, eye, peaks) : 1; step > 1) {
     march_lattice_layers(marcher, simd_view, view, eye, step, peaks, out, options.threads);
   } else {
     const auto rows = [&](long long y0, long long y1) {

@@ -93,7 +93,12 @@ struct MarchSettings {
   // finest level that holds them. Nodes within kLatticePeakNodes of a level's nodes of a light
   // in the steps (a near point light, a spot) in view count as rough (tests/grids/toward_eye_test.cpp
   // measures the error).
+  // With a host's depth, a first-level cell whose pixels' depths stray more than kLatticeDepth
+  // cells from the bilinear of its corners' (an edge of the host's geometry) takes every pixel's
+  // own ray. false: every pixel its own ray.
+  bool lattice = true;
   static constexpr double kLatticeNodesPerCell = 1.25;
+  static constexpr double kLatticeDepth = 0.1;
   static constexpr int kLatticePeakNodes = 4;
   // A lattice node whose second difference along x or y exceeds this (in T, or in L_in over its
   // largest) is rough: the volume's silhouette, the edge of a light's cone.
