@@ -87,7 +87,7 @@ struct MarchSettings {
   static constexpr float kFarDensity = 0.01f;
   // march_layers from one eye without a host's depth or surfaces: where a cell spans two such
   // steps of pixels or more, the rays are marched on a lattice of at least this many nodes per cell
-  // as the view sees it (its step in pixels a power of 2), and the cells with a rough node at a
+  // as the view sees it (its step in pixels the power of 2 at or below), and the cells with a rough node at a
   // corner (below) on a lattice of half the step, and so on down to 2 pixels, below which the
   // rough cells' pixels take their own rays; the others are bilinear between the nodes of the
   // finest level that holds them. Nodes within kLatticePeakNodes of a level's nodes of a light
@@ -97,12 +97,12 @@ struct MarchSettings {
   // cells from the bilinear of its corners' (an edge of the host's geometry) takes every pixel's
   // own ray. false: every pixel its own ray.
   bool lattice = true;
-  static constexpr double kLatticeNodesPerCell = 1.25;
+  static constexpr double kLatticeNodesPerCell = 0.9;
   static constexpr double kLatticeDepth = 0.1;
   static constexpr int kLatticePeakNodes = 4;
   // A lattice node whose second difference along x or y exceeds this (in T, or in L_in over its
   // largest) is rough: the volume's silhouette, the edge of a light's cone.
-  static constexpr float kLatticeSpread = 0.01f;
+  static constexpr float kLatticeSpread = 0.007f;
 };
 
 // The per-light volumes as the marcher reads them, all lights of a cell together ([cell * lights +
