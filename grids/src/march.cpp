@@ -296,6 +296,8 @@ void fold_toward_eye(const Marcher& m, const Vec3& eye, std::vector<MarchLight>&
   }
   lights.resize(kept);
   if (far.empty()) return;
+  for (MarchLight& l : far) l.plane = m.packed.attenuation_plane.empty() ? -1 : m.packed.attenuation_plane[static_cast<size_t>(l.slot)];
+  v.attenuation = m.packed.attenuation.empty() ? nullptr : m.packed.attenuation.data();
   const auto n = m.volume.density.resolution();
   folded.resize(static_cast<size_t>(n[0] + 2) * static_cast<size_t>(n[1] + 2) * static_cast<size_t>(n[2] + 2) * static_cast<size_t>(v.channels + 1) / 2);
   // The float16 values' scales: a quarter of their range (the prefilter may double a peak) for the
@@ -411,10 +413,11 @@ struct LatticeLevel {
   // Level 0's cells whose host depths are not bilinear between their corners' (an edge of the
   // host's geometry): every level refines them, down to each pixel's own ray.
   std::vector<std::uint8_t> deep;
-  // The refined cells' runs [first, end) along each row of cells: row j's in runs[run_start[j] ..
-  // run_start[j + 1]).
+  // The refined cells' runs [first, end) along each row of cells: row j's run_count[j] of them
+  // from runs[j (nx / 2 + 1)] (no row has more).
   std::vector<std::array<std::uint32_t, 2>> runs;
-  std::vector<std::uint32_t> run_start;
+  std::vector<std::uint32_t> run_count;
+  size_t run_stride() const { return nx / 2 + 1; }
   std::vector<float> weight;  // t / step, t < step: a pixel's between the nodes of its cell
   float* at(size_t r, size_t i, size_t j) { return nodes.data() + (r * ny + j) * nx + i; }
 };
@@ -455,8 +458,9 @@ void march_lattice_layers(const Marcher& m, const MarchVolume& v, const View& vi
   for (int slot = 0; slot < most_count; ++slot) {  // slot k: steps of 2^(k+1) or more
     LatticeLevel& l = levels[static_cast<size_t>(slot)];
     const size_t nodes = (((width - 1) >> (slot + 1)) + 2) * (((height - 1) >> (slot + 1)) + 2);
-    l.nodes.reserve(6 * nodes), l.held.reserve(nodes), l.rough.reserve(nodes), l.refined.reserve(nodes), l.deep.reserve(nodes), l.runs.reserve(nodes / 2 + 1);
-    l.run_start.reserve(((height - 1) >> (slot + 1)) + 3), l.weight.reserve(std::max(width, height));
+    l.nodes.reserve(6 * nodes), l.held.reserve(nodes), l.rough.reserve(nodes), l.refined.reserve(nodes), l.deep.reserve(nodes);
+    l.runs.reserve(((((width - 1) >> (slot + 1)) + 2) / 2 + 1) * (((height - 1) >> (slot + 1)) + 2));
+    l.run_count.reserve(((height - 1) >> (slot + 1)) + 2), l.weight.reserve(std::max(width, height));
   }
   // Layer row r's in the kernel's result (L_in then T per channel, row 0 and 3 alone where grey).
   const auto result_row = [layers](size_t r) { return r < layers / 2 ? r : 3 + r - layers / 2; };
@@ -515,14 +519,14 @@ void march_lattice_layers(const Marcher& m, const MarchVolume& v, const View& vi
       for (auto j = static_cast<size_t>(j0); j < static_cast<size_t>(j1); ++j)
         for (size_t i = 0; i + 1 < l.nx; ++i) {
           const float c00 = d(i * step, j * step), c10 = d((i + 1) * step, j * step), c01 = d(i * step, (j + 1) * step), c11 = d((i + 1) * step, (j + 1) * step);
-          bool off = false;
-          for (size_t y = j * step; y < std::min(height, (j + 1) * step) && !off; ++y) {
+          float off = 0.0f;
+          for (size_t y = j * step; y < std::min(height, (j + 1) * step); ++y) {
             const float fy = l.weight[y - j * step], left = c00 + fy * (c01 - c00), right = c10 + fy * (c11 - c10);
-            const float* row = depth + y * width;
-            for (size_t x = i * step; x < std::min(width, (i + 1) * step); ++x)
-              off = off || std::abs(std::min(row[x], reach) - (left + l.weight[x - i * step] * (right - left))) > tolerance;
+            const float* row = depth + y * width + i * step;
+            const size_t n = std::min(width, (i + 1) * step) - i * step;
+            for (size_t x = 0; x < n; ++x) off = std::max(off, std::abs(std::min(row[x], reach) - (left + l.weight[x] * (right - left))));
           }
-          l.deep[j * l.nx + i] = off;
+          l.deep[j * l.nx + i] = off > tolerance;
         }
     };
     parallel_for(static_cast<long long>(l.ny - 1), threads, 8, [&cells](long long j0, long long j1) { cells(j0, j1); });
@@ -611,19 +615,22 @@ void march_lattice_layers(const Marcher& m, const MarchVolume& v, const View& vi
     // or in a deep cell of level 0, inside a cell the level above refined.
     const LatticeLevel* above = k > 0 ? &level(k - 1) : nullptr;
     const LatticeLevel& first = level(0);
-    l.runs.clear(), l.run_start.clear();
-    for (size_t j = 0; j + 1 < l.ny; ++j) {
-      l.run_start.push_back(static_cast<std::uint32_t>(l.runs.size()));
-      for (size_t i = 0; i + 1 < l.nx; ++i) {
-        const std::uint8_t* c = l.rough.data() + j * l.nx + i;
-        const bool deep = depth && first.deep[(j >> k) * first.nx + (i >> k)];
-        if (!(deep || c[0] | c[1] | c[l.nx] | c[l.nx + 1]) || (above && !above->refined[(j / 2) * above->nx + i / 2])) continue;
-        l.refined[j * l.nx + i] = 1;
-        if (i > 0 && l.refined[j * l.nx + i - 1]) ++l.runs.back()[1];
-        else l.runs.push_back({static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(i + 1)});
+    l.runs.resize(l.run_stride() * l.ny), l.run_count.assign(l.ny, 0);
+    const auto cells = [&](long long j0, long long j1) {
+      for (auto j = static_cast<size_t>(j0); j < static_cast<size_t>(j1); ++j) {
+        std::array<std::uint32_t, 2>* runs = l.runs.data() + j * l.run_stride();
+        std::uint32_t& n = l.run_count[j];
+        for (size_t i = 0; i + 1 < l.nx; ++i) {
+          const std::uint8_t* c = l.rough.data() + j * l.nx + i;
+          const bool deep = depth && first.deep[(j >> k) * first.nx + (i >> k)];
+          if (!(deep || c[0] | c[1] | c[l.nx] | c[l.nx + 1]) || (above && !above->refined[(j / 2) * above->nx + i / 2])) continue;
+          l.refined[j * l.nx + i] = 1;
+          if (n > 0 && runs[n - 1][1] == i) ++runs[n - 1][1];
+          else runs[n++] = {static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(i + 1)};
+        }
       }
-    }
-    l.run_start.push_back(static_cast<std::uint32_t>(l.runs.size()));
+    };
+    parallel_for(static_cast<long long>(l.ny - 1), threads, 16, [&cells](long long j0, long long j1) { cells(j0, j1); });
   }
   // Each pixel: level 0 between its nodes, then each finer level over the pixels of the cells the
   // level above refines, then its own ray in the cells the last refines.
@@ -660,7 +667,7 @@ void march_lattice_layers(const Marcher& m, const MarchVolume& v, const View& vi
         const auto step = static_cast<size_t>(l.step);
         const size_t b = y / step;
         size_t n = 0;
-        for (size_t r = l.run_start[b]; r < l.run_start[b + 1]; ++r) {
+        for (size_t r = b * l.run_stride(); r < b * l.run_stride() + l.run_count[b]; ++r) {
           const size_t x0 = l.runs[r][0] * step, x1 = std::min(width, l.runs[r][1] * step);
           if (k + 1 < count) {
             blend(level(k + 1), x0, x1, y);
@@ -792,13 +799,40 @@ PackedLights pack_lights(const Scene& scene, const ExtinctionVolume& volume, con
       for (size_t l = 0; l < lights; ++l) out[c * lights + l] = grids[l].values()[c];
     return out;
   };
-  PackedLights packed{interleave(depths), {}};
+  PackedLights packed{interleave(depths), {}, 0.0f, {}, {}};
   const std::vector<float>& values = volume.density.values();
   packed.density_max = values.empty() ? 0.0f : *std::max_element(values.begin(), values.end());
-  if (volume.albedo == Rgb(0.0) || scene.surfaces.empty()) return packed;  // no light in the medium to shadow
   if (visibility && visibility->size() != depths.size())
     throw Error("visibility", to_text(visibility->size()) + " volumes", "one per light (" + to_text(depths.size()) + ")");
-  packed.visibility = interleave(visibility ? *visibility : surface_visibility(volume.density, scene.lights, scene.surfaces, threads));
+  if (volume.albedo != Rgb(0.0) && !scene.surfaces.empty())  // else no light in the medium to shadow
+    packed.visibility = interleave(visibility ? *visibility : surface_visibility(volume.density, scene.lights, scene.surfaces, threads));
+  // The lights march_toward_eye folds (directional, point away from dense cells) in a grey medium:
+  // each one's V e^(-sigma_t depth) per cell, a plane each.
+  const size_t lights = depths.size(), cells = volume.density.cell_count();
+  if (!is_grey(volume.sigma_t_scale) || lights != scene.lights.size()) return packed;
+  packed.attenuation_plane.assign(lights, -1);
+  int planes = 0;
+  for (size_t l = 0; l < lights; ++l) {
+    bool folds = std::holds_alternative<DirectionalLight>(scene.lights[l]);
+    if (const auto* point = std::get_if<PointLight>(&scene.lights[l])) {
+      MarchLight m;
+      for (int e = 0; e < 3; ++e) m.position[e] = static_cast<float>(point->position[e]);
+      folds = !near_dense_cells(volume.density, packed.density_max, m);
+    }
+    if (folds) packed.attenuation_plane[l] = planes++;
+  }
+  packed.attenuation.resize(static_cast<size_t>(planes) * cells);
+  const auto sigma_t = static_cast<float>(volume.sigma_t_scale.r);
+  parallel_for(static_cast<long long>(cells), threads, 4096, [&](long long c0, long long c1) {
+    for (size_t l = 0; l < lights; ++l) {
+      if (packed.attenuation_plane[l] < 0) continue;
+      float* plane = packed.attenuation.data() + static_cast<size_t>(packed.attenuation_plane[l]) * cells;
+      for (auto c = static_cast<size_t>(c0); c < static_cast<size_t>(c1); ++c) {
+        const float visible = packed.visibility.empty() ? 1.0f : packed.visibility[c * lights + l];
+        plane[c] = visible * std::exp(-sigma_t * std::max(packed.depths[c * lights + l], 0.0f));
+      }
+    }
+  });
   return packed;
 }
 

@@ -19,12 +19,10 @@ HWY_BEFORE_NAMESPACE();
 namespace haze::grids::HWY_NAMESPACE {
 namespace hn = hwy::HWY_NAMESPACE;
 
-// in[c] += p(to_light . w) E(x) visible e^(-sigma_t[c] depth_scale[c] depth) at points x, w the
-// unit vectors away from the eye, E a point light's I / r^2 (a spot's times its cone), a
-// directional light's irradiance; `grey`: one exponential for every channel.
-template <int C, class D, class V = hn::Vec<D>>
-HWY_INLINE void AddLight(D d, const MarchVolume& v, const MarchLight& light, const simd::PhaseParams& phase, const V* x, const V* w, V depth,
-                         V visible, bool grey, V* in) {
+// p(to_light . w) E(x) visible at points x, w the unit vectors away from the eye, E a point
+// light's I / r^2 (a spot's times its cone; per unit intensity), a directional light's irradiance.
+template <class D, class V = hn::Vec<D>>
+HWY_INLINE V LightWeight(D d, const MarchLight& light, const simd::PhaseParams& phase, const V* x, const V* w, V visible) {
   const V zero = hn::Zero(d), one = hn::Set(d, 1.0f);
   V to[3], falloff = visible;
   if (light.type == MarchLight::directional) {
@@ -42,7 +40,15 @@ HWY_INLINE void AddLight(D d, const MarchVolume& v, const MarchLight& light, con
     }
   }
   const V mu = hn::MulAdd(to[0], w[0], hn::MulAdd(to[1], w[1], hn::Mul(to[2], w[2])));
-  const V weight = hn::Mul(simd::HWY_NAMESPACE::EvalPhase(d, phase, mu), falloff);
+  return hn::Mul(simd::HWY_NAMESPACE::EvalPhase(d, phase, mu), falloff);
+}
+
+// in[c] += LightWeight I[c] e^(-sigma_t[c] depth_scale[c] depth); `grey`: one exponential for
+// every channel.
+template <int C, class D, class V = hn::Vec<D>>
+HWY_INLINE void AddLight(D d, const MarchVolume& v, const MarchLight& light, const simd::PhaseParams& phase, const V* x, const V* w, V depth,
+                         V visible, bool grey, V* in) {
+  const V weight = LightWeight(d, light, phase, x, w, visible);
   V attenuation[C];
   for (int c = 0; c < C; ++c)
     attenuation[c] = c > 0 && grey ? attenuation[0] : hn::Exp(d, hn::Mul(hn::Set(d, -v.sigma_t[c] * v.depth_scale[c]), depth));

@@ -49,8 +49,18 @@ HWY_INLINE void TowardEyeCells(D d, const MarchVolume& v, const simd::PhaseParam
   const bool grey = v.sigma_t[1] * v.depth_scale[1] == depth_0 && v.sigma_t[2] * v.depth_scale[2] == depth_0;
   V in[C];
   for (int c = 0; c < C; ++c) in[c] = zero;
+  // The attenuation planes' cells: whole rows of the volume's, but at the ghosts.
+  const size_t cells = static_cast<size_t>(v.n[0]) * static_cast<size_t>(v.n[1]) * static_cast<size_t>(v.n[2]);
+  const bool whole = x0 >= 1 && x0 + static_cast<int>(hn::Lanes(d)) <= v.n[0] + 1;
+  const size_t first = static_cast<size_t>((cz * v.n[1] + cy) * v.n[0] + x0 - 1);
   for (int l = 0; l < count; ++l) {
     const MarchLight& light = lights[l];
+    if (v.attenuation && light.plane >= 0) {
+      const float* plane = v.attenuation + static_cast<size_t>(light.plane) * cells;
+      const V weight = hn::Mul(LightWeight(d, light, phase, p, w, hn::Set(d, 1.0f)), whole ? hn::LoadU(d, plane + first) : hn::GatherIndex(d, plane, cell));
+      for (int c = 0; c < C; ++c) in[c] = hn::MulAdd(weight, hn::Set(d, light.intensity[c]), in[c]);
+      continue;
+    }
     const V visible = v.visibility ? hn::GatherIndex(d, v.visibility + light.slot, at) : hn::Set(d, 1.0f);
     AddLight<C>(d, v, light, phase, p, w, hn::Max(hn::GatherIndex(d, v.depths + light.slot, at), zero), visible, grey, in);
   }

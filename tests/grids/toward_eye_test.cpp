@@ -71,7 +71,8 @@ double from_half(uint32_t h) {
 // values stored as float16 over their scales: within 2^-10 of each value (float16's rounding, 2^-11,
 // where the CPU converts; Highway's conversion on targets without F16C truncates) plus 1e-4 of its
 // scale's unit (the float32 arithmetic and 0 below 2^-14), three channels and one, on a grid whose
-// x side (21) is no multiple of any vector's lanes.
+// x side (21) is no multiple of any vector's lanes; the grey medium's also from the attenuation
+// planes (PackedLights::attenuation) in place of the depths.
 TEST_P(TowardEyeTargets, MatchesTheFloat64Reference) {
   for (bool coloured : {true, false}) {
     Scene scene = cloud_scene(8, 8);
@@ -98,13 +99,23 @@ TEST_P(TowardEyeTargets, MatchesTheFloat64Reference) {
     }
     ASSERT_GT(scale[0], 1e-5);
     for (int c = 0; c < 4; ++c) k.v.folded_scale[c] = static_cast<float>(scale[c]);
-    std::vector<uint32_t> words(cells * static_cast<size_t>(channels + 1) / 2, 0xFFFFFFFFu);
-    march_toward_eye(k.v, k.volume.phase, eye, k.lights.data(), 2, words.data(), 2);
-    for (size_t i = 0; i < reference.size(); ++i) {
-      const size_t value = i % static_cast<size_t>(channels + 1), slot = value == static_cast<size_t>(channels) ? 3 : value;
-      const double got = from_half(words[i / 2] >> (16 * (i % 2)) & 0xFFFFu) * static_cast<double>(k.v.folded_scale[slot]);
-      ASSERT_NEAR(got, reference[i], std::ldexp(reference[i], -10) + 1e-4 * scale[slot])
-          << "value " << i << (coloured ? " coloured" : " grey") << " target " << hwy::TargetName(GetParam());
+    // The depths, then (grey) the attenuation planes of both lights.
+    ASSERT_EQ(k.packed.attenuation.empty(), coloured);
+    for (const bool planes : {false, true}) {
+      if (planes && coloured) continue;
+      if (planes) {
+        for (MarchLight& l : k.lights) l.plane = k.packed.attenuation_plane[static_cast<size_t>(l.slot)];
+        ASSERT_TRUE(k.lights[0].plane >= 0 && k.lights[1].plane >= 0);
+        k.v.attenuation = k.packed.attenuation.data();
+      }
+      std::vector<uint32_t> words(cells * static_cast<size_t>(channels + 1) / 2, 0xFFFFFFFFu);
+      march_toward_eye(k.v, k.volume.phase, eye, k.lights.data(), 2, words.data(), 2);
+      for (size_t i = 0; i < reference.size(); ++i) {
+        const size_t value = i % static_cast<size_t>(channels + 1), slot = value == static_cast<size_t>(channels) ? 3 : value;
+        const double got = from_half(words[i / 2] >> (16 * (i % 2)) & 0xFFFFu) * static_cast<double>(k.v.folded_scale[slot]);
+        ASSERT_NEAR(got, reference[i], std::ldexp(reference[i], -10) + 1e-4 * scale[slot])
+            << "value " << i << (coloured ? " coloured" : " grey") << (planes ? " planes" : "") << " target " << hwy::TargetName(GetParam());
+      }
     }
   }
 }

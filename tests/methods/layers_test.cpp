@@ -204,7 +204,8 @@ TEST(Layers, AutoPassesTheChosenMethodsLayers) {
 // spans (march_layers: the rows of its render, the same kernel) as its render's; dom's gather as
 // its render's with a point light, and under a sun the marcher's kernel with the moments' light
 // toward the eye per cell (4.4e-4 relative RMS, 2.3e-3 at worst: held to 4e-3 there, as its
-// froxels are).
+// froxels are); propagation's and dom's on the march's lattice, T within 1e-3 per pixel (9.3e-5
+// at worst under the sun).
 TEST(Layers, RenderLayersIntoCallerMemoryMatchesRender) {
   grids::register_methods();
   for (const std::string variant : {"box", "unbounded", "coloured", "surfaces", "propagation", "dom", "dom sun"}) {
@@ -245,7 +246,9 @@ TEST(Layers, RenderLayersIntoCallerMemoryMatchesRender) {
         d2 += glm::dot(got - want, got - want), r2 += glm::dot(want, want);
         worst = std::max(worst, glm::length(got - want) / std::max(glm::length(want), 1e-6));
         ASSERT_EQ(li[3], -7.0f) << "alpha written";
-        ASSERT_LT(glm::length(Rgb(t[at], t[at + 1], t[at + 2]) - exact.transmittance->at(x, y)), 1e-6) << variant << " T at " << x << ", " << y;
+        // The march's layers on its lattice (propagation.h, MarchSettings::lattice): T between nodes.
+        const double t_bound = method == "analytic" ? 1e-6 : 1e-3;
+        ASSERT_LT(glm::length(Rgb(t[at], t[at + 1], t[at + 2]) - exact.transmittance->at(x, y)), t_bound) << variant << " T at " << x << ", " << y;
         const Rgb surface = exact.surface->at(x, y);
         ASSERT_LT(glm::length(Rgb(c[at], c[at + 1], c[at + 2]) - surface), 1e-6 + 1e-4 * glm::length(surface)) << variant << " C at " << x << ", " << y;
       }

@@ -29,6 +29,7 @@ struct MarchLight {
   float intensity[3] = {1, 1, 1};  // I (point), I0 (spot), irradiance (directional)
   float cos_cone = 0.0f, exponent = 1.0f;  // spot: I0 cos^exponent(theta) where cos(theta) >= cos_cone
   int slot = 0;  // its depths and visibility: depths[cell * depth_stride + slot]
+  int plane = -1;  // march_toward_eye: its plane of MarchVolume::attenuation, or -1
 };
 
 struct MarchVolume {
@@ -59,6 +60,9 @@ struct MarchVolume {
   // the steps, the density is read from it too. folded_scale: channels 0 to 2, then the density.
   const uint32_t* folded = nullptr;
   float folded_scale[4] = {1, 1, 1, 1};
+  // march_toward_eye: planes of cells, [plane * cells + cell], V e^(-sigma_t depth) of a grey
+  // medium (PackedLights::attenuation), read for the lights with a plane instead of their depths.
+  const float* attenuation = nullptr;
 };
 
 struct RayPacket {

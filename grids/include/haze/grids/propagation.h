@@ -111,6 +111,11 @@ struct MarchSettings {
 struct PackedLights {
   std::vector<float> depths, visibility;
   float density_max = 0.0f;  // the volume's largest cell (MarchSettings::toward_eye's measure)
+  // In a grey medium, for each light MarchSettings::toward_eye folds (directional, or point with no
+  // dense cell near): V e^(-sigma_t depth) per cell, a plane a light (attenuation_plane[l], -1 for
+  // the others): the fold's per frame work without an exponential or a gather per cell and light.
+  std::vector<float> attenuation;
+  std::vector<int> attenuation_plane;
 };
 // `visibility` when given (one grid per light), else computed here.
 PackedLights pack_lights(const Scene& scene, const ExtinctionVolume& volume, const std::vector<DenseGrid>& depths, int threads,
