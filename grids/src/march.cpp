@@ -372,10 +372,10 @@ void march_row_layers_from(const Marcher& m, const MarchVolume& v, const View& v
 }
 
 // march_layers' lattice step in pixels (MarchSettings::kLatticeNodesPerCell): from one eye, a node
-// per kLatticeNodesPerCell of the narrowest cell as the view's central pixels
-// see it at the volume's farthest corner, rounded down to 2^a or 3 2^a (so that the finer levels
-// halve it down to 2 or 3); else 1. `peaks`: the film positions of the lights in the steps (point
-// lights near dense cells, spots: peaks narrower than a cell) in or near the view.
+// per kLatticeNodesPerCell of the narrowest cell as the view's central pixels see it at the
+// volume's farthest corner, rounded down to a power of 2 (the finer levels halve it down to 2);
+// else 1. `peaks`: the film positions of the lights in the steps (point lights near dense cells,
+// spots: peaks narrower than a cell) in or near the view.
 int lattice_step(const Marcher& m, const MarchVolume& v, const View& view, const Vec3& eye, std::vector<std::array<double, 2>>& peaks) {
   const Camera& camera = view.camera;
   const Aabb& box = m.volume.density.bounds();

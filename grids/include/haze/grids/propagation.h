@@ -85,17 +85,16 @@ struct MarchSettings {
   bool toward_eye = true;
   static constexpr int kFarCells = 8;
   static constexpr float kFarDensity = 0.01f;
-  // march_layers from one eye without a host's depth or surfaces: where a cell spans two such
-  // steps of pixels or more, the rays are marched on a lattice of at least this many nodes per cell
-  // as the view sees it (its step in pixels the power of 2 at or below), and the cells with a rough node at a
-  // corner (below) on a lattice of half the step, and so on down to 2 pixels, below which the
-  // rough cells' pixels take their own rays; the others are bilinear between the nodes of the
-  // finest level that holds them. Nodes within kLatticePeakNodes of a level's nodes of a light
-  // in the steps (a near point light, a spot) in view count as rough (tests/grids/toward_eye_test.cpp
-  // measures the error).
-  // With a host's depth, a first-level cell whose pixels' depths stray more than kLatticeDepth
-  // cells from the bilinear of its corners' (an edge of the host's geometry) takes every pixel's
-  // own ray. false: every pixel its own ray.
+  // march_layers from one eye without surfaces of Haze's own: where a cell spans two pixels or
+  // more, the rays are marched on a lattice of at least kLatticeNodesPerCell nodes per cell as the
+  // view sees it (its step in pixels the power of 2 at or below), the cells with a rough node at a
+  // corner (kLatticeSpread) on a lattice of half the step, and so on down to 2 pixels, below which
+  // the rough cells' pixels take their own rays; the others are bilinear between the nodes of the
+  // finest level that holds them. Nodes within kLatticePeakNodes of a level's nodes of a light in
+  // the steps (a near point light, a spot) in view count as rough. With a host's depth, a
+  // first-level cell whose pixels' depths stray more than kLatticeDepth cells from the bilinear of
+  // its corners' (an edge of the host's geometry) takes every pixel's own ray
+  // (tests/grids/toward_eye_test.cpp measures the error). false: every pixel its own ray.
   bool lattice = true;
   static constexpr double kLatticeNodesPerCell = 0.9;
   static constexpr double kLatticeDepth = 0.1;
