@@ -228,6 +228,28 @@ TEST(TowardEye, FrameLayersWithinTheIssuesBoundOfTheHalfCellSteps) {
   EXPECT_LT(rms, 1e-3);
 }
 
+// The distance along each pixel's ray to the floor y = height (+inf above the horizon).
+std::vector<float> floor_depths(const Camera& camera, double height) {
+  std::vector<float> depth;
+  std::vector<Ray> rays(static_cast<size_t>(camera.width_px));
+  for (int y = 0; y < camera.height_px; ++y) {
+    camera.row_rays(y, rays.data());
+    for (const Ray& r : rays)
+      depth.push_back(r.direction.y < 0.0 ? static_cast<float>((height - r.origin.y) / r.direction.y) : std::numeric_limits<float>::infinity());
+  }
+  return depth;
+}
+
+// A coarse grid seen up close, as paper 003's: RBF fog in [-1, 1]^3, a point light, 400 x 300.
+Scene lattice_scene(const Vec3& light) {
+  Scene scene = Scene::load(std::string(HAZE_SOURCE_DIR) + "/examples/smoke_rbf.json");
+  scene.lights = {PointLight{light, Rgb(6.0)}};
+  scene.medium->bounds = Aabb{Vec3(-1.0), Vec3(1.0)};
+  scene.camera.width_px = 400, scene.camera.height_px = 300;
+  scene.camera.position = Vec3(-1.0, -0.6, 4.2);
+  return scene;
+}
+
 // The same at the benchmark's 1920 x 1080 with its floor as the host's depth, where a cell spans
 // about 4 pixels and march_layers takes a lattice 4 pixels apart: against every pixel's own ray
 // (with the test above, the images before either within the issue's 1e-3 by the triangle
@@ -239,16 +261,7 @@ TEST(TowardEye, FrameLayersOnTheLatticeWithinTheIssuesBound) {
   const ExtinctionVolume volume = make_extinction_volume(scene, 128);
   const std::vector<DenseGrid> depths = optical_depths(volume.density, scene.lights);
   const PackedLights packed = pack_lights(scene, volume, depths, 0);
-  std::vector<float> host(static_cast<size_t>(w) * static_cast<size_t>(h));
-  std::vector<Ray> rays(static_cast<size_t>(w));
-  for (int y = 0; y < h; ++y) {  // the benchmark's floor, y = -1.5
-    scene.camera.row_rays(y, rays.data());
-    for (int x = 0; x < w; ++x) {
-      const Ray& r = rays[static_cast<size_t>(x)];
-      host[static_cast<size_t>(y) * static_cast<size_t>(w) + static_cast<size_t>(x)] =
-          r.direction.y < 0.0 ? static_cast<float>((-1.5 - r.origin.y) / r.direction.y) : std::numeric_limits<float>::infinity();
-    }
-  }
+  const std::vector<float> host = floor_depths(scene.camera, -1.5);  // the benchmark's floor
   const size_t n = 3 * static_cast<size_t>(w) * static_cast<size_t>(h);
   std::vector<float> lattice(n), pixels(n), t_lattice(n), t_pixels(n);
   MarchSettings settings;
@@ -275,15 +288,10 @@ TEST(TowardEye, FrameLayersOnTheLatticeWithinTheIssuesBound) {
 // every pixel's own ray (MarchSettings::lattice false): L_in within 2e-3
 // relative RMS, T within 1e-3 (measured: 8.3e-4 and 3.2e-4 at 15^3, 8.1e-4 and 3.3e-4 at 20^3).
 TEST(TowardEye, LatticeLayersWithinTheirBoundOfEveryPixel) {
-  Scene scene = Scene::load(std::string(HAZE_SOURCE_DIR) + "/examples/smoke_rbf.json");
-  scene.lights = {PointLight{Vec3(1.4, 1.2, 1.0), Rgb(6.0)}};
-  scene.medium->bounds = Aabb{Vec3(-1.0), Vec3(1.0)};
   const int w = 400, h = 300;
-  scene.camera.width_px = w, scene.camera.height_px = h;
   for (const bool in_view : {false, true})
     for (int n : {15, 20}) {
-      scene.lights = {PointLight{in_view ? Vec3(0.6, 0.5, 1.3) : Vec3(1.4, 1.2, 1.0), Rgb(6.0)}};
-      scene.camera.position = Vec3(-1.0, -0.6, 4.2);
+      const Scene scene = lattice_scene(in_view ? Vec3(0.6, 0.5, 1.3) : Vec3(1.4, 1.2, 1.0));
       const ExtinctionVolume volume = make_extinction_volume(scene, n);
       const std::vector<DenseGrid> depths = optical_depths(volume.density, scene.lights);
       std::vector<float> lattice(3 * w * h), pixels(3 * w * h), t_lattice(3 * w * h), t_pixels(3 * w * h);
@@ -310,25 +318,13 @@ TEST(TowardEye, LatticeLayersWithinTheirBoundOfEveryPixel) {
 // pixel's own ray to the same depths: L_in within 2e-3 relative RMS, T within 1e-3, the pole's
 // pixels exact (measured: 7.9e-4 and 2.7e-4).
 TEST(TowardEye, LatticeLayersKeepTheHostsDepth) {
-  Scene scene = Scene::load(std::string(HAZE_SOURCE_DIR) + "/examples/smoke_rbf.json");
-  scene.lights = {PointLight{Vec3(1.4, 1.2, 1.0), Rgb(6.0)}};
-  scene.medium->bounds = Aabb{Vec3(-1.0), Vec3(1.0)};
+  const Scene scene = lattice_scene(Vec3(1.4, 1.2, 1.0));
   const int w = 400, h = 300;
-  scene.camera.width_px = w, scene.camera.height_px = h;
-  scene.camera.position = Vec3(-1.0, -0.6, 4.2);
   const ExtinctionVolume volume = make_extinction_volume(scene, 15);
   const std::vector<DenseGrid> depths = optical_depths(volume.density, scene.lights);
-  std::vector<float> host(static_cast<size_t>(w * h), std::numeric_limits<float>::infinity());
-  std::vector<Ray> rays(static_cast<size_t>(w));
-  for (int y = 0; y < h; ++y) {
-    scene.camera.row_rays(y, rays.data());
-    for (int x = 0; x < w; ++x) {
-      const Ray& r = rays[static_cast<size_t>(x)];
-      float& d = host[static_cast<size_t>(y * w + x)];
-      if (r.direction.y < 0.0) d = static_cast<float>((-0.4 - r.origin.y) / r.direction.y);  // the floor, y = -0.4
-      if (x >= 197 && x < 200) d = std::min(d, 3.9f);  // the pole
-    }
-  }
+  std::vector<float> host = floor_depths(scene.camera, -0.4);
+  for (int y = 0; y < h; ++y)
+    for (int x = 197; x < 200; ++x) host[static_cast<size_t>(y * w + x)] = std::min(host[static_cast<size_t>(y * w + x)], 3.9f);  // the pole
   std::vector<float> lattice(3 * w * h), pixels(3 * w * h), t_lattice(3 * w * h), t_pixels(3 * w * h);
   MarchSettings settings;
   ASSERT_TRUE(march_layers(scene, volume, depths, settings, {}, View{scene.camera, host}, {ImageSpan{lattice.data(), w, h}, ImageSpan{t_lattice.data(), w, h}, ImageSpan{}}));
@@ -352,22 +348,11 @@ TEST(TowardEye, LatticeLayersKeepTheHostsDepth) {
 // The lattice's levels (marched, tested and blended row by row on Haze's threads) come out the
 // same on one thread and on four: RBF fog at 15^3, 400 x 300, a host's floor.
 TEST(TowardEye, LatticeLayersThreadIndependent) {
-  Scene scene = Scene::load(std::string(HAZE_SOURCE_DIR) + "/examples/smoke_rbf.json");
-  scene.lights = {PointLight{Vec3(0.6, 0.5, 1.3), Rgb(6.0)}};
-  scene.medium->bounds = Aabb{Vec3(-1.0), Vec3(1.0)};
+  const Scene scene = lattice_scene(Vec3(0.6, 0.5, 1.3));
   const int w = 400, h = 300;
-  scene.camera.width_px = w, scene.camera.height_px = h;
-  scene.camera.position = Vec3(-1.0, -0.6, 4.2);
   const ExtinctionVolume volume = make_extinction_volume(scene, 15);
   const std::vector<DenseGrid> depths = optical_depths(volume.density, scene.lights);
-  std::vector<float> host(static_cast<size_t>(w * h), std::numeric_limits<float>::infinity());
-  std::vector<Ray> rays(static_cast<size_t>(w));
-  for (int y = 0; y < h; ++y) {
-    scene.camera.row_rays(y, rays.data());
-    for (int x = 0; x < w; ++x)
-      if (rays[static_cast<size_t>(x)].direction.y < 0.0)
-        host[static_cast<size_t>(y * w + x)] = static_cast<float>((-0.4 - rays[static_cast<size_t>(x)].origin.y) / rays[static_cast<size_t>(x)].direction.y);
-  }
+  const std::vector<float> host = floor_depths(scene.camera, -0.4);
   std::vector<float> one(3 * w * h), four(3 * w * h), t_one(3 * w * h), t_four(3 * w * h);
   RenderOptions options;
   options.threads = 1;
