@@ -371,6 +371,13 @@ void march_row_layers_from(const Marcher& m, const MarchVolume& v, const View& v
     put_row(row(first), row(first + grey), row(first + 2 * grey), width, span, y);
 }
 
+// The distance from `eye` to the box's farthest corner.
+double farthest_corner(const Aabb& box, const Vec3& eye) {
+  double far = 0.0;
+  for (int c = 0; c < 8; ++c) far = std::max(far, glm::length(Vec3(c & 1 ? box.hi.x : box.lo.x, c & 2 ? box.hi.y : box.lo.y, c & 4 ? box.hi.z : box.lo.z) - eye));
+  return far;
+}
+
 // march_layers' lattice step in pixels (MarchSettings::kLatticeNodesPerCell): from one eye, a node
 // per kLatticeNodesPerCell of the narrowest cell as the view's central pixels see it at the
 // volume's farthest corner, rounded down to a power of 2 (the finer levels halve it down to 2);
@@ -378,9 +385,7 @@ void march_row_layers_from(const Marcher& m, const MarchVolume& v, const View& v
 // spots: peaks narrower than a cell) in or near the view.
 int lattice_step(const Marcher& m, const MarchVolume& v, const View& view, const Vec3& eye, std::vector<std::array<double, 2>>& peaks) {
   const Camera& camera = view.camera;
-  const Aabb& box = m.volume.density.bounds();
-  double far = 0.0;
-  for (int c = 0; c < 8; ++c) far = std::max(far, glm::length(Vec3(c & 1 ? box.hi.x : box.lo.x, c & 2 ? box.hi.y : box.lo.y, c & 4 ? box.hi.z : box.lo.z) - eye));
+  const double far = farthest_corner(m.volume.density.bounds(), eye);
   const Vec3 h = m.volume.density.cell_size();
   const double cell_pixels = std::min({h.x, h.y, h.z}) / (far * camera.pixel_angle());
   int step = std::min(static_cast<int>(cell_pixels / MarchSettings::kLatticeNodesPerCell), std::max(camera.width_px, camera.height_px));
@@ -506,12 +511,9 @@ void march_lattice_layers(const Marcher& m, const MarchVolume& v, const View& vi
   if (depth) {
     // Level 0's cells whose pixels' depths stray from the bilinear of their corners' by more than
     // kLatticeDepth cells (depths past the volume's farthest corner taken as there).
-    const Aabb& box = m.volume.density.bounds();
-    double far = 0.0;
-    for (int c = 0; c < 8; ++c) far = std::max(far, glm::length(Vec3(c & 1 ? box.hi.x : box.lo.x, c & 2 ? box.hi.y : box.lo.y, c & 4 ? box.hi.z : box.lo.z) - eye));
     const Vec3 h = m.volume.density.cell_size();
     const auto tolerance = static_cast<float>(MarchSettings::kLatticeDepth * std::min({h.x, h.y, h.z}));
-    const auto reach = static_cast<float>(far);
+    const auto reach = static_cast<float>(farthest_corner(m.volume.density.bounds(), eye));
     LatticeLevel& l = level(0);
     const auto step = static_cast<size_t>(l.step);
     const auto d = [&](size_t x, size_t y) { return std::min(depth[std::min(y, height - 1) * width + std::min(x, width - 1)], reach); };
@@ -554,7 +556,7 @@ void march_lattice_layers(const Marcher& m, const MarchVolume& v, const View& vi
       const auto rows = [&](long long j0, long long j1) {
         thread_local std::vector<float> at;
         thread_local std::vector<size_t> which;
-        room(at, l.nx), which.reserve(most_rays), which.clear();
+        room(at, l.nx), which.reserve(most_rays), which.resize(l.nx);
         for (auto j = static_cast<size_t>(j0); j < static_cast<size_t>(j1); ++j) {
           size_t n = 0;
           const size_t pj = j / 2;
@@ -566,10 +568,7 @@ void march_lattice_layers(const Marcher& m, const MarchVolume& v, const View& vi
             if (i % 2 == 0 && j % 2 == 0) {
               for (size_t r = 0; r < layers; ++r) *l.at(r, i, j) = *above.at(r, pi, pj);
             } else if (held == 2) {
-              at[n] = static_cast<float>(i * static_cast<size_t>(l.step)) + 0.5f;
-              if (which.size() <= n) which.push_back(i);
-              else which[n] = i;
-              ++n;
+              at[n] = static_cast<float>(i * static_cast<size_t>(l.step)) + 0.5f, which[n++] = i;
             } else {
               const float fi = (i % 2) ? 0.5f : 0.0f;
               for (size_t r = 0; r < layers; ++r) {
@@ -640,7 +639,7 @@ void march_lattice_layers(const Marcher& m, const MarchVolume& v, const View& vi
     thread_local std::vector<size_t> which;
     const size_t mix_stride = (width - 1) / 2 + 2;  // nodes a row of any level holds
     line.reserve(6 * (most_rays + 64)), line.resize(layers * padded), mix.reserve(6 * mix_stride), mix.resize(layers * mix_stride);
-    room(at, width), which.reserve(most_rays), which.clear();
+    room(at, width), which.reserve(most_rays), which.resize(width);
     // Pixels [x0, x1) of row y (x0 on a node) bilinear between level l's nodes: between its node
     // rows, then each cell's pixels along x.
     const auto blend = [&](LatticeLevel& l, size_t x0, size_t x1, size_t y) {
@@ -674,10 +673,7 @@ void march_lattice_layers(const Marcher& m, const MarchVolume& v, const View& vi
             continue;
           }
           for (size_t x = x0; x < x1; ++x) {
-            at[n] = static_cast<float>(x) + 0.5f;
-            if (which.size() <= n) which.push_back(x);
-            else which[n] = x;
-            ++n;
+            at[n] = static_cast<float>(x) + 0.5f, which[n++] = x;
           }
         }
         if (n > 0) march_points(static_cast<double>(y) + 0.5, at, n, [&](size_t r, size_t e, float value) { line[r * padded + which[e]] = value; });
