@@ -1,9 +1,16 @@
-// haze demo: every built-in scene (examples/*.json) with every registered method against a
-// reference that resolves their errors (rendered once, then cached), EXR + PNG each, a contact
-// sheet per scene with error maps, and a table of time and error. The time it will take is said
-// before anything renders.
+// haze demo: the source papers' showcase (tracker issue 52). Each paper's own scene
+// (examples/demo/showcase.json names rows of bench/seeds/rows.json) at its own resolution, the
+// camera moving on its orbit and the lights or the density where the paper moves them, as
+// `haze bench seeds` runs it: each frame's update and layers timed, and written (outside the time)
+// into an animated GIF. Then the last frame, small, against the low-noise references shipped in
+// examples/demo (made once by `haze demo --make-references`), and a table of paper, setting, the
+// paper's frame rate, Haze's and that error. `--sheets`: the contact sheets of every method on
+// examples/*.json instead (cmd_demo_sheets.cpp).
 #include "commands.h"
+#include "demo.h"
+#include "gif.h"
 #include "progress_bar.h"
+#include "seed_rows.h"
 
 #include <haze/core/error.h>
 #include <haze/core/stopwatch.h>
@@ -12,274 +19,231 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
-#include <iterator>
-#include <sstream>
 
 namespace haze::app {
-
-std::vector<std::filesystem::path> scene_files(const std::string& directory, const std::string& option) {
-  std::vector<std::filesystem::path> scenes;
-  if (!std::filesystem::is_directory(directory)) throw Error(option, directory, "a directory of scene files");
-  for (const auto& entry : std::filesystem::directory_iterator(directory))
-    if (entry.path().extension() == ".json") scenes.push_back(entry.path());
-  std::sort(scenes.begin(), scenes.end());
-  if (scenes.empty()) throw Error(option, directory, "at least one .json scene");
-  return scenes;
-}
-
 namespace {
 
-struct DemoArgs {
-  std::string out = "haze-demo";
-  std::string examples = HAZE_EXAMPLES_DIR;
-  int threads = 0;
-  double reference_seconds = 30.0;
+constexpr int kGifDelayCs = 4;  // the preview at 25 frames a second
+
+struct Showcase {
+  std::filesystem::path dir;  // examples/demo: the references beside showcase.json
+  std::string made_by;
+  int frames = 60, error_width = 48;
+  double target_noise = 0.01;
+  std::vector<SeedRow> rows;
 };
 
-constexpr long long kPilotSpp = 64;
-// Part of each cached reference's key: raise it when the reference's image of a scene changes
-// (2: particle scenes render the Gaussians themselves, not a 96^3 resample).
-constexpr int kReferenceRevision = 2;
-constexpr double kCheapSeconds = 0.5;  // a method this quick at the reference's size is shown at twice it
-
-// What the demo renders a scene at, and the reference it compares with: the finest of 1%
-// noise and what reference_seconds buys, at twice the scene's size where that still reaches 2%.
-struct Plan {
-  std::filesystem::path scene_file;
-  int scale = 1;
-  long long spp = 0;
-  double expected_seconds = 0.0;  // of the reference; 0 when cached
-  std::filesystem::path reference;  // its EXR in the cache (with the standard-error layer)
-};
-
-Scene scaled(Scene scene, int scale) {
-  scene.camera.width_px *= scale, scene.camera.height_px *= scale;
-  return scene;
-}
-
-RenderResult reference_render(const Scene& scene, long long spp, int threads, const std::string& label) {
-  RenderOptions options;
-  options.threads = threads;
-  options.settings = {{"spp", spp}, {"seed", 1}};
-  ProgressBar bar(label);
-  options.progress = bar.callback();
-  return render(scene, method_with_role(MethodInfo::Role::reference), options);
-}
-
-Plan plan(const std::filesystem::path& file, const DemoArgs& a) {
+Showcase load_showcase(const std::string& examples) {
+  Showcase s;
+  s.dir = std::filesystem::path(examples) / "demo";
+  const auto file = s.dir / "showcase.json";
   std::ifstream in(file);
-  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  const auto dir = default_cache_dir() / "demo";
-  const std::string key = file.stem().string() + "_" + to_text(std::hash<std::string>{}(text)) + "_" + to_text(a.reference_seconds) + "s_r" +
-                          to_text(kReferenceRevision);
-  Plan p{file, 1, 0, 0.0, dir / (key + ".exr")};
-  if (std::ifstream cached(dir / (key + ".json")); cached && std::filesystem::exists(p.reference)) {
-    const nlohmann::json j = nlohmann::json::parse(cached);
-    p.scale = j.at("scale"), p.spp = j.at("spp");
-    return p;
+  if (!in) throw Error("--examples", examples, "a directory with demo/showcase.json");
+  const nlohmann::json j = nlohmann::json::parse(in);
+  s.made_by = j.at("made_by"), s.frames = j.at("frames"), s.error_width = j.at("error_width"), s.target_noise = j.at("target_noise");
+  const std::vector<SeedRow> all = seed_rows(HAZE_SEEDS_ROWS);
+  for (const nlohmann::json& r : j.at("rows")) {
+    const auto found = std::find_if(all.begin(), all.end(), [&](const SeedRow& row) { return row.paper == r.at("paper") && row.row == r.at("row"); });
+    if (found == all.end()) throw Error(file.string() + ": rows", r.dump(), "a paper and row of bench/seeds/rows.json");
+    s.rows.push_back(*found);
   }
-  const Scene scene = Scene::load(file);
-  Stopwatch watch;
-  const RenderResult pilot = reference_render(scene, kPilotSpp, a.threads, file.stem().string() + " pilot");
-  const double seconds = watch.seconds();
-  const double noise = std::max(lit_pixel_error(pilot.radiance, pilot.radiance, &*pilot.std_error).noise_rms, 1e-6);
-  // Noise falls as 1 / sqrt(spp); time grows with spp and pixels.
-  auto spp_for = [&](double target) { return kPilotSpp * (noise / target) * (noise / target); };
-  auto affordable = [&](int scale) { return kPilotSpp * a.reference_seconds / (seconds * scale * scale); };
-  p.scale = std::min(spp_for(0.01), affordable(2)) >= spp_for(0.02) ? 2 : 1;
-  const double spp = std::clamp(std::min(spp_for(0.01), affordable(p.scale)), 256.0, 1e9);
-  p.spp = static_cast<long long>(std::ceil(spp / 64.0)) * 64;
-  p.expected_seconds = seconds * p.scale * p.scale * static_cast<double>(p.spp) / kPilotSpp;
-  return p;
-}
-
-// Display colours written through write_png's tone map (exposure 1, Reinhard, sRGB) unchanged.
-Rgb untonemap(const Rgb& display) {
-  Rgb out;
-  for (int c = 0; c < 3; ++c) {
-    const double s = std::clamp(display[c], 0.0, 0.998);
-    const double linear = s <= 0.04045 ? s / 12.92 : std::pow((s + 0.055) / 1.055, 2.4);
-    out[c] = linear / (1.0 - linear);
-  }
-  return out;
-}
-
-double luminance(const Rgb& c) { return 0.2126 * c.r + 0.7152 * c.g + 0.0722 * c.b; }
-
-// Relative error -> black (0), red (5%), yellow (10%), white (20% and more).
-Rgb error_colour(double e) {
-  const double t = std::clamp(e / 0.2, 0.0, 1.0);
-  if (t < 0.25) return {t / 0.25, 0.0, 0.0};
-  if (t < 0.5) return {1.0, (t - 0.25) / 0.25, 0.0};
-  return {1.0, 1.0, (t - 0.5) / 0.5};
-}
-
-// A 2x image averaged over 2 x 2 pixels: what it shows at the reference's size.
-Image downsample2(const Image& image) {
-  Image out(image.width() / 2, image.height() / 2);
-  for (int y = 0; y < out.height(); ++y)
-    for (int x = 0; x < out.width(); ++x)
-      out.set(x, y, 0.25 * (image.at(2 * x, 2 * y) + image.at(2 * x + 1, 2 * y) + image.at(2 * x, 2 * y + 1) + image.at(2 * x + 1, 2 * y + 1)));
-  return out;
-}
-
-// Top row: the reference, then each method (`shown`, at the reference's size or twice it; the
-// cells take the largest, smaller images enlarged); bottom row: the reference's own noise, then
-// each method's error against it (`compared`, at the reference's size), per pixel: |image -
-// reference| over the reference's luminance, at least 1% of its peak.
-void write_sheet(const std::filesystem::path& path, const Image& reference, const Image& noise, const std::vector<Image>& shown,
-                 const std::vector<Image>& compared) {
-  const int w = reference.width(), h = reference.height(), n = static_cast<int>(shown.size()) + 1;
-  int f = 1;  // the cells' scale over the reference's pixels
-  for (const Image& image : shown) f = std::max(f, image.width() / w);
-  std::vector<double> lum;
-  double peak = 0.0;
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) lum.push_back(luminance(reference.at(x, y))), peak = std::max(peak, lum.back());
-  std::vector<double> sorted = lum;
-  std::sort(sorted.begin(), sorted.end());
-  const double exposure = 1.0 / std::max(sorted[sorted.size() * 95 / 100], 1e-12);
-  Image sheet(n * f * w, 2 * f * h);
-  for (int i = 0; i < n; ++i) {
-    const Image& top = i == 0 ? reference : shown[static_cast<size_t>(i - 1)];
-    const int g = top.width() / w;  // this image's scale
-    for (int y = 0; y < f * h; ++y)
-      for (int x = 0; x < f * w; ++x) {
-        const int rx = x / f, ry = y / f;
-        const double scale = std::max(lum[static_cast<size_t>(ry * w + rx)], 0.01 * peak);
-        const double e = i == 0 ? luminance(noise.at(rx, ry)) / scale
-                                : luminance(glm::abs(compared[static_cast<size_t>(i - 1)].at(rx, ry) - reference.at(rx, ry))) / scale;
-        sheet.set(i * f * w + x, y, top.at(x * g / f, y * g / f) * exposure);
-        sheet.set(i * f * w + x, f * h + y, untonemap(error_colour(e)));
-      }
-  }
-  write_png(path, sheet);
-}
-
-std::string percent(double v) {
-  char s[32];
-  std::snprintf(s, sizeof s, "%.1f%%", 100.0 * v);
   return s;
 }
 
-int run(const DemoArgs& a) {
-  const std::vector<std::filesystem::path> scenes = scene_files(a.examples, "--examples");
-  auto methods = registered_methods();
-  // auto is a chooser and the reference the yardstick: the rows are the methods auto chooses from.
-  std::erase_if(methods, [](const MethodInfo& m) { return m.role != MethodInfo::Role::solver; });
-  const std::string reference_name = method_with_role(MethodInfo::Role::reference);
+// The reference a row's last frame is compared with: the full transport, or (`single`) the light
+// paths a single-scattering method computes (one medium scattering event and one reflection).
+struct Reference {
+  std::filesystem::path exr, json;
+  std::string key;  // the last frame's scene, the size and the light paths: a stale file differs
+};
 
-  std::vector<Plan> plans;
-  for (const auto& file : scenes) plans.push_back(plan(file, a));
-  double reference_seconds = 0.0;
-  int to_render = 0;
-  for (const Plan& p : plans) reference_seconds += p.expected_seconds, to_render += p.expected_seconds > 0.0;
-  std::printf("haze demo: %zu scenes x %zu methods against path-traced references (%d cached, %d to render: about %.0f s,\n"
-              "from 64-spp pilots); each method takes from milliseconds to a few seconds.\n\n",
-              plans.size(), methods.size(), static_cast<int>(plans.size()) - to_render, to_render, reference_seconds);
+Reference reference_of(const Showcase& s, const SeedRow& row, bool single) {
+  const std::string stem = "paper" + row.paper + (single ? "_single" : "");
+  const std::string what = row.scene.dump() + (row.lights_move ? "L" : "") + (row.density_moves ? "D" : "") + to_text(s.frames) + "x" +
+                           to_text(s.error_width) + (single ? "single" : "full");
+  return {s.dir / (stem + ".exr"), s.dir / (stem + ".json"), to_text(std::hash<std::string>{}(what))};
+}
+
+// The row's last frame at the error's width (the height keeps the aspect).
+Scene error_scene(const Showcase& s, const SeedRow& row) {
+  Scene scene = frame_scene(row, Scene::from_json(row.scene), s.frames);
+  const double aspect = static_cast<double>(scene.camera.height_px) / scene.camera.width_px;
+  scene.camera.width_px = s.error_width;
+  scene.camera.height_px = std::max(1, static_cast<int>(std::lround(s.error_width * aspect)));
+  return scene;
+}
+
+bool single_scattering(const SeedRow& row) {
+  for (const MethodInfo& m : registered_methods())
+    if (m.name == row.method) return m.single_scattering;
+  return false;
+}
+
+// The row's reference: a 64-spp pilot gives the noise and the time per sample, then the samples
+// that bring the noise to the showcase's target, or those `seconds` buys if fewer.
+void make_reference(const Showcase& s, const SeedRow& row, bool single, int threads, double seconds) {
+  const Reference r = reference_of(s, row, single);
+  const Scene scene = error_scene(s, row);
+  auto render_at = [&](long long spp, const std::string& label) {
+    RenderOptions options;
+    options.threads = threads;
+    options.settings = {{"spp", spp}, {"seed", 11}};
+    if (single) options.settings["max_scattering"] = 1, options.settings["max_bounces"] = 1;
+    ProgressBar bar(label);
+    options.progress = bar.callback();
+    return render(scene, method_with_role(MethodInfo::Role::reference), options);
+  };
+  auto noise_of = [](const RenderResult& result) { return lit_pixel_error(result.radiance, result.radiance, &*result.std_error).noise_rms; };
+  const std::string label = "paper " + row.paper + (single ? " single-scattering" : "") + " reference";
+  constexpr long long kPilot = 64;
+  Stopwatch watch;
+  const double pilot_noise = std::max(noise_of(render_at(kPilot, label + " pilot")), 1e-6);
+  const double per_sample = watch.seconds() / kPilot;
+  const double want = kPilot * (pilot_noise / s.target_noise) * (pilot_noise / s.target_noise);
+  const long long spp = static_cast<long long>(std::ceil(std::clamp(std::min(want, seconds / per_sample), 256.0, 1e9) / 64.0)) * 64;
+  std::printf("%s: %lld spp, about %.0f s (noise %.1f%% at %lld spp; %.0f spp would reach %.1f%%)\n", r.exr.string().c_str(), spp, per_sample * spp,
+              100.0 * pilot_noise, kPilot, want, 100.0 * s.target_noise);
   std::fflush(stdout);
+  watch.restart();
+  const RenderResult result = render_at(spp, label);
+  const double noise = noise_of(result);
+  write_exr(r.exr, result.radiance, &*result.std_error);
+  std::ofstream(r.json) << nlohmann::json{{"key", r.key}, {"paper", row.paper},      {"row", row.row},           {"single_scattering", single},
+                                          {"spp", spp},   {"noise", noise},          {"seconds", watch.seconds()}, {"made_by", s.made_by}}
+                               .dump(1)
+                        << "\n";
+  std::printf("%s: noise %.2f%%, %.0f s\n", r.exr.string().c_str(), 100.0 * noise, watch.seconds());
+  std::fflush(stdout);
+}
 
-  std::printf("%-16s %-12s %9s %10s %9s  %s\n", "scene", "method", "size", "seconds", "error", "output");
-  int rendered = 0;
-  for (const Plan& p : plans) {
-    const std::string stem = p.scene_file.stem().string();
-    const Scene scene = scaled(Scene::load(p.scene_file), p.scale);
-    const std::string size = to_text(scene.camera.width_px) + "x" + to_text(scene.camera.height_px);
-    Image reference, noise;
-    double seconds = 0.0;
-    if (std::filesystem::exists(p.reference)) {
-      std::optional<Image> se;
-      reference = read_exr(p.reference, &se);
-      noise = *se;
-    } else {
-      Stopwatch watch;
-      RenderResult r = reference_render(scene, p.spp, a.threads, stem + " reference " + to_text(p.spp) + " spp");
-      seconds = watch.seconds();
-      std::filesystem::create_directories(p.reference.parent_path());
-      write_exr(p.reference, r.radiance, &*r.std_error);
-      std::ofstream(std::filesystem::path(p.reference).replace_extension(".json")) << nlohmann::json{{"scale", p.scale}, {"spp", p.spp}}.dump();
-      reference = std::move(r.radiance), noise = std::move(*r.std_error);
+// A row's last frame against a shipped reference: "12.3% (0.9%)", the error over the lit pixels
+// with the reference's noise removed and that noise, or why there is none.
+std::string error_against(const Showcase& s, const SeedRow& row, bool single, const Image& image) {
+  const Reference r = reference_of(s, row, single);
+  std::ifstream in(r.json);
+  if (!in || !std::filesystem::exists(r.exr)) return "no reference (" + s.made_by + ")";
+  if (nlohmann::json::parse(in).at("key") != r.key) return "stale reference (" + s.made_by + ")";
+  std::optional<Image> se;
+  const Image reference = read_exr(r.exr, &se);
+  const LitPixelError e = lit_pixel_error(image, reference, &*se);
+  char text[64];
+  std::snprintf(text, sizeof text, "%.1f%% (%.1f%%)", 100.0 * e.rms_noise_removed, 100.0 * e.noise_rms);
+  return text;
+}
+
+// The exposure the preview shows a row with: the 95th percentile of the first frame's luminance
+// over its lit pixels (above 1% of its peak) at 1 (Reinhard's half grey).
+double preview_exposure(const Image& frame) {
+  std::vector<double> lum;
+  double peak = 0.0;
+  for (int y = 0; y < frame.height(); ++y)
+    for (int x = 0; x < frame.width(); ++x) {
+      const Rgb c = frame.at(x, y);
+      lum.push_back(0.2126 * c.r + 0.7152 * c.g + 0.0722 * c.b), peak = std::max(peak, lum.back());
     }
-    const double reference_noise = lit_pixel_error(reference, reference, &noise).noise_rms;
-    const auto ref_exr = std::filesystem::path(a.out) / (stem + "_reference.exr");
-    save_result({reference, noise, {}}, reference_name, seconds, ref_exr, true);
-    char took[32];
-    std::snprintf(took, sizeof took, "%.3f", seconds);
-    std::printf("%-16s %-12s %9s %10s %9s  %s (%lld spp%s)\n", stem.c_str(), reference_name.c_str(), size.c_str(), seconds > 0 ? took : "cached",
-                ("noise " + percent(reference_noise)).c_str(), ref_exr.string().c_str(), p.spp, seconds > 0 ? "" : ", from the cache");
-    if (reference_noise > 0.05)
-      std::printf("%-16s %-12s   errors under %s are not resolved; --reference-seconds %.0f would bring the noise to about 5%%\n", "", "",
-                  percent(1.5 * reference_noise).c_str(),
-                  a.reference_seconds * (reference_noise / 0.05) * (reference_noise / 0.05));
-    std::vector<Image> shown, compared;
-    std::string order = reference_name;
-    for (const auto& method : methods) {
-      auto timed = [&](const Scene& at, const std::string& label) {
-        RenderOptions options;
-        options.threads = a.threads;
-        options.cache_dir = default_cache_dir();
-        ProgressBar bar(label);
-        options.progress = bar.callback();
-        const Stopwatch watch;
-        RenderResult r = render(at, method.name, options);
-        seconds = watch.seconds();
-        return r;
-      };
-      try {
-        RenderResult result = timed(scene, stem + " " + method.name);
-        Image at_reference = result.radiance;
-        std::string shown_size = size;
-        // Where the method is cheap and the reference small, show it at twice the size (compared
-        // with the reference averaged back over 2 x 2 pixels).
-        if (p.scale == 1 && seconds < kCheapSeconds) {
-          const Scene large = scaled(scene, 2);
-          result = timed(large, stem + " " + method.name + " 2x");
-          at_reference = downsample2(result.radiance);
-          shown_size = to_text(large.camera.width_px) + "x" + to_text(large.camera.height_px);
-        }
-        auto exr = std::filesystem::path(a.out) / (stem + "_" + method.name + ".exr");
-        save_result(result, method.name, seconds, exr, true);
-        ++rendered;
-        const double error = lit_pixel_error(at_reference, reference, &noise).mean_abs;
-        // Within 1.5x the reference's noise the error is not resolved: say so.
-        const std::string error_text = error < 1.5 * reference_noise ? "~noise" : percent(error);
-        std::printf("%-16s %-12s %9s %10.3f %9s  %s\n", stem.c_str(), method.name.c_str(), shown_size.c_str(), seconds, error_text.c_str(),
-                    exr.string().c_str());
-        shown.push_back(std::move(result.radiance));
-        compared.push_back(std::move(at_reference));
-        order += " | " + method.name;
-      } catch (const Cancelled&) {
-        throw;
-      } catch (const Error& e) {
-        std::printf("%-16s %-12s %9s %10s %9s  not applicable: %s\n", stem.c_str(), method.name.c_str(), size.c_str(), "-", "-", e.what());
-      }
-      std::fflush(stdout);
-    }
-    const auto sheet = std::filesystem::path(a.out) / (stem + "_sheet.png");
-    write_sheet(sheet, reference, noise, shown, compared);
-    std::printf("%-16s %-12s %9s %10s %9s  %s: %s\n\n", stem.c_str(), "sheet", "", "", "", sheet.string().c_str(), order.c_str());
+  std::erase_if(lum, [&](double l) { return l <= 0.01 * peak; });
+  if (lum.empty()) return 1.0;
+  std::nth_element(lum.begin(), lum.begin() + static_cast<std::ptrdiff_t>(lum.size() * 95 / 100), lum.end());
+  return 1.0 / std::max(lum[lum.size() * 95 / 100], 1e-12);
+}
+
+struct RowRun {
+  double prepare_s = 0.0, ms = 0.0, update_ms = 0.0;
+  Image last;  // the last frame at the error's size
+};
+
+RowRun run_row(const Showcase& s, const SeedRow& row, const std::filesystem::path& gif_path, const std::filesystem::path& png_path, int threads) {
+  const Scene base = Scene::from_json(row.scene);
+  RenderOptions options;
+  options.threads = threads;
+  options.settings = row.settings;
+  RowRun run;
+  const Stopwatch watch;
+  Solution solution = prepare(frame_scene(row, base, 0), row.method, options);
+  run.prepare_s = watch.seconds();
+  RenderOptions render_options;
+  render_options.threads = threads;
+  const int width = base.camera.width_px, height = base.camera.height_px;
+  std::vector<float> layers[3];
+  for (auto& l : layers) l.resize(static_cast<size_t>(width) * static_cast<size_t>(height) * 3);
+  const LayerSpans out{{layers[0].data(), width, height}, {layers[1].data(), width, height}, {layers[2].data(), width, height}};
+  AnimatedGif gif(gif_path, width, height, kGifDelayCs);
+  Image frame(width, height);
+  double exposure = 1.0;
+  std::vector<double> ms, update_ms;
+  ProgressBar bar("paper " + row.paper + ": " + to_text(s.frames) + " frames");
+  const ProgressCallback progress = bar.callback();
+  Scene scene;
+  for (int f = 1; f <= s.frames; ++f) {
+    scene = frame_scene(row, base, f);
+    const FrameTime t = play_frame(row, solution, scene, out, render_options);
+    ms.push_back(t.ms), update_ms.push_back(t.update_ms);
+    // The frame a renderer shows: L_in + T C.
+    for (size_t i = 0; i < layers[0].size(); ++i) frame.data()[i] = layers[0][i] + layers[1][i] * layers[2][i];
+    if (f == 1) exposure = preview_exposure(frame);
+    gif.add(frame, exposure);
+    if (progress) progress(static_cast<double>(f) / s.frames);
   }
-  std::printf("error: mean relative error over the lit pixels (those above 1%% of the reference's peak) against the\n"
-              "reference, whose own noise is its row's figure; \"~noise\" marks errors within 1.5x that noise. Methods\n"
-              "quick at the reference's size are rendered at twice it and compared averaged over 2 x 2 pixels. The\n"
-              "reference solves the full transport: single-scattering methods also differ by the multiple scattering\n"
-              "and shadows they leave out (docs/METHODS.md). Sheets: images on top (the order printed), error maps\n"
-              "below (the reference's noise first; black 0, red 5%%, yellow 10%%, white 20%% and more).\n");
-  return rendered > 0 ? 0 : 1;
+  gif.close();
+  write_png(png_path, frame, exposure);
+  run.ms = median(ms), run.update_ms = median(update_ms);
+  Scene small = error_scene(s, row);
+  run.last = solution.render(View{small.camera}, render_options).radiance;
+  return run;
+}
+
+int run_showcase(const DemoArgs& a) {
+  const Showcase s = load_showcase(a.examples);
+  if (a.make_references) {
+    for (const SeedRow& row : s.rows) {
+      make_reference(s, row, false, a.threads, a.reference_seconds);
+      if (single_scattering(row)) make_reference(s, row, true, a.threads, a.reference_seconds);
+    }
+    return 0;
+  }
+  std::filesystem::create_directories(a.out);
+  std::printf("haze demo: the source papers' own scenes at their resolutions, %d frames each, the camera moving (and the\n"
+              "lights or the density where the paper moves them); each frame's update and layers timed on %s, the\n"
+              "previews written beside (about a minute in all; `haze demo --sheets` compares every method instead).\n\n",
+              s.frames, a.threads > 0 ? (to_text(a.threads) + " threads").c_str() : "all cores");
+  std::printf("| paper | setting | its hardware | its fps | Haze fps (ms: update + render) | ratio | error (reference noise) | preview |\n"
+              "|---|---|---|---|---|---|---|---|\n");
+  std::fflush(stdout);
+  for (const SeedRow& row : s.rows) {
+    const auto gif = std::filesystem::path(a.out) / ("paper" + row.paper + ".gif");
+    const RowRun run = run_row(s, row, gif, std::filesystem::path(gif).replace_extension(".png"), a.threads);
+    const double fps = 1e3 / run.ms;
+    std::string error = error_against(s, row, false, run.last);
+    if (single_scattering(row)) error += "; single scattering: " + error_against(s, row, true, run.last);
+    std::printf("| %s | %s | %s | %s | %.1f (%.1f + %.1f ms) | %.2fx | %s | %s |\n", row.paper.c_str(), row.row.c_str(), row.hardware.c_str(),
+                to_text(row.paper_fps).c_str(), fps, run.update_ms, run.ms - run.update_ms, fps / row.paper_fps, error.c_str(), gif.string().c_str());
+    std::fflush(stdout);
+  }
+  std::printf("\nHaze fps: the median frame (the solution's update and its layers at the paper's resolution into a\n"
+              "renderer's buffers; preparing the solution before the first frame not counted). error: the last frame\n"
+              "at %d pixels across against the reference path tracer's image of it (examples/demo, made by `%s`),\n"
+              "relative RMS over the lit pixels with the reference's noise (in brackets) removed. Single-scattering\n"
+              "methods (papers 002, 003) leave out the light scattered more than once: their error against the\n"
+              "full transport is mostly that; against the single-scattering reference, their own.\n",
+              s.error_width, s.made_by.c_str());
+  return 0;
 }
 
 }  // namespace
 
 Command add_demo(CLI::App& app) {
-  auto* sub = app.add_subcommand("demo", "Render the built-in scenes with every method against a cached reference; EXR + PNG, contact sheets, a table");
+  auto* sub = app.add_subcommand("demo", "The source papers' scenes moving at their own resolutions: frame rates, errors, animated previews");
   auto a = std::make_shared<DemoArgs>();
   sub->add_option("--out", a->out, "Output directory")->capture_default_str();
-  sub->add_option("--examples", a->examples, "Directory of scene files")->capture_default_str();
+  sub->add_option("--examples", a->examples, "The examples directory (demo/showcase.json and its references; --sheets: its scenes)")->capture_default_str();
   sub->add_option("--threads", a->threads, "Thread cap (0: all cores)")->check(CLI::NonNegativeNumber);
-  sub->add_option("--reference-seconds", a->reference_seconds, "Time each uncached reference may take (it stops at 1% noise sooner)")
+  sub->add_flag("--make-references", a->make_references, "Render the showcase's references into <examples>/demo (minutes to hours)");
+  sub->add_flag("--sheets", a->sheets, "Instead: every method on examples/*.json against cached references, contact sheets");
+  sub->add_option("--reference-seconds", a->reference_seconds,
+                  "Time each reference may take (--make-references: the showcase's, stopping at its target noise; --sheets: each uncached one, at 1%)")
       ->capture_default_str()
       ->check(CLI::Range(1.0, 86400.0));
-  return {sub, [a] { return run(*a); }};
+  return {sub, [a] { return a->sheets ? run_sheets(*a) : run_showcase(*a); }};
 }
 
 }  // namespace haze::app

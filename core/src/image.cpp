@@ -215,6 +215,13 @@ std::vector<float> read_exr_table(const std::filesystem::path& path, int& width,
   }
 }
 
+unsigned char preview_byte(double v) {
+  v = std::isfinite(v) ? std::max(0.0, v) : 0.0;
+  v = v / (1.0 + v);
+  v = v <= 0.0031308 ? 12.92 * v : 1.055 * std::pow(v, 1.0 / 2.4) - 0.055;
+  return static_cast<unsigned char>(std::lround(std::clamp(v, 0.0, 1.0) * 255.0));
+}
+
 void write_png(const std::filesystem::path& path, const Image& image, double exposure) {
   std::unique_ptr<FILE, int (*)(FILE*)> file(std::fopen(path.string().c_str(), "wb"), &std::fclose);
   if (!file) throw Error("png output", path.string(), "a writable file");
@@ -240,14 +247,8 @@ void write_png(const std::filesystem::path& path, const Image& image, double exp
   png_write_info(png, info);
   for (int y = 0; y < image.height(); ++y) {
     for (int x = 0; x < image.width(); ++x) {
-      Rgb c = image.at(x, y) * exposure;
-      for (int k = 0; k < 3; ++k) {
-        double v = std::max(0.0, c[k]);
-        if (!std::isfinite(v)) v = 0.0;
-        v = v / (1.0 + v);
-        v = v <= 0.0031308 ? 12.92 * v : 1.055 * std::pow(v, 1.0 / 2.4) - 0.055;
-        row[3 * static_cast<size_t>(x) + static_cast<size_t>(k)] = static_cast<unsigned char>(std::lround(std::clamp(v, 0.0, 1.0) * 255.0));
-      }
+      const Rgb c = image.at(x, y) * exposure;
+      for (int k = 0; k < 3; ++k) row[3 * static_cast<size_t>(x) + static_cast<size_t>(k)] = preview_byte(c[k]);
     }
     png_write_row(png, row.data());
   }

@@ -73,6 +73,8 @@ std::vector<float> read_exr_depth(const std::filesystem::path& path, int& width,
 Image read_exr(const std::filesystem::path& path, std::optional<Image>* std_error = nullptr);
 // 8-bit sRGB preview, tone-mapped with exposure then Reinhard x / (1 + x): not data.
 void write_png(const std::filesystem::path& path, const Image& image, double exposure = 1.0);
+// A linear value as write_png shows it: Reinhard x / (1 + x), sRGB, 8 bits (0 for NaN or below 0).
+unsigned char preview_byte(double linear);
 
 // One float channel "T" (a precomputed table, x fastest) with string attributes, as an EXR.
 void write_exr_table(const std::filesystem::path& path, int width, int height, const std::vector<float>& values,
