@@ -104,7 +104,7 @@ struct SurfaceSolve {
   double surface_seconds = 0.0;
 };
 SurfaceSolve solve_with_surfaces(const Scene& scene, const ExtinctionVolume& volume, const std::vector<DenseGrid>& depths, DomSettings settings,
-                                 const DomSolution* warm, int passes, double step_cells) {
+                                 const DomSolution* warm, int passes, double step_cells, std::vector<std::vector<float>>* spare = nullptr) {
   SurfaceSolve out;
   if (scene.surfaces.empty() || settings.scheme == DomScheme::paper) passes = 0;
   const ProgressCallback progress = settings.progress;
@@ -113,7 +113,7 @@ SurfaceSolve solve_with_surfaces(const Scene& scene, const ExtinctionVolume& vol
   };
   const std::vector<DenseGrid> sources = source_depths(scene, volume, depths, settings.threads);
   share(0);
-  out.solution = solve_dom(volume, scene.lights, sources, settings, warm);
+  out.solution = solve_dom(volume, scene.lights, sources, settings, warm, nullptr, spare);
   out.iterations = out.solution.iterations;
   Rgb sky;
   const Scene delta = without_sky(scene, sky);
@@ -379,7 +379,7 @@ class DomMethodSolution final : public GridSolution {
       warm.progress = options.progress;
       // A budget of sweeps: source iteration, each sweep with the first-collision source in it.
       if (warm_iterations_ > 0) warm.max_iterations = warm_iterations_, warm.accelerator = DomAccelerator::none, warm.fold_first_collision = true;
-      SurfaceSolve next = solve_with_surfaces(scene, volume_, depths_, warm, &solution_, surface_passes_, step_cells_);
+      SurfaceSolve next = solve_with_surfaces(scene, volume_, depths_, warm, &solution_, surface_passes_, step_cells_, &spare_);
       report.redone.push_back("moments: first-collision source and " + to_text(next.iterations) + " sweeps over " +
                               to_text(next.solution.channels) + " channel(s) from the previous solution" +
                               (next.passes > 0 ? ", " + to_text(next.passes) + " surface pass(es)" : std::string()));
@@ -388,6 +388,8 @@ class DomMethodSolution final : public GridSolution {
       report.stats["converged"] = next.solution.converged;
       report.stats["sweep_seconds"] = next.solution.sweep_seconds;
       next.solution.texel_surfaces = solution_.texel_surfaces;
+      for (std::vector<float>& m : solution_.moments) spare_.push_back(std::move(m));  // the next update's buffers
+      spare_.resize(std::min<size_t>(spare_.size(), 2 * static_cast<size_t>(next.solution.channels)));
       solution_ = std::move(next.solution);
       // The warnings hold for the solution as it now is (a new density may have thicker cells).
       say_warnings(volume_, solution_, settings_, warm_iterations_ > 0, stats);
@@ -445,16 +447,18 @@ class DomMethodSolution final : public GridSolution {
     if (!gather_) {
       delta_ = without_sky(scene_, sky_);
       gather_ = std::make_unique<dom::Gather>(delta_, volume_, depths_, solution_, step_cells_, 1, nullptr);
-      toward_eye_.reset();
       if (solution_.terms() <= 64 && solution_.first_plane == 0 && solution_.resolution == volume_.density.resolution()) {
-        toward_eye_ = std::make_unique<dom::TowardEye>(solution_);
+        if (!toward_eye_ || !toward_eye_->made_for(solution_)) toward_eye_ = std::make_unique<dom::TowardEye>(solution_);
         packed_ = pack_lights(delta_, volume_, depths_, settings_.threads);
+      } else {
+        toward_eye_.reset();
       }
     }
     return *gather_;
   }
 
   DomSolution solution_;
+  std::vector<std::vector<float>> spare_;  // moments' buffers an update reuses (solve_dom's spare)
   mutable std::mutex gather_mutex_;
   mutable Scene delta_;
   mutable Rgb sky_;

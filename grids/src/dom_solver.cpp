@@ -272,8 +272,35 @@ size_t dom_memory_bytes(const std::array<int, 3>& resolution, int channels, cons
   return result + std::max(first + sizeof(float) * 2 * cells * n, iterating);
 }
 
+namespace {
+
+// The solution's directions, phase (the medium's, or its delta-M remainder) and the phase matrix
+// with its N-term factorization.
+void factorize(const PhaseFunction& phase, const DomSettings& settings, DomSolution& out) {
+  out.directions = std::make_shared<DirectionSet>(DirectionSet::fibonacci(settings.directions));
+  out.phase = phase;
+  if (settings.delta_m && kept_terms(settings) < settings.directions) {
+    const auto m = static_cast<int>(std::floor(std::sqrt(kept_terms(settings))));
+    const std::vector<double> b = phase.legendre_moments(m + 1);
+    if (const double f = b[static_cast<size_t>(m)]; f > 1e-6 && f < 1.0) {
+      std::vector<double> remainder(static_cast<size_t>(m));
+      for (size_t k = 0; k < remainder.size(); ++k) remainder[k] = (b[k] - f) / (1.0 - f);
+      std::vector<double> table(2049);
+      for (size_t i = 0; i < table.size(); ++i)
+        table[i] = std::max(0.0, eval_legendre_series(remainder, -1.0 + 2.0 * static_cast<double>(i) / 2048.0));
+      out.phase = PhaseFunction::tabulated(std::move(table));
+      out.delta_m_fraction = f;
+    }
+  }
+  out.matrix = std::make_shared<PhaseMatrix>(out.phase, *out.directions);
+  out.separable = std::make_shared<SeparablePhase>(*out.matrix, kept_terms(settings));
+}
+
+}  // namespace
+
 DomSolution solve_dom(const ExtinctionVolume& volume, const std::vector<Light>& lights, const std::vector<DenseGrid>& delta_depths,
-                      const DomSettings& settings, const DomSolution* warm, const DomBoundary* boundary) {
+                      const DomSettings& settings, const DomSolution* warm, const DomBoundary* boundary,
+                      std::vector<std::vector<float>>* spare) {
   if (settings.directions < 8 || settings.directions > 4096)
     throw Error("directions", to_text(settings.directions), "a direction count in [8, 4096]");
   if (settings.terms < 0 || settings.terms > settings.directions)
@@ -324,23 +351,16 @@ DomSolution solve_dom(const ExtinctionVolume& volume, const std::vector<Light>& 
                "fewer cells, directions or terms");
   if (exchange) exchange->begin();
 
-  out.directions = std::make_shared<DirectionSet>(DirectionSet::fibonacci(settings.directions));
-  out.phase = volume.phase;
-  if (settings.delta_m && kept_terms(settings) < settings.directions) {
-    const auto m = static_cast<int>(std::floor(std::sqrt(kept_terms(settings))));
-    const std::vector<double> b = volume.phase.legendre_moments(m + 1);
-    if (const double f = b[static_cast<size_t>(m)]; f > 1e-6 && f < 1.0) {
-      std::vector<double> remainder(static_cast<size_t>(m));
-      for (size_t k = 0; k < remainder.size(); ++k) remainder[k] = (b[k] - f) / (1.0 - f);
-      std::vector<double> table(2049);
-      for (size_t i = 0; i < table.size(); ++i)
-        table[i] = std::max(0.0, eval_legendre_series(remainder, -1.0 + 2.0 * static_cast<double>(i) / 2048.0));
-      out.phase = PhaseFunction::tabulated(std::move(table));
-      out.delta_m_fraction = f;
-    }
+  // The directions and the phase matrix's factorization depend only on the medium's phase and the
+  // settings: a warm solve of the same ones (an update) takes them as they are.
+  out.factorization = volume.phase.key() + (settings.delta_m ? " delta-M" : "") + " D=" + to_text(settings.directions) + " N=" +
+                      to_text(kept_terms(settings));
+  if (warm && warm->factorization == out.factorization && warm->separable) {
+    out.directions = warm->directions, out.phase = warm->phase, out.delta_m_fraction = warm->delta_m_fraction;
+    out.matrix = warm->matrix, out.separable = warm->separable;
+  } else {
+    factorize(volume.phase, settings, out);
   }
-  out.matrix = std::make_shared<PhaseMatrix>(out.phase, *out.directions);
-  out.separable = std::make_shared<SeparablePhase>(*out.matrix, kept_terms(settings));
   const dom::Transport transport(volume.density, *out.directions, *out.matrix, *out.separable, settings.spatial, settings.scalar_kernel,
                                    exchange);
   const size_t size = cells * static_cast<size_t>(out.terms());
@@ -381,8 +401,16 @@ DomSolution solve_dom(const ExtinctionVolume& volume, const std::vector<Light>& 
       // source in it (forming b apart would take one more). With the diamond's fix-up, b apart
       // (its sweep sets the marks, as in a cold solve), unless fold_first_collision sets them in
       // the sweeps of b + K x (DomSettings).
-      x = warm->moments[static_cast<size_t>(c)];
-      std::vector<float> next(size), b;
+      // A spare buffer of `size` floats, its contents undefined (the sweeps write all of it).
+      const auto take = [&] {
+        std::vector<float> v;
+        if (spare && !spare->empty()) v = std::move(spare->back()), spare->pop_back();
+        v.resize(size);
+        return v;
+      };
+      x = take();
+      std::copy(warm->moments[static_cast<size_t>(c)].begin(), warm->moments[static_cast<size_t>(c)].end(), x.begin());
+      std::vector<float> next = take(), b;
       channel.mark_with_moments = channel.bounded && settings.fold_first_collision;
       if (channel.bounded && !settings.fold_first_collision) {
         b.resize(size);
@@ -405,6 +433,7 @@ DomSolution solve_dom(const ExtinctionVolume& volume, const std::vector<Light>& 
         progress(out.iterations);
         if (change < settings.tolerance) break;
       }
+      if (spare) spare->push_back(std::move(next));
       continue;
     }
     std::vector<float> b(size);

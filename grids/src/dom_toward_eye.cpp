@@ -21,7 +21,7 @@ Vec3 decode(double u, double v) {
 
 }  // namespace
 
-TowardEye::TowardEye(const DomSolution& solution) : solution_(solution) {
+TowardEye::TowardEye(const DomSolution& solution) : solution_(solution), separable_(solution.separable) {
   const auto terms = static_cast<size_t>(solution.terms());
   table_.resize(static_cast<size_t>(kSide) * kSide * terms);
   Eigen::VectorXd row, c;

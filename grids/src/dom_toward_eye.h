@@ -12,8 +12,10 @@ namespace haze::grids::dom {
 class TowardEye {
  public:
   // The in-scatter weights c(-w) (inscatter_weights) over kSide x kSide directions w of an
-  // octahedral map, made once per solution.
+  // octahedral map, made once per solution's factorization (kept over updates that keep it).
   explicit TowardEye(const DomSolution& solution);
+  // Whether the table holds `solution`'s weights: it was made from the same directions and phase.
+  bool made_for(const DomSolution& solution) const { return &solution == &solution_ && solution.separable == separable_; }
   // Per cell of the solution's grid (`density`'s resolution and bounds) and channel:
   // scale[c] max(0, c(-w) . m_c), w the unit direction from `eye` to the cell's centre (c(-w)
   // bilinear in the table), into out[c * cells + cell] (kept by the caller), on the threads.
@@ -26,6 +28,7 @@ class TowardEye {
 
  private:
   const DomSolution& solution_;
+  std::shared_ptr<const SeparablePhase> separable_;  // the factorization the table was made from
   std::vector<float> table_;  // [(v * kSide + u) * terms + k]
 };
 

@@ -314,6 +314,32 @@ TEST(DomSolver, WarmStartConvergesFaster) {
   EXPECT_LT(relative_difference(warm.moments[0], cold.moments[0]), 1e-3);
 }
 
+// A warm solve of the same phase and settings keeps the warm solution's factorization (an update
+// does not redo the phase matrix); another g makes its own. With `spare` buffers (the previous
+// moments), the warm iteration takes them and leaves one back, and the moments are the same bits.
+TEST(DomSolver, WarmSolveReusesItsFactorizationAndBuffers) {
+  Small s;
+  DomSettings settings;
+  settings.directions = 64;
+  settings.accelerator = DomAccelerator::none;
+  settings.max_iterations = 2;
+  const DomSolution before = solve_dom(s.volume, s.lights, s.depths, settings);
+  s.lights[0] = PointLight{Vec3(0.25, 0.1, 0.05), Rgb(2.0)};
+  s.depths[0] = optical_depth(s.volume.density, s.lights[0], {DepthScheme::exact});
+  const DomSolution warm = solve_dom(s.volume, s.lights, s.depths, settings, &before);
+  EXPECT_EQ(warm.separable, before.separable);
+  EXPECT_EQ(warm.matrix, before.matrix);
+  std::vector<std::vector<float>> spare{std::vector<float>(7), before.moments[0]};
+  const DomSolution recycled = solve_dom(s.volume, s.lights, s.depths, settings, &before, nullptr, &spare);
+  EXPECT_EQ(recycled.moments[0], warm.moments[0]);
+  ASSERT_EQ(spare.size(), 1u);
+  EXPECT_EQ(spare[0].size(), warm.moments[0].size());
+  s.volume.phase = PhaseFunction::henyey_greenstein(0.2);
+  const DomSolution other = solve_dom(s.volume, s.lights, s.depths, settings, &before);
+  EXPECT_NE(other.separable, before.separable);
+  EXPECT_NE(other.factorization, before.factorization);
+}
+
 // A white furnace: albedo 1 in a closed box under a sky of radiance 1 (entering through the
 // boundary) is invisible, with any separable truncation (the constant eigenvector has eigenvalue 1
 // and is always kept).

@@ -191,6 +191,7 @@ struct DomSolution {
   std::shared_ptr<const SeparablePhase> separable;
   PhaseFunction phase;             // the one the matrix holds: the medium's, or its delta-M remainder
   double delta_m_fraction = 0.0;   // f: 0 without delta-M scaling
+  std::string factorization;       // what the directions, matrix and separable phase were made from
   std::array<int, 3> resolution{0, 0, 0};  // with an exchange, of this process's planes
   int first_plane = 0;                       // with an exchange: its first plane in the whole grid
   int channels = 0;
@@ -231,9 +232,13 @@ struct DomBoundary {
 // render_dom takes them; sky lights enter through the boundary and have none. `warm`, when given and of the same shape, starts the iteration from its moments (the
 // paper's one-iteration-per-frame mode when density or lights change a little); with accelerator
 // none each iteration is then one sweep with the first-collision source in it (x <- b + K x).
-// `boundary`, when given, replaces the sky's radiance at the faces.
+// `boundary`, when given, replaces the sky's radiance at the faces. `spare`, when given, holds
+// buffers the warm iteration may take for its moments and its next iterate (their contents are
+// overwritten) and gets back the one it leaves: a caller that hands it the previous solution's
+// moments solves frame after frame without allocating them.
 DomSolution solve_dom(const ExtinctionVolume& volume, const std::vector<Light>& lights, const std::vector<DenseGrid>& delta_depths,
-                      const DomSettings& settings, const DomSolution* warm = nullptr, const DomBoundary* boundary = nullptr);
+                      const DomSettings& settings, const DomSolution* warm = nullptr, const DomBoundary* boundary = nullptr,
+                      std::vector<std::vector<float>>* spare = nullptr);
 
 // For a direction w (propagation direction of the scattered light): c_k with
 // sum_j P(w, w_j) L_j ~ sum_k c_k m_k, the row of P at w extended off the direction set
