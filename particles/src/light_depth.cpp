@@ -204,24 +204,33 @@ void LightDepthMap::splat_parallel(Face& f, const Vec3& x, double h, double w, i
   const std::pair<size_t, size_t> range = nodes_within(t, kCut * h, s0_, ds_, k_count);
   const size_t k0 = range.first, k1 = range.second;
   const double before = erf(t / h);
-  thread_local std::vector<double> kept_nodes, kept_columns, kept_rows;
+  // Per texel column u and row v (over h): u^2 and exp(-u^2), v^2 and exp(-v^2).
+  struct Axis {
+    double square, factor;
+  };
+  thread_local std::vector<double> kept_nodes;
+  thread_local std::vector<Axis> kept_columns, kept_rows;
   std::vector<double>& nodes = kept_nodes;
-  std::vector<double>& column = kept_columns;
-  std::vector<double>& row = kept_rows;
+  std::vector<Axis>& column = kept_columns;
+  std::vector<Axis>& row = kept_rows;
   nodes.clear(), column.clear(), row.clear();
   for (size_t k = k0; k < k1; ++k) nodes.push_back(erf((s0_ + static_cast<double>(k) * ds_ - t) / h) + before);
   const double texel = 2.0 * extent_ / resolution_;
-  for (int i = i0; i <= i1; ++i) column.push_back((-extent_ + (i + 0.5) * texel - a) / h);
-  for (int j = j0; j <= j1; ++j) row.push_back((-extent_ + (j + 0.5) * texel - b) / h);
+  const auto axis = [&](int i, double centre) {
+    const double u = (-extent_ + (i + 0.5) * texel - centre) / h;
+    return Axis{u * u, std::exp(-u * u)};
+  };
+  for (int i = i0; i <= i1; ++i) column.push_back(axis(i, a));
+  for (int j = j0; j <= j1; ++j) row.push_back(axis(j, b));
   const double scale = w * h * 0.5 * std::sqrt(kPi);
   const auto m = static_cast<size_t>(resolution_);
   for (int j = j0; j <= j1; ++j) {
-    const double v = row[static_cast<size_t>(j - j0)];
+    const Axis v = row[static_cast<size_t>(j - j0)];
     for (int i = i0; i <= i1; ++i) {
-      const double u = column[static_cast<size_t>(i - i0)];
-      if (u * u + v * v >= kCut * kCut) continue;
+      const Axis u = column[static_cast<size_t>(i - i0)];
+      if (u.square + v.square >= kCut * kCut) continue;
       const size_t texel_index = static_cast<size_t>(j) * m + static_cast<size_t>(i);
-      add_gaussian(f.depth.data(), texel_index * k_count, k0, k1, k_count, scale * std::exp(-(u * u + v * v)), before,
+      add_gaussian(f.depth.data(), texel_index * k_count, k0, k1, k_count, scale * u.factor * v.factor, before,
                    [&](size_t k) { return nodes[k - k0]; }, tail);
       if (!tail) f.touched[texel_index] = 1;
     }

@@ -122,6 +122,9 @@ struct SplatInputs {
   // Per pixel: where its ray ends (its t_end: Haze's own surface or the host's depth, else inf) and
   // the light leaving that end; empty where nothing ends any ray.
   std::function<Rgb(int x, int y, const Ray& ray, double& t_end)> end_of;
+  // Or null: the caller's float32 layers, which the pixels interpolated from a lattice go into
+  // straight, not through the sink.
+  const LayerSpans* layers = nullptr;
 };
 
 // Where a render hands its pixels' layers: a run of row y from pixel x0 on, threaded.

@@ -86,7 +86,7 @@ Rgb march(std::vector<Along>& along, const Rgb& sigma_t, const std::vector<Rgb>&
 
 // render_network, each pixel's layers handed to `sink`; returns the render's stats.
 nlohmann::json render_into(const Scene& scene, const ParticleField& field, const NetworkSolution& solution, const RenderOptions& options,
-                           const View& view, NetworkRender render, const PixelSink& sink) {
+                           const View& view, NetworkRender render, const PixelSink& sink, const LayerSpans* layers = nullptr) {
   const Camera& cam = view.camera;
   if (cam.type == Camera::Type::rays)
     throw Error("view.camera", "per-pixel rays", "a camera with one eye (pinhole, orthographic or matrices) for method network, whose "
@@ -218,7 +218,8 @@ nlohmann::json render_into(const Scene& scene, const ParticleField& field, const
            : std::isinf(t_hit) ? background : Rgb(0.0);  // none behind a host's depth
   };
   if (render == NetworkRender::splat) {
-    SplatInputs in{cam, field, solution, scattered, direct, nearest, background, [&](const Vec3& x) { return parallel ? backward : glm::normalize(eye - x); }, {}};
+    SplatInputs in{cam, field, solution, scattered, direct, nearest, background, [&](const Vec3& x) { return parallel ? backward : glm::normalize(eye - x); }, {},
+                   layers};
     if (!scene.surfaces.empty() || !view.depth.empty())
       in.end_of = [&](int x, int y, const Ray& ray, double& t_end) {
         thread_local std::vector<Along> gathered;
@@ -327,7 +328,7 @@ class NetworkMethodSolution final : public MethodSolution {
         put(out.inscatter, x, y, run[i].inscatter), put(out.transmittance, x, y, run[i].transmittance);
         if (out.surface.data) put(out.surface, x, y, run[i].surface);
       }
-    });
+    }, &out);
     return true;
   }
 

@@ -223,29 +223,44 @@ int splat_network(const SplatInputs& in, std::span<const uint32_t> front_to_back
   });
   progress.throw_if_cancelled();
   if (step == 1) return step;
-  // Each pixel bilinear between its lattice's nodes.
+  // Each pixel bilinear between its lattice's nodes, in float32: each row's nodes blended between
+  // their node rows, then each pixel between two of those; into the caller's layers, or the sink.
+  const auto nx = static_cast<size_t>(lattice.nx);
   parallel_for(cam.height_px, options.threads, 16, [&](long long y0, long long y1) {
-    thread_local std::vector<PixelLayers> kept;  // a row's, handed to the sink at once
-    std::vector<PixelLayers>& row = kept;
-    row.resize(static_cast<size_t>(cam.width_px));
+    thread_local std::vector<float> kept_mixed;  // [layer][node]: L_in's channels, then T's
+    thread_local std::vector<PixelLayers> kept_row;  // a row's, handed to the sink at once
+    std::vector<float>& mixed = kept_mixed;
+    std::vector<PixelLayers>& row = kept_row;
+    mixed.resize(6 * nx);
+    if (!in.layers) row.resize(static_cast<size_t>(cam.width_px));
     for (auto y = static_cast<int>(y0); y < static_cast<int>(y1); ++y) {
-      const int j = y / step;
-      const double fy = static_cast<double>(y - j * step) / step;
-      for (int x = 0; x < cam.width_px; ++x) {
-        const int i = x / step;
-        const double fx = static_cast<double>(x - i * step) / step;
-        const size_t a = static_cast<size_t>(j) * static_cast<size_t>(lattice.nx) + static_cast<size_t>(i), b = a + static_cast<size_t>(lattice.nx);
-        const double w[4] = {(1 - fx) * (1 - fy), fx * (1 - fy), (1 - fx) * fy, fx * fy};
-        const auto at = [&](const std::array<std::vector<float>, 3>& v) {
-          Rgb sum(0.0);
-          for (size_t c = 0; c < 3; ++c)
-            sum[static_cast<int>(c)] = w[0] * static_cast<double>(v[c][a]) + w[1] * static_cast<double>(v[c][a + 1]) + w[2] * static_cast<double>(v[c][b]) +
-                                       w[3] * static_cast<double>(v[c][b + 1]);
-          return sum;
-        };
-        row[static_cast<size_t>(x)] = {at(node_radiance), at(node_transmittance), in.background};
+      const auto j = static_cast<size_t>(y / step);
+      const float fy = static_cast<float>(y % step) / static_cast<float>(step);
+      for (size_t c = 0; c < 6; ++c) {
+        const float* v = (c < 3 ? node_radiance[c] : node_transmittance[c - 3]).data() + j * nx;
+        float* m = mixed.data() + c * nx;
+        for (size_t i = 0; i < nx; ++i) m[i] = v[i] + fy * (v[i + nx] - v[i]);
       }
-      sink(y, 0, row);
+      for (int x = 0; x < cam.width_px; ++x) {
+        const auto i = static_cast<size_t>(x / step);
+        const float fx = static_cast<float>(x % step) / static_cast<float>(step);
+        float layer[6];
+        for (size_t c = 0; c < 6; ++c) {
+          const float* m = mixed.data() + c * nx + i;
+          layer[c] = m[0] + fx * (m[1] - m[0]);
+        }
+        if (in.layers) {
+          std::copy(layer, layer + 3, in.layers->inscatter.pixel(x, y));
+          std::copy(layer + 3, layer + 6, in.layers->transmittance.pixel(x, y));
+          if (in.layers->surface.data) {
+            float* p = in.layers->surface.pixel(x, y);
+            for (int c = 0; c < 3; ++c) p[c] = static_cast<float>(in.background[c]);
+          }
+        } else {
+          row[static_cast<size_t>(x)] = {Rgb(layer[0], layer[1], layer[2]), Rgb(layer[3], layer[4], layer[5]), in.background};
+        }
+      }
+      if (!in.layers) sink(y, 0, row);
     }
   });
   return step;
