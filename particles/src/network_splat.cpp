@@ -241,6 +241,14 @@ int splat_network(const SplatInputs& in, std::span<const uint32_t> front_to_back
         float* m = mixed.data() + c * nx;
         for (size_t i = 0; i < nx; ++i) m[i] = v[i] + fy * (v[i + nx] - v[i]);
       }
+      // The row's pixels in the caller's layers, held in locals: stores through the spans' own
+      // pointers would reload them after each (they might alias).
+      float* const to[3] = {in.layers ? in.layers->inscatter.pixel(0, y) : nullptr, in.layers ? in.layers->transmittance.pixel(0, y) : nullptr,
+                            in.layers && in.layers->surface.data ? in.layers->surface.pixel(0, y) : nullptr};
+      const size_t channels[3] = {in.layers ? static_cast<size_t>(in.layers->inscatter.channels) : 0,
+                                  in.layers ? static_cast<size_t>(in.layers->transmittance.channels) : 0,
+                                  to[2] ? static_cast<size_t>(in.layers->surface.channels) : 0};
+      const float behind[3] = {static_cast<float>(in.background.r), static_cast<float>(in.background.g), static_cast<float>(in.background.b)};
       for (int x = 0; x < cam.width_px; ++x) {
         const auto i = static_cast<size_t>(x / step);
         const float fx = static_cast<float>(x % step) / static_cast<float>(step);
@@ -249,13 +257,11 @@ int splat_network(const SplatInputs& in, std::span<const uint32_t> front_to_back
           const float* m = mixed.data() + c * nx + i;
           layer[c] = m[0] + fx * (m[1] - m[0]);
         }
-        if (in.layers) {
-          std::copy(layer, layer + 3, in.layers->inscatter.pixel(x, y));
-          std::copy(layer + 3, layer + 6, in.layers->transmittance.pixel(x, y));
-          if (in.layers->surface.data) {
-            float* p = in.layers->surface.pixel(x, y);
-            for (int c = 0; c < 3; ++c) p[c] = static_cast<float>(in.background[c]);
-          }
+        if (to[0]) {
+          const auto at = static_cast<size_t>(x);
+          std::copy(layer, layer + 3, to[0] + at * channels[0]);
+          std::copy(layer + 3, layer + 6, to[1] + at * channels[1]);
+          if (to[2]) std::copy(behind, behind + 3, to[2] + at * channels[2]);
         } else {
           row[static_cast<size_t>(x)] = {Rgb(layer[0], layer[1], layer[2]), Rgb(layer[3], layer[4], layer[5]), in.background};
         }
