@@ -148,8 +148,8 @@ double preview_exposure(const Image& frame) {
 }
 
 struct RowRun {
-  double prepare_s = 0.0, ms = 0.0, update_ms = 0.0;
-  Image last;  // the last frame at the error's size
+  double ms = 0.0, update_ms = 0.0;  // the median frame's
+  Image last;                        // the last frame at the error's size
 };
 
 RowRun run_row(const Showcase& s, const SeedRow& row, const std::filesystem::path& gif_path, const std::filesystem::path& png_path, int threads) {
@@ -158,9 +158,7 @@ RowRun run_row(const Showcase& s, const SeedRow& row, const std::filesystem::pat
   options.threads = threads;
   options.settings = row.settings;
   RowRun run;
-  const Stopwatch watch;
   Solution solution = prepare(frame_scene(row, base, 0), row.method, options);
-  run.prepare_s = watch.seconds();
   RenderOptions render_options;
   render_options.threads = threads;
   const int width = base.camera.width_px, height = base.camera.height_px;
