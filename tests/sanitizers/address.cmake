@@ -35,7 +35,7 @@ set(slow "AirlightBatch.FloatPath|AirlightBatch.TailDifferences|Layers.AnalyticR
          "DomSlab.(MatchesPublished|WideSlab)|LightDepthMap.Update|Froxels.HoldTheLayers|install_consumer"
          "cli_bench_frame|Layers.RenderLayersIntoCallerMemory|Extremes.(EdgesOfTheAllowed|FarBlobs)|AirlightBatch.SlicesAgreeWithQuadrature"
          "NetworkRender.SplatAgreesWithTheMarch|Solution.MisuseIsAClearError|Analytic.GreyShortcut|DomSlab.(DeltaM|ThickSlabs)"
-         "TowardEye.LayersWithinTheStepsOnTheFrameCloud|SurfaceLight.FloorUnderACloud")
+         "TowardEye.LayersWithinTheStepsOnTheFrameCloud|SurfaceLight.FloorUnderACloud|cli_demo")
 string(JOIN "|" slow ${slow})
 if(NOT avx2)  # on EMU128 (emulated float16 conversion) the float16 solve takes 15 sweeps, float32's 7
   string(APPEND slow "|DomSolver.Float16StorageAgrees")
