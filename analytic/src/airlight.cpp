@@ -184,7 +184,7 @@ void AirlightTable::refine() {
   // T > 0 but for underflow: log 1e-30 is e^-69 below every value the lanes can resolve.
   for (size_t k = 0; k < t_.size(); ++k) log_t[k] = std::log(std::max(t_[k], 1e-30f));
   const auto nf = static_cast<size_t>(fine_eta_samples());
-  log_fine_.assign(nf * na, 0.0f);
+  std::vector<float> fine_values(nf * na);  // eta fastest
   for (int fine = 0; fine < fine_eta_samples(); ++fine) {
     const int j = std::min(fine / kFineEta, neta_ - 2);
     double w[4];
@@ -192,9 +192,13 @@ void AirlightTable::refine() {
     for (size_t i = 0; i < na; ++i) {
       double v = 0.0;
       for (int k = 0; k < 4; ++k) v += w[k] * static_cast<double>(log_t[static_cast<size_t>(std::clamp(j - 1 + k, 0, neta_ - 1)) * na + i]);
-      log_fine_[i * nf + static_cast<size_t>(fine)] = static_cast<float>(v);
+      fine_values[i * nf + static_cast<size_t>(fine)] = static_cast<float>(v);
     }
   }
+  // Rows i and i + 1 interleaved (log_fine_pairs).
+  log_fine_.assign(2 * (na - 1) * nf, 0.0f);
+  for (size_t i = 0; i + 1 < na; ++i)
+    for (size_t j = 0; j < nf; ++j) log_fine_[2 * (i * nf + j)] = fine_values[i * nf + j], log_fine_[2 * (i * nf + j) + 1] = fine_values[(i + 1) * nf + j];
 }
 
 void add_airlight_float64(const AirlightTable& table, const AirlightChannel& light, const SegmentBatch& batch, float* out) {

@@ -34,8 +34,8 @@ float log_tail_scalar(const AirlightTable& table, float u, float eta, float w, f
   float fe = (std::clamp(eta, -eta_max, eta_max) + eta_max) * (static_cast<float>(ne - 1) / (2.0f * eta_max));
   float fi = std::min(std::floor(fa), static_cast<float>(na - 2)), fj = std::min(std::floor(fe), static_cast<float>(ne - 2));
   float x = fa - fi, y = fe - fj;
-  const float* t = table.log_fine_values().data() + static_cast<size_t>(fi * static_cast<float>(ne) + fj);  // eta fastest
-  float t0 = t[0] + x * (t[ne] - t[0]), t1 = t[1] + x * (t[ne + 1] - t[1]);
+  const float* t = table.log_fine_pairs().data() + 2 * static_cast<size_t>(fi * static_cast<float>(ne) + fj);  // t00 t10 t01 t11
+  float t0 = t[0] + x * (t[1] - t[0]), t1 = t[2] + x * (t[3] - t[2]);
   scale = 2.0f / ((1.0f + w) * (1.0f + a));
   return t0 + y * (t1 - t0);
 }
@@ -90,13 +90,13 @@ void sum_tails_scalar(const AirlightTable& table, const TailRow& row, size_t i, 
 }  // namespace
 
 void tail_sums(const AirlightTable& table, const TailRow& row, const float* d, float* const sums[3]) {
-  HWY_DYNAMIC_DISPATCH(TailSums)(table.log_fine_values().data(), table.a_samples(), table.fine_eta_samples(),
+  HWY_DYNAMIC_DISPATCH(TailSums)(table.log_fine_pairs().data(), table.a_samples(), table.fine_eta_samples(),
                                  static_cast<float>(AirlightTable::kEtaMax), row, d, sums);
 }
 
 void airlight_slices(const AirlightTable& table, const TailRow& row, std::span<const float> distances, float* inscatter, float* transmittance,
                      size_t slice_stride) {
-  HWY_DYNAMIC_DISPATCH(AirlightSlices)(table.log_fine_values().data(), table.a_samples(), table.fine_eta_samples(),
+  HWY_DYNAMIC_DISPATCH(AirlightSlices)(table.log_fine_pairs().data(), table.a_samples(), table.fine_eta_samples(),
                                        static_cast<float>(AirlightTable::kEtaMax), row, distances.data(), distances.size(), inscatter,
                                        transmittance, slice_stride);
 }
@@ -187,7 +187,7 @@ void add_airlight_reference(const AirlightTable& table, const AirlightChannel& l
 void add_airlight(const AirlightTable& table, const AirlightChannel& light, const SegmentBatch& batch, float* out) {
   std::vector<float> result(batch.count), fallback(batch.count);
   const float params[6] = {light.x, light.y, light.z, light.sigma_t, light.sigma_s, light.intensity};
-  size_t done = HWY_DYNAMIC_DISPATCH(AirlightBatch)(table.log_fine_values().data(), table.a_samples(), table.fine_eta_samples(),
+  size_t done = HWY_DYNAMIC_DISPATCH(AirlightBatch)(table.log_fine_pairs().data(), table.a_samples(), table.fine_eta_samples(),
                                                     static_cast<float>(AirlightTable::kEtaMax), params, batch.ox, batch.oy,
                                                     batch.oz, batch.dx, batch.dy, batch.dz, batch.length, batch.count,
                                                     result.data(), fallback.data());

@@ -106,10 +106,13 @@ class AirlightTable {
   int eta_samples() const { return neta_; }
   const std::vector<float>& values() const { return t_; }  // a fastest
   // The float32 lanes' form (haze::simd::add_airlight): log T on a grid kFineEta times finer in
-  // eta (a_samples() rows of fine_eta_samples(), eta fastest: a ray's neighbouring slices look
-  // up neighbouring values), resampled from the table by Catmull-Rom in log T along eta. T is steep in eta for forward-scattering media: bilinear
-  // lookups in T itself were 1.2e-2 off eval's bicubic ones at g = 0.9, in this form 8e-4.
-  const std::vector<float>& log_fine_values() const { return log_fine_; }
+  // eta, resampled from the table by Catmull-Rom in log T along eta. T is steep in eta for
+  // forward-scattering media: bilinear lookups in T itself were 1.2e-2 off eval's bicubic ones at
+  // g = 0.9, in this form 8e-4. Stored as pairs of neighbouring a rows, eta fastest: at float
+  // 2 (i fine_eta_samples() + j), log T at (i, j), (i + 1, j), (i, j + 1), (i + 1, j + 1), so that
+  // a bilinear lookup is one 16-byte load (and a ray's neighbouring slices read neighbouring
+  // records); rows i < a_samples() - 1.
+  const std::vector<float>& log_fine_pairs() const { return log_fine_; }
   int fine_eta_samples() const { return kFineEta * (neta_ - 1) + 1; }
 
   static constexpr double kEtaMax = 30.0;
@@ -121,7 +124,7 @@ class AirlightTable {
       : phase_(phase), na_(a_samples), neta_(eta_samples), t_(std::move(values)), origin_(std::move(origin)) {
     refine();
   }
-  void refine();  // log_fine_ from t_
+  void refine();  // log_fine_ (log_fine_pairs) from t_
   PhaseFunction phase_;
   int na_, neta_;
   std::vector<float> t_, log_fine_;

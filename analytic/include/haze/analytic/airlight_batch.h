@@ -2,7 +2,7 @@
 // (the fast path of method `analytic`). ISA-free header: per-target code in analytic/src/airlight_batch-inl.h.
 //
 // Lanes: float32. Per segment and light: the two tails of the tabulated airlight (airlight.h) with
-// bilinear lookups in its fine log table (AirlightTable::log_fine_values), float Log/Exp (Highway
+// bilinear lookups in its fine log table (AirlightTable::log_fine_pairs), float Log/Exp (Highway
 // contrib, <= 4 ulp). Segments where float cannot resolve the geometry (the ray within 1e-3 d_sv
 // of the light) or where the two tails nearly cancel are handed to the float64 path,
 // AirlightTable::eval. Error against quadrature: below 1e-3 for HG g up to 0.9 and sigma_t up to 5
