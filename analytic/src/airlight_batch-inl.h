@@ -14,6 +14,8 @@
 #include <algorithm>
 #include <cfloat>
 #include <cmath>
+#include <cstdint>
+#include <vector>
 
 HWY_BEFORE_NAMESPACE();
 namespace haze::analytic::HWY_NAMESPACE {
@@ -200,6 +202,9 @@ HWY_INLINE void SumTailsN(D d, const float* HWY_RESTRICT table, int na, int ne, 
 
 // Chains UnitTailsFrom interleaves: four fill the out-of-order window on AVX-512 (1.3x over one).
 constexpr int kChains = 4;
+// AirlightSlices' lattice: its anchors every kTop-th slice (4, with a level between, was slower:
+// few of those slices are smooth enough).
+constexpr size_t kTop = 2;
 
 HWY_NOINLINE void TailSums(const float* HWY_RESTRICT table, int na, int ne, float eta_max, const TailRow& row, const float* at,
                            float* const* sums) {
@@ -220,7 +225,11 @@ HWY_NOINLINE void TailSums(const float* HWY_RESTRICT table, int na, int ne, floa
 }
 
 // Slices `distances` of the row, a vector of rays through every slice before the next vector:
-// a ray's neighbouring slices look up neighbouring table values, still in cache.
+// a ray's neighbouring slices look up neighbouring table values, still in cache. The tails of
+// the even slices (and the last) are evaluated, four slices at a time; an odd slice k between
+// them takes the cubic through slices k - 3, k - 1, k + 1 and k + 3 where, in every lane and
+// channel, T(k) times that cubic's error estimated from the fourth differences about it is
+// within kSliceTolerance of the whole ray's in-scatter (airlight_batch.h), else its own tails.
 HWY_NOINLINE void AirlightSlices(const float* HWY_RESTRICT table, int na, int ne, float eta_max, const TailRow& row, const float* distances,
                                  size_t slices, float* HWY_RESTRICT inscatter, float* HWY_RESTRICT transmittance, size_t slice_stride) {
   const hn::ScalableTag<float> d;
@@ -229,56 +238,114 @@ HWY_NOINLINE void AirlightSlices(const float* HWY_RESTRICT table, int na, int ne
   const bool grey = row.sigma_t[0] == row.sigma_t[1] && row.sigma_t[1] == row.sigma_t[2];
   const V zero = hn::Zero(d), one = hn::Set(d, 1.0f);
   HWY_ALIGN float tail[3 * HWY_MAX_BYTES / sizeof(float)];
+  // Per slice of the vector of rays: T and the tails' sums s per channel (kept: a frame allocates nothing).
+  thread_local std::vector<float> kept;
+  kept.resize(6 * slices * lanes + lanes);
+  const size_t misaligned = reinterpret_cast<uintptr_t>(kept.data()) / sizeof(float) % lanes;
+  float* const HWY_RESTRICT t_of = kept.data() + (misaligned ? lanes - misaligned : 0);
+  float* const HWY_RESTRICT s_of = t_of + 3 * slices * lanes;
+  const auto at_slice = [&](size_t k) { return hn::Set(d, distances[std::min(k, slices - 1)]); };
+  // Slice k's channel c of T or s.
+  const auto T_at = [&](size_t k, size_t c) { return t_of + (3 * k + c) * lanes; };
+  const auto s_at = [&](size_t k, size_t c) { return s_of + (3 * k + c) * lanes; };
+  constexpr int kN = kChains;
+  size_t todo[kN + 64];  // slices whose tails are evaluated, up to kN at a time
   for (size_t i = 0; i < row.count; i += lanes) {
     const V t0 = hn::LoadU(d, row.t0 + i), t1 = hn::LoadU(d, row.t1 + i);
-    const V whole0 = hn::LoadU(d, row.whole[0] + i), whole1 = hn::LoadU(d, row.whole[1] + i), whole2 = hn::LoadU(d, row.whole[2] + i);
-    constexpr int kN = kChains;
-    size_t same[kN];
-    std::fill_n(same, kN, i);
-    // Once T(d) g(d) is below 1e-6 of g(t0) in every lane and channel, L_in is g(t0) to that
-    // and further slices skip the tails: both factors only fall with d (g sums what lies past d).
-    bool spent = false;
-    for (size_t k0 = 0; k0 < slices; k0 += kN) {
-      V at[kN], inside[kN];
-      decltype(hn::Lt(zero, zero)) outside[kN];
-      for (int n = 0; n < kN; ++n) {
-        const V at_slice = hn::Set(d, distances[std::min(k0 + n, slices - 1)]);
-        outside[n] = hn::Or(hn::Le(at_slice, t0), hn::Le(t1, t0));
-        at[n] = hn::Min(hn::Max(at_slice, t0), t1), inside[n] = hn::Sub(at[n], t0);
-      }
-      V s[kN][3];
-      if (spent) {
-        for (int n = 0; n < kN; ++n) s[n][0] = s[n][1] = s[n][2] = zero;
-      } else {
+    const V whole[3] = {hn::LoadU(d, row.whole[0] + i), hn::LoadU(d, row.whole[1] + i), hn::LoadU(d, row.whole[2] + i)};
+    for (size_t k = 0; k < slices; ++k) {
+      const V inside = hn::Sub(hn::Min(hn::Max(at_slice(k), t0), t1), t0);
+      const V T0 = hn::Exp(d, hn::Mul(hn::Set(d, -row.sigma_t[0]), inside));
+      hn::Store(T0, d, T_at(k, 0));
+      hn::Store(grey ? T0 : hn::Exp(d, hn::Mul(hn::Set(d, -row.sigma_t[1]), inside)), d, T_at(k, 1));
+      hn::Store(grey ? T0 : hn::Exp(d, hn::Mul(hn::Set(d, -row.sigma_t[2]), inside)), d, T_at(k, 2));
+    }
+    // The sums of slices todo[0, n), kN at a time (the last group padded with its last slice).
+    const auto evaluate = [&](size_t n) {
+      for (size_t g = 0; g < n; g += kN) {
+        size_t same[kN], k[kN];
+        V at[kN], s[kN][3];
+        for (int m = 0; m < kN; ++m) {
+          same[m] = i, k[m] = todo[std::min(g + m, n - 1)];
+          at[m] = hn::Min(hn::Max(at_slice(k[m]), t0), t1);
+        }
         SumTailsN<kN>(d, table, na, ne, eta_max, row, same, at, s);
+        for (int m = 0; m < kN; ++m)
+          for (size_t c = 0; c < 3; ++c) hn::Store(s[m][c], d, s_at(k[m], c));
       }
-      for (int n = 0; n < kN && k0 + n < slices; ++n) {
-        const size_t k = k0 + n;
-        const V T0 = hn::Exp(d, hn::Mul(hn::Set(d, -row.sigma_t[0]), inside[n]));
-        const V T1 = grey ? T0 : hn::Exp(d, hn::Mul(hn::Set(d, -row.sigma_t[1]), inside[n]));
-        const V T2 = grey ? T0 : hn::Exp(d, hn::Mul(hn::Set(d, -row.sigma_t[2]), inside[n]));
-        if (!spent && n == kN - 1) {
-          const V small = hn::Set(d, 1e-6f);
-          spent = hn::AllTrue(d, hn::And(hn::Le(hn::Mul(T0, s[n][0]), hn::Mul(small, whole0)),
-                                         hn::And(hn::Le(hn::Mul(T1, s[n][1]), hn::Mul(small, whole1)),
-                                                 hn::Le(hn::Mul(T2, s[n][2]), hn::Mul(small, whole2)))));
+    };
+    // The lattice's anchors, every kTop-th slice and the last, in groups; once T g is below 1e-6
+    // of g(t0) in every lane and channel at a group's last slice, L_in is g(t0) to that from
+    // there on and the further slices skip their tails (both factors only fall with distance): s
+    // 0 from `spent`.
+    size_t spent = slices;
+    for (size_t k0 = 0; k0 < slices && spent == slices; k0 += kTop * kN) {
+      size_t n = 0;
+      for (size_t k = k0; k < std::min(k0 + kTop * kN, slices); k += kTop) todo[n++] = k;
+      if (k0 + kTop * kN >= slices && (slices - 1) % kTop != 0) todo[n++] = slices - 1;
+      evaluate(n);
+      const size_t last = todo[n - 1];
+      auto small = hn::Not(hn::FirstN(d, 0));
+      for (size_t c = 0; c < 3; ++c)
+        small = hn::And(small, hn::Le(hn::Mul(hn::Load(d, T_at(last, c)), hn::Load(d, s_at(last, c))), hn::Mul(hn::Set(d, 1e-6f), whole[c])));
+      if (hn::AllTrue(d, small)) spent = last + 1;
+    }
+    for (size_t k = spent; k < slices; ++k)
+      for (size_t c = 0; c < 3; ++c) hn::Store(zero, d, s_at(k, c));
+    // Then the slices halfway between known ones, h = kTop / 2, ..., 1 apart from them: each the
+    // cubic through k - 3h, k - h, k + h and k + 3h where sure, else its own tails.
+    for (size_t h = kTop / 2; h >= 1; h /= 2) {
+      size_t n = 0;
+      for (size_t k = h; k + 1 < spent; k += 2 * h) {
+        const bool before = k >= 5 * h, after = k + 5 * h < slices;
+        bool sure = k >= 3 * h && k + 3 * h < slices && (before || after);
+        if (sure) {  // no ray's entry or exit within the cubic's nodes: s bends there (it is constant outside)
+          const V from = at_slice(k - 3 * h), to = at_slice(k + 3 * h);
+          sure = hn::AllFalse(d, hn::Or(hn::And(hn::Lt(from, t0), hn::Lt(t0, to)), hn::And(hn::Lt(from, t1), hn::Lt(t1, to))));
         }
-        const V l0 = hn::IfThenZeroElse(outside[n], hn::Max(zero, hn::NegMulAdd(T0, s[n][0], whole0)));
-        const V l1 = hn::IfThenZeroElse(outside[n], hn::Max(zero, hn::NegMulAdd(T1, s[n][1], whole1)));
-        const V l2 = hn::IfThenZeroElse(outside[n], hn::Max(zero, hn::NegMulAdd(T2, s[n][2], whole2)));
-        const V u0 = hn::IfThenElse(outside[n], one, T0), u1 = hn::IfThenElse(outside[n], one, T1), u2 = hn::IfThenElse(outside[n], one, T2);
-        float* const l_out = inscatter + k * slice_stride + 3 * i;
-        float* const t_out = transmittance + k * slice_stride + 3 * i;
-        if (i + lanes <= row.count) {
-          hn::StoreInterleaved3(l0, l1, l2, d, l_out);
-          hn::StoreInterleaved3(u0, u1, u2, d, t_out);
-        } else {  // the row's last, partial vector
-          const size_t m = 3 * (row.count - i);
-          hn::StoreInterleaved3(l0, l1, l2, d, tail);
-          std::copy_n(tail, m, l_out);
-          hn::StoreInterleaved3(u0, u1, u2, d, tail);
-          std::copy_n(tail, m, t_out);
+        V cubic[3];
+        for (size_t c = 0; c < 3 && sure; ++c) {
+          const V a = hn::Load(d, s_at(k - 3 * h, c)), b = hn::Load(d, s_at(k - h, c)), e = hn::Load(d, s_at(k + h, c));
+          const V f = hn::Load(d, s_at(k + 3 * h, c));
+          cubic[c] = hn::Mul(hn::Sub(hn::Mul(hn::Set(d, 9.0f), hn::Add(b, e)), hn::Add(a, f)), hn::Set(d, 1.0f / 16.0f));
+          // The cubic's error from the fourth differences about it: 3/128 of one (the error is
+          // 9/24 (2h)^4 s'''' at the middle of nodes 2h apart, the difference 16 (2h)^4 s''''), doubled.
+          const V inner = hn::MulAdd(hn::Set(d, 6.0f), e, hn::NegMulAdd(hn::Set(d, 4.0f), hn::Add(b, f), a));       // a - 4 b + 6 e - 4 f
+          const V inner_back = hn::MulAdd(hn::Set(d, 6.0f), b, hn::NegMulAdd(hn::Set(d, 4.0f), hn::Add(a, e), f));  // f - 4 e + 6 b - 4 a
+          V fourth = zero;
+          if (after) fourth = hn::Abs(hn::Add(inner, hn::Load(d, s_at(k + 5 * h, c))));
+          if (before) fourth = hn::Max(fourth, hn::Abs(hn::Add(inner_back, hn::Load(d, s_at(k - 5 * h, c)))));
+          const V error = hn::Mul(hn::Mul(hn::Load(d, T_at(k, c)), fourth), hn::Set(d, 6.0f / 128.0f));
+          sure = hn::AllTrue(d, hn::Le(error, hn::Mul(hn::Set(d, kSliceTolerance), whole[c])));
         }
+        if (sure) {
+          for (size_t c = 0; c < 3; ++c) hn::Store(cubic[c], d, s_at(k, c));
+        } else {
+          todo[n++] = k;
+          if (n == static_cast<size_t>(kN)) evaluate(n), n = 0;
+        }
+      }
+      if (n > 0) evaluate(n);
+    }
+    for (size_t k = 0; k < slices; ++k) {
+      const auto outside = hn::Or(hn::Le(at_slice(k), t0), hn::Le(t1, t0));
+      V l[3], u[3];
+      for (size_t c = 0; c < 3; ++c) {
+        const V T = hn::Load(d, T_at(k, c));
+        l[c] = hn::IfThenZeroElse(outside, hn::Max(zero, hn::NegMulAdd(T, hn::Load(d, s_at(k, c)), whole[c])));
+        u[c] = hn::IfThenElse(outside, one, T);
+      }
+      float* const l_out = inscatter + k * slice_stride + 3 * i;
+      float* const t_out = transmittance + k * slice_stride + 3 * i;
+      if (i + lanes <= row.count) {
+        hn::StoreInterleaved3(l[0], l[1], l[2], d, l_out);
+        hn::StoreInterleaved3(u[0], u[1], u[2], d, t_out);
+      } else {  // the row's last, partial vector
+        const size_t m = 3 * (row.count - i);
+        hn::StoreInterleaved3(l[0], l[1], l[2], d, tail);
+        std::copy_n(tail, m, l_out);
+        hn::StoreInterleaved3(u[0], u[1], u[2], d, tail);
+        std::copy_n(tail, m, t_out);
       }
     }
   }

@@ -169,7 +169,8 @@ TEST_P(AirlightBatchTargets, SlicesMatchScalarReference) {
 }
 
 // Many slices out to where the tails are spent (T g below 1e-6 of g(t0): the kernel stops
-// evaluating them) against each slice by the reference.
+// evaluating them) against each slice by the reference: within the kernel's rounding plus, where
+// the cubic between slices stands for a slice's tails, kSliceTolerance of the whole ray's L_in.
 TEST_P(AirlightBatchTargets, SpentSlicesMatchScalarReference) {
   const size_t n = 37, padded = 48;
   const SliceRow r(n, 23, Rgb(0.26), Rgb(0.234), table());
@@ -182,7 +183,8 @@ TEST_P(AirlightBatchTargets, SpentSlicesMatchScalarReference) {
     std::vector<float> l_ref(3 * n), t_ref(3 * n);
     airlight_slice_reference(table(), r.row, distances[k], l_ref.data(), t_ref.data());
     for (size_t i = 0; i < 3 * n; ++i) {
-      ASSERT_NEAR(l[k * stride + i], l_ref[i], 2e-5f * r.whole[(i % 3) * padded + i / 3] + 1e-30f) << "ray " << i / 3 << " slice " << k;
+      ASSERT_NEAR(l[k * stride + i], l_ref[i], (2e-5f + kSliceTolerance) * r.whole[(i % 3) * padded + i / 3] + 1e-30f)
+          << "ray " << i / 3 << " slice " << k;
       ASSERT_NEAR(t[k * stride + i], t_ref[i], 1e-6f * t_ref[i]) << "ray " << i / 3 << " slice " << k;
     }
   }

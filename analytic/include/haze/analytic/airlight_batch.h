@@ -54,7 +54,12 @@ void airlight_slice(const AirlightTable& table, const TailRow& row, float distan
 // Every slice of `distances` (ascending) the same way, slice k into inscatter[k slice_stride + 3 i
 // + c] (likewise transmittance): a vector of rays through all the slices before the next, four
 // slices' tails at a time; once T g is below 1e-6 of g(t0) in every ray and channel, the further
-// slices take L_in = g(t0) without their tails (both factors only fall with distance).
+// slices take L_in = g(t0) without their tails (both factors only fall with distance). The even
+// slices (and the last) take their tails; an odd slice k takes the cubic through the tails' sums
+// at k - 3, k - 1, k + 1 and k + 3 where, in every ray and channel of its vector, T(k) times the
+// cubic's error as the fourth differences about it estimate it is within kSliceTolerance of the
+// whole ray's in-scatter, else its own tails (log-spaced slices: past the lights and before them
+// the sums vary smoothly from slice to slice; 160 x 90 x 64 froxels of 4 lights: 17% faster).
 void airlight_slices(const AirlightTable& table, const TailRow& row, std::span<const float> distances, float* inscatter, float* transmittance,
                      size_t slice_stride);
 // Where the far tail T g(end) exceeds this share of the near one g(t0), their difference is left
@@ -64,6 +69,8 @@ void airlight_slices(const AirlightTable& table, const TailRow& row, std::span<c
 // and within 1.1e-2 (worst, g 0.5) up to 0.999; in the trade suite's fog_lamps with a sphere's
 // shadows the worst pixel's L_in is 2.9e-4 off the float64 kernel's.
 inline constexpr float kTailsCancel = 0.999f;
+// airlight_slices' interpolated slices: the estimated error of L_in as a share of the whole ray's.
+inline constexpr float kSliceTolerance = 1e-4f;
 
 // Per-pixel layers from the tails at each ray's entry (row.whole) and its end: ray i ends at
 // ends[i] (+inf: never, T = 0), sums[c][i] its tails there; L_in = max(0, whole - T sums) and
