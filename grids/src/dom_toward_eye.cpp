@@ -1,6 +1,8 @@
 // The moments' scattered light toward one eye per cell (dom_toward_eye.h).
 #include "dom_toward_eye.h"
 
+#include <haze/grids/eye_cells.h>
+
 #include <haze/core/progress.h>
 
 #include <algorithm>
@@ -21,15 +23,16 @@ Vec3 decode(double u, double v) {
 
 }  // namespace
 
-TowardEye::TowardEye(const DomSolution& solution) : solution_(solution), separable_(solution.separable) {
-  const auto terms = static_cast<size_t>(solution.terms());
-  table_.resize(static_cast<size_t>(kSide) * kSide * terms);
+TowardEye::TowardEye(const DomSolution& solution)
+    : solution_(solution), separable_(solution.separable), stride_((solution.terms() + 15) / 16 * 16) {
+  const auto terms = static_cast<size_t>(solution.terms()), stride = static_cast<size_t>(stride_);
+  table_.assign(static_cast<size_t>(kSide) * kSide * stride, 0.0f);
   Eigen::VectorXd row, c;
   for (int t = 0; t < kSide; ++t)
     for (int s = 0; s < kSide; ++s) {
       const Vec3 w = decode((s + 0.5) / kSide * 2.0 - 1.0, (t + 0.5) / kSide * 2.0 - 1.0);
       inscatter_weights(solution, -w, row, c);
-      float* to = table_.data() + (static_cast<size_t>(t) * kSide + static_cast<size_t>(s)) * terms;
+      float* to = table_.data() + (static_cast<size_t>(t) * kSide + static_cast<size_t>(s)) * stride;
       for (size_t k = 0; k < terms; ++k) to[k] = static_cast<float>(c(static_cast<Eigen::Index>(k)));
     }
 }
@@ -42,40 +45,21 @@ void TowardEye::fill(const DenseGrid& density, const Vec3& eye, const Rgb& scale
   const size_t cells = plane * static_cast<size_t>(nz);
   out.resize(cells * channels);
   const Vec3 lo = density.bounds().lo, h = density.cell_size();
-  const float half = 0.5f * kSide;
+  const float scales[3] = {static_cast<float>(scale[0]), static_cast<float>(scale[1]), static_cast<float>(scale[2])};
   const auto planes = [&](long long z0, long long z1) {
-    std::array<float, 64> c;  // a cell's weights (terms <= 64: the caller's condition)
     for (auto z = static_cast<int>(z0); z < z1; ++z)
       for (int y = 0; y < ny; ++y) {
-        // The cells' directions from the eye along the row, unnormalized: the map divides by |x| + |y| + |z|.
-        const auto dy = static_cast<float>(lo.y + (y + 0.5) * h.y - eye.y), dz = static_cast<float>(lo.z + (z + 0.5) * h.z - eye.z);
-        const auto ay = std::abs(dy), az = std::abs(dz);
-        for (int x = 0; x < nx; ++x) {
-          const auto dx = static_cast<float>(lo.x + (x + 0.5) * h.x - eye.x);
-          const float n = std::abs(dx) + ay + az;
-          float u = dx / n, v = dy / n;
-          if (dz < 0.0f) {  // the lower hemisphere folded out
-            const float fu = std::copysign(1.0f - std::abs(v), u), fv = std::copysign(1.0f - std::abs(u), v);
-            u = fu, v = fv;
-          }
-          // Bilinear between texel centres, clamped at the map's edge.
-          const float fs = std::clamp((u + 1.0f) * half - 0.5f, 0.0f, kSide - 1.0f), ft = std::clamp((v + 1.0f) * half - 0.5f, 0.0f, kSide - 1.0f);
-          const int s0 = std::min(static_cast<int>(fs), kSide - 2), t0 = std::min(static_cast<int>(ft), kSide - 2);
-          const float a = fs - static_cast<float>(s0), b = ft - static_cast<float>(t0);
-          const float w00 = (1.0f - a) * (1.0f - b), w10 = a * (1.0f - b), w01 = (1.0f - a) * b, w11 = a * b;
-          const float* p00 = table_.data() + (static_cast<size_t>(t0) * kSide + static_cast<size_t>(s0)) * terms;
-          const float* p10 = p00 + terms;
-          const float* p01 = p00 + static_cast<size_t>(kSide) * terms;
-          const float* p11 = p01 + terms;
-          for (size_t k = 0; k < terms; ++k) c[k] = w00 * p00[k] + w10 * p10[k] + w01 * p01[k] + w11 * p11[k];
-          const size_t cell = static_cast<size_t>(z) * plane + static_cast<size_t>(y) * static_cast<size_t>(nx) + static_cast<size_t>(x);
-          for (size_t ch = 0; ch < channels; ++ch) {
-            const float* m = solution_.moments[ch].data() + cell * terms;
-            float j = 0.0f;
-            for (size_t k = 0; k < terms; ++k) j += c[k] * m[k];
-            out[ch * cells + cell] = static_cast<float>(scale[static_cast<int>(ch)]) * std::max(0.0f, j);
-          }
-        }
+        const size_t first = static_cast<size_t>(z) * plane + static_cast<size_t>(y) * static_cast<size_t>(nx);
+        const float* moments[3];
+        float* to[3];
+        for (size_t ch = 0; ch < channels; ++ch) moments[ch] = solution_.moments[ch].data() + first * terms, to[ch] = out.data() + ch * cells + first;
+        EyeCellsRow row;
+        row.table = table_.data(), row.side = kSide, row.terms = static_cast<int>(terms), row.stride = stride_;
+        row.moments = moments, row.readable = (cells - first) * terms, row.scale = scales, row.channels = static_cast<int>(channels);
+        row.x0 = static_cast<float>(lo.x + 0.5 * h.x - eye.x), row.dx = static_cast<float>(h.x);
+        row.dy = static_cast<float>(lo.y + (y + 0.5) * h.y - eye.y), row.dz = static_cast<float>(lo.z + (z + 0.5) * h.z - eye.z);
+        row.count = nx, row.out = to;
+        eye_cells_row(row);
       }
   };
   // A body of one reference: std::function keeps it without allocating.

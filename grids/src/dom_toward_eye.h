@@ -18,7 +18,8 @@ class TowardEye {
   bool made_for(const DomSolution& solution) const { return &solution == &solution_ && solution.separable == separable_; }
   // Per cell of the solution's grid (`density`'s resolution and bounds) and channel:
   // scale[c] max(0, c(-w) . m_c), w the unit direction from `eye` to the cell's centre (c(-w)
-  // bilinear in the table), into out[c * cells + cell] (kept by the caller), on the threads.
+  // bilinear in the table), into out[c * cells + cell] (kept by the caller), on the threads: rows
+  // of cells through eye_cells_row (haze/grids/eye_cells.h).
   void fill(const DenseGrid& density, const Vec3& eye, const Rgb& scale, std::vector<float>& out, int threads) const;
   int channels() const { return solution_.channels; }
 
@@ -29,7 +30,8 @@ class TowardEye {
  private:
   const DomSolution& solution_;
   std::shared_ptr<const SeparablePhase> separable_;  // the factorization the table was made from
-  std::vector<float> table_;  // [(v * kSide + u) * terms + k]
+  int stride_;  // terms rounded up to 16 (EyeCellsRow::stride)
+  std::vector<float> table_;  // [(v * kSide + u) * stride_ + k], zeros past terms
 };
 
 }  // namespace haze::grids::dom
