@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <optional>
 
@@ -719,10 +720,12 @@ void march_row_distances(const Marcher& m, const MarchVolume& v, const View& vie
   thread_local std::vector<Near> near;
   thread_local std::vector<float> packed, result;
   thread_local std::vector<Vec3f> l, t;  // each ray's layers so far
+  thread_local std::vector<size_t> start, next;
+  thread_local std::vector<uint32_t> column;
   rays.resize(width), columns.resize(width), near.clear();
   // Grown once to the most a row can take (every column near every light, in every slice), so
   // that no later frame's row grows them.
-  near.reserve(width * m.scene.lights.size()), packed.reserve(9 * width * n), result.reserve(6 * width * n);
+  near.reserve(width * m.scene.lights.size()), packed.reserve(9 * width * n), result.reserve(6 * width * n), column.reserve(width * n);
   camera.row_rays(y, rays.data());
   size_t count = 0;
   for (size_t x = 0; x < width; ++x) {
@@ -754,12 +757,20 @@ void march_row_distances(const Marcher& m, const MarchVolume& v, const View& vie
     }
     return false;
   };
+  // The segments slice by slice: slice k's are [start[k], start[k + 1]), of the columns `column`
+  // (a counting sort over the columns' slice ranges).
+  start.assign(n + 1, 0), column.resize(count);
+  for (size_t x = 0; x < width; ++x)
+    for (size_t k = columns[x].k0; k < columns[x].k1; ++k) ++start[k + 1];
+  for (size_t k = 0; k < n; ++k) start[k + 1] += start[k];
+  next.assign(start.begin(), start.end() - 1);
+  for (size_t x = 0; x < width; ++x)
+    for (size_t k = columns[x].k0; k < columns[x].k1; ++k) column[next[k]++] = static_cast<uint32_t>(x);
   packed.resize(9 * count), result.assign(6 * count, 0.0f);
-  size_t i = 0;
   for (size_t k = 0; k < n; ++k)
-    for (size_t x = 0; x < width; ++x) {
+    for (size_t i = start[k]; i < start[k + 1]; ++i) {
+      const size_t x = column[i];
       const Column& c = columns[x];
-      if (k < c.k0 || k >= c.k1) continue;
       const double from = std::max(c.t0, k == 0 ? 0.0 : distances[k - 1]), to = std::min(c.t1, distances[k]);
       const double slice = distances[k] - (k == 0 ? 0.0 : distances[k - 1]);
       const double coarse = std::max(pitch * from, std::min(slice / kSliceSteps, kStepShare * from)), step = coarse > m.step && !fine(c, from, to, coarse) ? coarse : m.step;
@@ -768,7 +779,6 @@ void march_row_distances(const Marcher& m, const MarchVolume& v, const View& vie
       const double segment[9] = {r.origin.x, r.origin.y, r.origin.z, r.direction.x, r.direction.y, r.direction.z, from, (to - from) / steps,
                                  static_cast<double>(steps)};
       for (size_t e = 0; e < 9; ++e) packed[e * count + i] = static_cast<float>(segment[e]);
-      ++i;
     }
   if (count > 0) march_rays(v, m.volume.phase, packet_of(packed, result, count, count));
   const auto row = [&](std::vector<float>& buffer, size_t a) { return buffer.data() + a * count; };
@@ -776,13 +786,10 @@ void march_row_distances(const Marcher& m, const MarchVolume& v, const View& vie
   l.assign(width, Vec3f(0.0f)), t.assign(width, Vec3f(1.0f));
   const size_t per_slice = width * static_cast<size_t>(camera.height_px), first = static_cast<size_t>(y) * width;
   const size_t grey = v.channels == 1 ? 0 : 1;  // channel c's row: c times this
-  i = 0;
   for (size_t k = 0; k < n; ++k) {
-    for (size_t x = 0; x < width; ++x) {
-      if (k >= columns[x].k0 && k < columns[x].k1) {
-        for (size_t c = 0; c < 3; ++c) l[x][c] += t[x][c] * row(result, c * grey)[i], t[x][c] *= row(result, 3 + c * grey)[i];
-        ++i;
-      }
+    for (size_t i = start[k]; i < start[k + 1]; ++i) {
+      const size_t x = column[i];
+      for (size_t c = 0; c < 3; ++c) l[x][c] += t[x][c] * row(result, c * grey)[i], t[x][c] *= row(result, 3 + c * grey)[i];
     }
     std::copy(l.begin(), l.begin() + static_cast<std::ptrdiff_t>(width), out.inscatter.begin() + static_cast<std::ptrdiff_t>(k * per_slice + first));
     std::copy(t.begin(), t.begin() + static_cast<std::ptrdiff_t>(width), out.transmittance.begin() + static_cast<std::ptrdiff_t>(k * per_slice + first));
