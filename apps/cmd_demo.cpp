@@ -13,6 +13,7 @@
 #include "seed_rows.h"
 
 #include <haze/core/error.h>
+#include <haze/core/math.h>
 #include <haze/core/stopwatch.h>
 
 #include <algorithm>
@@ -137,10 +138,7 @@ double preview_exposure(const Image& frame) {
   std::vector<double> lum;
   double peak = 0.0;
   for (int y = 0; y < frame.height(); ++y)
-    for (int x = 0; x < frame.width(); ++x) {
-      const Rgb c = frame.at(x, y);
-      lum.push_back(0.2126 * c.r + 0.7152 * c.g + 0.0722 * c.b), peak = std::max(peak, lum.back());
-    }
+    for (int x = 0; x < frame.width(); ++x) lum.push_back(luminance(frame.at(x, y))), peak = std::max(peak, lum.back());
   std::erase_if(lum, [&](double l) { return l <= 0.01 * peak; });
   if (lum.empty()) return 1.0;
   std::nth_element(lum.begin(), lum.begin() + static_cast<std::ptrdiff_t>(lum.size() * 95 / 100), lum.end());

@@ -7,6 +7,7 @@
 #include "progress_bar.h"
 
 #include <haze/core/error.h>
+#include <haze/core/math.h>
 #include <haze/core/stopwatch.h>
 
 #include <algorithm>
@@ -98,8 +99,6 @@ Rgb untonemap(const Rgb& display) {
   }
   return out;
 }
-
-double luminance(const Rgb& c) { return 0.2126 * c.r + 0.7152 * c.g + 0.0722 * c.b; }
 
 // Relative error -> black (0), red (5%), yellow (10%), white (20% and more).
 Rgb error_colour(double e) {

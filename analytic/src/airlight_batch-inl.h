@@ -249,7 +249,7 @@ HWY_NOINLINE void AirlightSlices(const float* HWY_RESTRICT table, int na, int ne
   const auto T_at = [&](size_t k, size_t c) { return t_of + (3 * k + c) * lanes; };
   const auto s_at = [&](size_t k, size_t c) { return s_of + (3 * k + c) * lanes; };
   constexpr int kN = kChains;
-  size_t todo[kN + 64];  // slices whose tails are evaluated, up to kN at a time
+  size_t todo[kN + 1];  // slices whose tails are evaluated: a group of anchors (and the last slice), or up to kN
   for (size_t i = 0; i < row.count; i += lanes) {
     const V t0 = hn::LoadU(d, row.t0 + i), t1 = hn::LoadU(d, row.t1 + i);
     const V whole[3] = {hn::LoadU(d, row.whole[0] + i), hn::LoadU(d, row.whole[1] + i), hn::LoadU(d, row.whole[2] + i)};
